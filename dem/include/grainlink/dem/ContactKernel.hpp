@@ -1,0 +1,132 @@
+#pragma once
+// Force of one contact, given concrete slot types so the compiler inlines the whole law.
+// Every formula here is written out, with its test, in docs/physics.md §2.
+#include "grainlink/dem/ContactLaw.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <type_traits>
+
+namespace grainlink::dem {
+
+/// Geometry and kinematics of one contact. `normal` points from j (or the wall) to i.
+struct ContactGeometry {
+    Vec3 normal;
+    double overlap_m;
+    double radius_eff_m;          ///< R* = r_i r_j / (r_i + r_j); r_i for walls
+    double mass_eff_kg;           ///< m* = m_i m_j / (m_i + m_j); m_i for walls
+    double arm_i_m;               ///< centre of i to contact point
+    double arm_j_m;               ///< centre of j to contact point (0 for walls)
+    Vec3 contact_velocity_m_s;    ///< velocity of i relative to j at the contact point
+    Vec3 relative_spin_rad_s;     ///< omega_i - omega_j
+};
+
+struct ContactResult {
+    Vec3 force_on_i_N;
+    Vec3 torque_on_i_N_m;
+    Vec3 torque_on_j_N_m;
+    double normal_force_N; ///< repulsive normal force (elastic + damping, >= 0)
+};
+
+namespace detail {
+constexpr double kSqrtFiveSixths = 0.91287092917527685576;
+
+/// Turns a history vector into the current tangent plane, keeping its length (§2.4).
+inline void rotateIntoPlane(Vec3& history, const Vec3& normal) {
+    const double length_sq = history.squaredNorm();
+    if (length_sq == 0.0) return;
+    history -= history.dot(normal) * normal;
+    const double new_sq = history.squaredNorm();
+    if (new_sq > 0.0) history *= std::sqrt(length_sq / new_sq);
+}
+} // namespace detail
+
+template <class Normal, class Damping, class Tangential, class Rolling, class Cohesion>
+inline void evaluateContact(const Damping& damping, const Tangential& tangential,
+                            const Rolling& rolling, const Cohesion& cohesion,
+                            const PairProperties& pair, const ContactGeometry& g, double dt_s,
+                            ContactHistory& history, ContactResult& out) {
+    static_assert(std::is_same_v<Normal, NormalHertz>, "only Hertz normal contact exists");
+    const Vec3& n = g.normal;
+    const double sqrt_r_delta = std::sqrt(g.radius_eff_m * g.overlap_m);
+    // Hertz: S_n = dF/d(delta) = 2 E* sqrt(R* delta); F = 2/3 S_n delta (seed eq. 3).
+    const double normal_stiffness = 2.0 * pair.effective_modulus_Pa * sqrt_r_delta;
+    const double elastic = (2.0 / 3.0) * normal_stiffness * g.overlap_m;
+
+    const double v_normal = g.contact_velocity_m_s.dot(n); // < 0 while approaching
+    double damping_coefficient;
+    if constexpr (std::is_same_v<Damping, DampingViscous>) {
+        damping_coefficient = damping.coefficient_N_s_m; // seed eq. 4
+    } else {
+        damping_coefficient = -2.0 * detail::kSqrtFiveSixths * damping.beta *
+                              std::sqrt(normal_stiffness * g.mass_eff_kg);
+    }
+    // No tensile force from the dashpot: a separating contact cannot pull (§2.2).
+    const double normal_force = std::max(elastic - damping_coefficient * v_normal, 0.0);
+
+    double cohesive = 0.0;
+    if constexpr (std::is_same_v<Cohesion, CohesionLinear>) {
+        cohesive = cohesion.energy_density_J_m3 * M_PI * g.radius_eff_m * g.overlap_m;
+    } else {
+        (void)cohesion;
+    }
+
+    // Tangential spring on the accumulated displacement, turned with the contact plane.
+    const Vec3 v_tangential = g.contact_velocity_m_s - v_normal * n;
+    detail::rotateIntoPlane(history.tangential_m, n);
+    history.tangential_m += v_tangential * dt_s;
+    double k_t, c_t;
+    if constexpr (std::is_same_v<Tangential, TangentialLinear>) {
+        k_t = tangential.stiffness_N_m;
+        c_t = tangential.damping_N_s_m;
+    } else {
+        k_t = 8.0 * pair.effective_shear_modulus_Pa * sqrt_r_delta;
+        c_t = -2.0 * detail::kSqrtFiveSixths * tangential.beta * std::sqrt(k_t * g.mass_eff_kg);
+    }
+    Vec3 f_tangential = -k_t * history.tangential_m - c_t * v_tangential;
+    const double limit = (history.sliding ? pair.tan_slip : pair.tan_stick) * normal_force;
+    const double trial_sq = f_tangential.squaredNorm();
+    if (trial_sq > limit * limit) {
+        // Slip: friction at the sliding angle; the spring keeps the matching stretch (seed eq. 5).
+        f_tangential *= pair.tan_slip * normal_force / std::sqrt(trial_sq);
+        history.tangential_m =
+            k_t > 0.0 ? Vec3(-(f_tangential + c_t * v_tangential) / k_t) : Vec3::Zero();
+        history.sliding = true;
+    } else {
+        history.sliding = false;
+    }
+
+    out.force_on_i_N = (normal_force - cohesive) * n + f_tangential;
+    const Vec3 n_cross_ft = n.cross(f_tangential);
+    out.torque_on_i_N_m = -g.arm_i_m * n_cross_ft;
+    out.torque_on_j_N_m = -g.arm_j_m * n_cross_ft;
+    out.normal_force_N = normal_force;
+
+    if constexpr (std::is_same_v<Rolling, RollingEpsd>) {
+        // EPSD rolling spring on the relative rolling rotation, capped at mu_r R* F_N (§2.6).
+        Vec3 spin = g.relative_spin_rad_s;
+        spin -= spin.dot(n) * n; // twisting is not rolling
+        detail::rotateIntoPlane(history.rolling_N_m, n);
+        const double mu_r = rolling.coefficient;
+        const double k_r = 2.25 * mu_r * mu_r * g.radius_eff_m * g.radius_eff_m * normal_stiffness;
+        history.rolling_N_m -= k_r * dt_s * spin;
+        const double max_moment = mu_r * g.radius_eff_m * normal_force;
+        const double moment_sq = history.rolling_N_m.squaredNorm();
+        if (moment_sq > max_moment * max_moment)
+            history.rolling_N_m *= max_moment / std::sqrt(moment_sq);
+        out.torque_on_i_N_m += history.rolling_N_m;
+        out.torque_on_j_N_m -= history.rolling_N_m;
+    } else {
+        (void)rolling;
+    }
+}
+
+/// Calls `body` with the concrete slot types of `law` (one std::visit per batch of contacts).
+template <class Body> inline void withConcreteLaw(const ContactLaw& law, Body&& body) {
+    std::visit(
+        [&](const auto& normal, const auto& damping, const auto& tangential, const auto& rolling,
+            const auto& cohesion) { body(normal, damping, tangential, rolling, cohesion); },
+        law.normal, law.damping, law.tangential, law.rolling, law.cohesion);
+}
+
+} // namespace grainlink::dem

@@ -1,0 +1,70 @@
+#pragma once
+// Uniform cell grid and a half Verlet list with skin. Each list entry owns the history of its
+// pair, so the contact loop touches no hash table; histories are carried across rebuilds and
+// re-sorts by stable id (docs/physics.md §4).
+#include "grainlink/dem/ContactLaw.hpp"
+#include "grainlink/dem/Types.hpp"
+
+#include <cstdint>
+#include <vector>
+
+namespace grainlink::dem {
+
+/// Bins points into cubic cells covering their bounding box (recomputed at every binning).
+class CellGrid {
+public:
+    /// Bins `positions`; `min_cell_size_m` is the smallest admissible edge.
+    void bin(const std::vector<Vec3>& positions, double min_cell_size_m);
+
+    Eigen::Vector3i cellCoords(const Vec3& p) const;
+    int cellIndex(const Eigen::Vector3i& c) const { return (c.z() * dims_.y() + c.y()) * dims_.x() + c.x(); }
+    const Eigen::Vector3i& dims() const { return dims_; }
+    double cellSize() const { return cell_size_; }
+    /// Particles of cell c are cell_particles[cell_start[c] .. cell_start[c+1]).
+    const std::vector<int>& cellStart() const { return cell_start_; }
+    const std::vector<int>& cellParticles() const { return cell_particles_; }
+    /// Cell index of particle i at binning time.
+    const std::vector<int>& particleCell() const { return particle_cell_; }
+
+private:
+    Vec3 origin_ = Vec3::Zero();
+    double cell_size_ = 1.0;
+    Eigen::Vector3i dims_ = Eigen::Vector3i::Ones();
+    std::vector<int> cell_start_, cell_particles_, particle_cell_;
+};
+
+/// Pairs (i, j), i < j by storage index, closer than r_i + r_j + skin at build time.
+class NeighbourList {
+public:
+    /// Rebuilds from current positions and carries over histories of pairs that were in contact.
+    /// `old_to_new` maps storage indices of the previous build to current ones (empty: identity).
+    void build(const std::vector<Vec3>& positions, const std::vector<double>& radii,
+               double skin_m, const std::vector<std::size_t>& old_to_new, int threads);
+
+    std::size_t pairCount() const { return neighbour.size(); }
+    const CellGrid& grid() const { return grid_; }
+    std::uint64_t buildCount() const { return builds_; }
+    /// Continues a checkpointed run's build counter; the next build brings it to `count`.
+    void restoreBuildCount(std::uint64_t count) { builds_ = count > 0 ? count - 1 : 0; }
+
+    /// Entries of particle i are [first[i], first[i+1]).
+    std::vector<std::size_t> first;
+    std::vector<int> neighbour;
+    std::vector<ContactHistory> history;
+
+    /// Active contact histories with their particles, for checkpoints.
+    struct StoredContact {
+        std::size_t i, j;
+        ContactHistory history;
+    };
+    std::vector<StoredContact> activeContacts() const;
+    /// Installs histories (i < j) to be merged into the next build.
+    void setPendingContacts(std::vector<StoredContact> contacts) { pending_ = std::move(contacts); }
+
+private:
+    CellGrid grid_;
+    std::vector<StoredContact> pending_;
+    std::uint64_t builds_ = 0;
+};
+
+} // namespace grainlink::dem

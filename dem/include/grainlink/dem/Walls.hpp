@@ -1,0 +1,87 @@
+#pragma once
+// Boundaries the particles touch: infinite planes (with an optional friction track) and rigid
+// bodies carrying triangle meshes whose motion is set from outside every step.
+#include "grainlink/dem/ContactLaw.hpp"
+#include "grainlink/dem/TriangleMesh.hpp"
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlink::dem {
+
+/// Rectangle on a plane where another friction applies (the seed's friction track in its bin).
+struct FrictionTrack {
+    Vec3 lower_m;  ///< axis-aligned box containing the track's contact points
+    Vec3 upper_m;
+    double friction_coefficient = 0.0;
+    bool contains(const Vec3& p) const {
+        return (p.array() >= lower_m.array()).all() && (p.array() <= upper_m.array()).all();
+    }
+};
+
+/// Infinite plane; particles live on the side the normal points to.
+struct PlaneWall {
+    std::string name;
+    Vec3 point_m = Vec3::Zero();
+    Vec3 normal = Vec3::UnitZ();
+    /// Wall friction coefficient; unset means the particle law's own Coulomb angles.
+    std::optional<double> friction_coefficient;
+    std::optional<FrictionTrack> track;
+    Material material; ///< wall elasticity; defaults to the particles' material
+};
+
+/// Pose and velocity of a rigid body, world frame, about the body's origin.
+struct RigidBodyState {
+    Vec3 position_m = Vec3::Zero();
+    Quat orientation = Quat::Identity(); ///< body frame -> world frame
+    Vec3 velocity_m_s = Vec3::Zero();
+    Vec3 angular_velocity_rad_s = Vec3::Zero();
+    /// Velocity of the body-fixed point now at world position p.
+    Vec3 pointVelocity(const Vec3& p) const {
+        return velocity_m_s + angular_velocity_rad_s.cross(p - position_m);
+    }
+};
+
+/// Rigid body carrying a triangle mesh (wheel, plate, mole hull). Its state is imposed; the
+/// particles' reaction is accumulated as a wrench about the body origin.
+class MeshBody {
+public:
+    MeshBody(std::string name, TriangleMesh mesh_body_frame, RigidBodyState initial);
+
+    const std::string& name() const { return name_; }
+    const TriangleMesh& mesh() const { return mesh_; }
+    const RigidBodyState& state() const { return state_; }
+    /// Imposes pose and velocity (prescribed motion now, the coupling later).
+    void setState(const RigidBodyState& state);
+
+    std::optional<double> friction_coefficient; ///< unset: particle law's Coulomb angles
+    Material material;                          ///< defaults to the particles' material
+    bool record_triangle_loads = false;
+
+    // Filled by the DEM step: reaction of the particles on the body during the last step.
+    Vec3 force_N = Vec3::Zero();
+    Vec3 torque_N_m = Vec3::Zero();          ///< about the body origin
+    std::vector<Vec3> triangle_force_N;      ///< per triangle, when recorded
+    // Impulse summed since the last resetAccumulatedImpulse() (window averages for coupling).
+    Vec3 impulse_N_s = Vec3::Zero();
+    Vec3 angular_impulse_N_m_s = Vec3::Zero();
+    double accumulated_time_s = 0.0;
+    void resetAccumulatedImpulse();
+
+    /// World-frame vertices at the current pose.
+    const std::vector<Vec3>& worldVertices() const { return world_vertices_; }
+    double boundingRadius() const { return bounding_radius_; }
+
+private:
+    std::string name_;
+    TriangleMesh mesh_;
+    RigidBodyState state_;
+    std::vector<Vec3> world_vertices_;
+    double bounding_radius_ = 0.0;
+};
+
+/// Body state at time t for constant linear and angular velocity from an initial pose.
+RigidBodyState constantVelocityMotion(const RigidBodyState& initial, double t_s);
+
+} // namespace grainlink::dem

@@ -1,0 +1,868 @@
+#include "grainlink/dem/DemSystem.hpp"
+
+#include "grainlink/dem/ContactKernel.hpp"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <sstream>
+
+namespace grainlink::dem {
+
+SimulationError::SimulationError(std::uint64_t step_, ParticleId particle_,
+                                 const std::string& quantity_, const std::string& detail)
+    : std::runtime_error("step " + std::to_string(step_) + ", particle " +
+                         std::to_string(particle_) + ": " + quantity_ + " " + detail),
+      step(step_), particle(particle_), quantity(quantity_) {}
+
+DemSystem::DemSystem(ContactLaw law, std::vector<Material> materials, DemSettings settings)
+    : settings_(settings), law_(std::move(law)), materials_(std::move(materials)) {
+    if (materials_.empty()) throw std::invalid_argument("DemSystem needs at least one material");
+    for (const Material& m : materials_) m.validate();
+    law_.finalize();
+    if (!(settings_.time_step_s > 0.0))
+        throw std::invalid_argument("time_step_s must be > 0, got " +
+                                    std::to_string(settings_.time_step_s));
+    if (settings_.threads < 1) throw std::invalid_argument("threads must be >= 1");
+    if (settings_.integrator == Integrator::Newmark &&
+        !(settings_.newmark_beta >= 0.0 && settings_.newmark_gamma >= 0.5))
+        throw std::invalid_argument("Newmark needs beta >= 0 and gamma >= 0.5");
+    const std::size_t nm = materials_.size();
+    pair_props_.resize(nm * nm);
+    for (std::size_t a = 0; a < nm; ++a)
+        for (std::size_t b = 0; b < nm; ++b)
+            pair_props_[a * nm + b] = pairProperties(materials_[a], materials_[b], law_);
+    phase_.kick = timer_.phase("halfKick");
+    phase_.drift = timer_.phase("drift");
+    phase_.predict = timer_.phase("newmarkPredict");
+    phase_.correct = timer_.phase("newmarkCorrect");
+    phase_.bodies = timer_.phase("moveBodies");
+    phase_.neighbours = timer_.phase("updateNeighbours");
+    phase_.clear = timer_.phase("clearForces");
+    phase_.contacts = timer_.phase("pairContacts");
+    phase_.walls = timer_.phase("planeContacts");
+    phase_.meshes = timer_.phase("meshContacts");
+    phase_.body_forces = timer_.phase("bodyForces");
+    phase_.check = timer_.phase("checkForces");
+}
+
+int DemSystem::addPlane(PlaneWall wall) {
+    if (!(wall.normal.norm() > 0.0)) throw std::invalid_argument("plane '" + wall.name + "' has a zero normal");
+    wall.normal.normalize();
+    if (wall.material.youngs_modulus_Pa == 0.0) wall.material = materials_[0];
+    wall.material.validate();
+    planes_.push_back(std::move(wall));
+    initialised_ = false;
+    return int(planes_.size() - 1);
+}
+
+int DemSystem::addBody(MeshBody body, std::function<RigidBodyState(double)> motion) {
+    if (body.material.youngs_modulus_Pa == 0.0) body.material = materials_[0];
+    body.material.validate();
+    bodies_.push_back(std::move(body));
+    body_motion_.push_back(std::move(motion));
+    initialised_ = false;
+    candidates_stale_ = true;
+    return int(bodies_.size() - 1);
+}
+
+void DemSystem::prepareWalls() {
+    const std::size_t nm = materials_.size();
+    plane_props_.assign(planes_.size(), {});
+    for (std::size_t w = 0; w < planes_.size(); ++w) {
+        const PlaneWall& p = planes_[w];
+        for (std::size_t m = 0; m < nm; ++m)
+            plane_props_[w].push_back(
+                p.friction_coefficient
+                    ? pairProperties(materials_[m], p.material, law_, *p.friction_coefficient)
+                    : pairProperties(materials_[m], p.material, law_));
+        for (std::size_t m = 0; m < nm && p.track; ++m)
+            plane_props_[w].push_back(
+                pairProperties(materials_[m], p.material, law_, p.track->friction_coefficient));
+    }
+    body_props_.assign(bodies_.size(), {});
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+        for (std::size_t m = 0; m < nm; ++m)
+            body_props_[b].push_back(
+                bodies_[b].friction_coefficient
+                    ? pairProperties(materials_[m], bodies_[b].material, law_,
+                                     *bodies_[b].friction_coefficient)
+                    : pairProperties(materials_[m], bodies_[b].material, law_));
+    plane_force_.assign(planes_.size(), Vec3::Zero());
+}
+
+void DemSystem::resizeWallHistories() {
+    const std::size_t n = particles_.size();
+    plane_history_.resize(n * planes_.size());
+    mesh_slots_.resize(n * kMeshSlots);
+}
+
+void DemSystem::initialise() {
+    for (int m : particles_.material)
+        if (m < 0 || std::size_t(m) >= materials_.size())
+            throw std::invalid_argument("particle refers to material " + std::to_string(m) +
+                                        ", but only " + std::to_string(materials_.size()) +
+                                        " are defined");
+    prepareWalls();
+    if (settings_.skin_m <= 0.0) settings_.skin_m = 0.4 * particles_.minRadius();
+    if (settings_.check_time_step) validateTimeStep();
+    const int threads = settings_.threads;
+    const std::size_t n = particles_.size();
+    thread_force_.assign(threads, std::vector<Vec3>(threads > 1 ? n : 0, Vec3::Zero()));
+    thread_torque_.assign(threads, std::vector<Vec3>(threads > 1 ? n : 0, Vec3::Zero()));
+    thread_body_force_.assign(threads, std::vector<Vec3>(bodies_.size()));
+    thread_body_torque_.assign(threads, std::vector<Vec3>(bodies_.size()));
+    thread_plane_force_.assign(threads, std::vector<Vec3>(planes_.size()));
+    thread_triangle_force_.assign(threads, {});
+    for (auto& per_thread : thread_triangle_force_)
+        for (const MeshBody& b : bodies_)
+            per_thread.emplace_back(b.record_triangle_loads ? b.mesh().triangleCount() : 0,
+                                    Vec3::Zero());
+    thread_max_overlap_.assign(threads, 0.0);
+    thread_max_overlap_pair_.assign(threads, {0, 0});
+    // Histories may already be restored from a checkpoint; keep them if the size fits.
+    if (plane_history_.size() != n * planes_.size() || mesh_slots_.size() != n * kMeshSlots)
+        resizeWallHistories();
+    body_reference_.resize(bodies_.size());
+    initialised_ = true;
+    if (reference_position_.size() != n) rebuildNeighbours();
+    else {
+        // Restored: rebuild the pair list at the saved reference so the rebuild schedule and
+        // the storage order continue exactly as in the run that wrote the checkpoint.
+        neighbours_.build(reference_position_, particles_.radius, settings_.skin_m, {}, threads);
+    }
+    candidates_stale_ = true;
+}
+
+void DemSystem::validateTimeStep() const {
+    const double estimate = stableTimeStepEstimate();
+    if (settings_.time_step_s > estimate) {
+        std::ostringstream msg;
+        msg << "time_step_s = " << settings_.time_step_s
+            << " s is above the stability estimate " << estimate
+            << " s (docs/physics.md §3.3); reduce it or set check_time_step: false";
+        throw std::invalid_argument(msg.str());
+    }
+}
+
+double DemSystem::stableTimeStepEstimate() const {
+    double estimate = std::numeric_limits<double>::infinity();
+    if (particles_.empty()) return estimate;
+    // Rayleigh time step of the smallest grain of each material.
+    for (std::size_t m = 0; m < materials_.size(); ++m) {
+        double r_min = std::numeric_limits<double>::infinity(), rho = 0.0;
+        for (std::size_t i = 0; i < particles_.size(); ++i)
+            if (std::size_t(particles_.material[i]) == m && particles_.radius[i] < r_min) {
+                r_min = particles_.radius[i];
+                rho = particles_.mass[i] / (4.0 / 3.0 * M_PI * std::pow(r_min, 3));
+            }
+        if (!std::isfinite(r_min)) continue;
+        const Material& mat = materials_[m];
+        const double shear = mat.youngs_modulus_Pa / (2.0 * (1.0 + mat.poisson_ratio));
+        const double rayleigh = M_PI * r_min * std::sqrt(rho / shear) /
+                                (0.1631 * mat.poisson_ratio + 0.8766);
+        estimate = std::min(estimate, rayleigh);
+    }
+    // An explicit dashpot c is stable only for dt < 2 m*/c (lightest pair, m* = m/2).
+    if (const auto* viscous = std::get_if<DampingViscous>(&law_.damping)) {
+        const double m_min = *std::min_element(particles_.mass.begin(), particles_.mass.end());
+        if (viscous->coefficient_N_s_m > 0.0)
+            estimate = std::min(estimate, m_min / viscous->coefficient_N_s_m);
+    }
+    if (law_.background_damping_1_s > 0.0)
+        estimate = std::min(estimate, 2.0 / law_.background_damping_1_s);
+    return estimate;
+}
+
+void DemSystem::setTimeStep(double dt_s) {
+    if (!(dt_s > 0.0)) throw std::invalid_argument("time step must be > 0");
+    time_offset_s_ = time();
+    step_offset_ = step_;
+    settings_.time_step_s = dt_s;
+    if (initialised_ && settings_.check_time_step) validateTimeStep();
+}
+
+// ---------------------------------------------------------------------------------------------
+// The step
+
+void DemSystem::step() {
+    if (!initialised_) initialise();
+    if (!forces_valid_) {
+        moveBodies(time());
+        computeForces();
+        forces_valid_ = true;
+    }
+    const double t_next = time() + settings_.time_step_s;
+    if (settings_.integrator == Integrator::VelocityVerlet) {
+        kickDrift(0.5, true); // halfKick + drift
+        moveBodies(t_next);
+        computeForces();
+        kickDrift(0.5, false); // halfKick
+    } else {
+        newmarkPredict();
+        moveBodies(t_next);
+        computeForces();
+        newmarkCorrect();
+    }
+    ++step_;
+}
+
+void DemSystem::run(std::uint64_t steps) {
+    for (std::uint64_t k = 0; k < steps; ++k) step();
+}
+
+void DemSystem::angularAcceleration(std::size_t i, Vec3& alpha) const {
+    const Vec3& inertia = particles_.inertia[i];
+    const Vec3& tau = particles_.torque[i];
+    if (particles_.isotropic(i)) {
+        alpha = tau / inertia.x();
+        return;
+    }
+    // Euler's equations in the particle frame (per-axis inertia, seed eq. 2).
+    const Mat3 rot = particles_.orientation[i].toRotationMatrix();
+    const Vec3 w = rot.transpose() * particles_.angular_velocity[i];
+    const Vec3 t = rot.transpose() * tau;
+    const Vec3 body_alpha = (t - w.cross(inertia.cwiseProduct(w))).cwiseQuotient(inertia);
+    alpha = rot * body_alpha;
+}
+
+void DemSystem::kickDrift(double kick_fraction, bool drift) {
+    const double dt = settings_.time_step_s;
+    const std::size_t n = particles_.size();
+    auto& p = particles_;
+    {
+        PhaseTimer::Scope scope(timer_, phase_.kick);
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+        for (std::size_t i = 0; i < n; ++i) {
+            p.velocity[i] += (kick_fraction * dt * p.inv_mass[i]) * p.force[i];
+            Vec3 alpha;
+            angularAcceleration(i, alpha);
+            p.angular_velocity[i] += (kick_fraction * dt) * alpha;
+        }
+    }
+    if (!drift) return;
+    PhaseTimer::Scope scope(timer_, phase_.drift);
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+    for (std::size_t i = 0; i < n; ++i) {
+        p.position[i] += dt * p.velocity[i];
+        p.orientation[i] = rotationFromVector(dt * p.angular_velocity[i]) * p.orientation[i];
+        p.orientation[i].normalize();
+    }
+}
+
+void DemSystem::newmarkPredict() {
+    PhaseTimer::Scope scope(timer_, phase_.predict);
+    const double dt = settings_.time_step_s, beta = settings_.newmark_beta,
+                 gamma = settings_.newmark_gamma;
+    auto& p = particles_;
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 a = p.inv_mass[i] * p.force[i];
+        p.position[i] += dt * p.velocity[i] + (dt * dt * (0.5 - beta)) * a;
+        p.velocity[i] += (dt * (1.0 - gamma)) * a;
+        Vec3 alpha;
+        angularAcceleration(i, alpha);
+        p.orientation[i] = rotationFromVector(dt * p.angular_velocity[i] +
+                                              (dt * dt * (0.5 - beta)) * alpha) *
+                           p.orientation[i];
+        p.angular_velocity[i] += (dt * (1.0 - gamma)) * alpha;
+    }
+}
+
+void DemSystem::newmarkCorrect() {
+    PhaseTimer::Scope scope(timer_, phase_.correct);
+    const double dt = settings_.time_step_s, beta = settings_.newmark_beta,
+                 gamma = settings_.newmark_gamma;
+    auto& p = particles_;
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 a = p.inv_mass[i] * p.force[i];
+        p.position[i] += (beta * dt * dt) * a;
+        p.velocity[i] += (gamma * dt) * a;
+        Vec3 alpha;
+        angularAcceleration(i, alpha);
+        p.orientation[i] = rotationFromVector((beta * dt * dt) * alpha) * p.orientation[i];
+        p.orientation[i].normalize();
+        p.angular_velocity[i] += (gamma * dt) * alpha;
+    }
+}
+
+void DemSystem::moveBodies(double t_s) {
+    PhaseTimer::Scope scope(timer_, phase_.bodies);
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+        if (body_motion_[b]) bodies_[b].setState(body_motion_[b](t_s));
+}
+
+void DemSystem::computeForces() {
+    updateNeighbours();
+    {
+        PhaseTimer::Scope scope(timer_, phase_.clear);
+        std::fill(particles_.force.begin(), particles_.force.end(), Vec3::Zero());
+        std::fill(particles_.torque.begin(), particles_.torque.end(), Vec3::Zero());
+    }
+    pairContacts();
+    planeContacts();
+    meshContacts();
+    bodyForces();
+    checkForces();
+}
+
+// ---------------------------------------------------------------------------------------------
+// Neighbours
+
+void DemSystem::updateNeighbours() {
+    PhaseTimer::Scope scope(timer_, phase_.neighbours);
+    const std::size_t n = particles_.size();
+    const auto& x = particles_.position;
+    double max_sq = 0.0, max_mesh_sq = 0.0;
+    const bool have_bodies = !bodies_.empty();
+#pragma omp parallel for schedule(static) num_threads(settings_.threads) \
+    reduction(max : max_sq, max_mesh_sq)
+    for (std::size_t i = 0; i < n; ++i) {
+        max_sq = std::max(max_sq, (x[i] - reference_position_[i]).squaredNorm());
+        if (have_bodies)
+            max_mesh_sq = std::max(max_mesh_sq, (x[i] - mesh_reference_position_[i]).squaredNorm());
+    }
+    const double skin = settings_.skin_m;
+    if (2.0 * std::sqrt(max_sq) > skin) rebuildNeighbours();
+    if (!have_bodies) return;
+    // A particle-triangle pair may approach by the particle's and the mesh's displacement.
+    double body_move = 0.0;
+    for (std::size_t b = 0; b < bodies_.size() && !candidates_stale_; ++b) {
+        const RigidBodyState &now = bodies_[b].state(), &ref = body_reference_[b];
+        const double angle = 2.0 * std::acos(std::min(
+                                        1.0, std::abs((now.orientation * ref.orientation.conjugate()).w())));
+        body_move = std::max(body_move, (now.position_m - ref.position_m).norm() +
+                                            angle * bodies_[b].boundingRadius());
+    }
+    if (candidates_stale_ || std::sqrt(max_mesh_sq) + body_move > skin) rebuildMeshCandidates();
+}
+
+void DemSystem::rebuildNeighbours() {
+    const std::size_t n = particles_.size();
+    std::vector<std::size_t> old_to_new;
+    const bool resort = settings_.resort_every_builds > 0 &&
+                        neighbours_.buildCount() % std::uint64_t(settings_.resort_every_builds) == 0;
+    if (resort && n > 0) {
+        // Spatial re-sort by cell for memory locality; histories follow by index map.
+        CellGrid grid;
+        grid.bin(particles_.position, 2.0 * particles_.maxRadius() + settings_.skin_m);
+        std::vector<std::size_t> order(n);
+        std::iota(order.begin(), order.end(), 0);
+        const auto& cell = grid.particleCell();
+        std::stable_sort(order.begin(), order.end(),
+                         [&](std::size_t a, std::size_t b) { return cell[a] < cell[b]; });
+        old_to_new.resize(n);
+        for (std::size_t k = 0; k < n; ++k) old_to_new[order[k]] = k;
+        particles_.permute(order);
+        permuteWallHistories(order);
+        candidates_stale_ = true;
+    }
+    neighbours_.build(particles_.position, particles_.radius, settings_.skin_m, old_to_new,
+                      settings_.threads);
+    reference_position_ = particles_.position;
+}
+
+void DemSystem::permuteWallHistories(const std::vector<std::size_t>& order) {
+    const std::size_t np = planes_.size();
+    std::vector<ContactHistory> planes(plane_history_.size());
+    std::vector<MeshContactSlot> slots(mesh_slots_.size());
+    for (std::size_t k = 0; k < order.size(); ++k) {
+        for (std::size_t w = 0; w < np; ++w) planes[k * np + w] = plane_history_[order[k] * np + w];
+        for (int s = 0; s < kMeshSlots; ++s)
+            slots[k * kMeshSlots + s] = mesh_slots_[order[k] * kMeshSlots + s];
+    }
+    plane_history_.swap(planes);
+    mesh_slots_.swap(slots);
+}
+
+void DemSystem::rebuildMeshCandidates() {
+    const std::size_t n = particles_.size();
+    const double skin = settings_.skin_m, r_max = particles_.maxRadius();
+    mesh_grid_.bin(particles_.position, 2.0 * r_max + skin);
+    const auto& start = mesh_grid_.cellStart();
+    const auto& members = mesh_grid_.cellParticles();
+    std::vector<std::pair<std::size_t, std::pair<int, int>>> found;
+    for (std::size_t b = 0; b < bodies_.size(); ++b) {
+        const MeshBody& body = bodies_[b];
+        const auto& v = body.worldVertices();
+        const auto& tris = body.mesh().triangles;
+        for (std::size_t t = 0; t < tris.size(); ++t) {
+            const Vec3 &a = v[tris[t][0]], &bb = v[tris[t][1]], &c = v[tris[t][2]];
+            const Vec3 pad = Vec3::Constant(r_max + skin);
+            const Eigen::Vector3i lo = mesh_grid_.cellCoords(a.cwiseMin(bb).cwiseMin(c) - pad);
+            const Eigen::Vector3i hi = mesh_grid_.cellCoords(a.cwiseMax(bb).cwiseMax(c) + pad);
+            for (int z = lo.z(); z <= hi.z(); ++z)
+                for (int y = lo.y(); y <= hi.y(); ++y)
+                    for (int x = lo.x(); x <= hi.x(); ++x) {
+                        const int cell = mesh_grid_.cellIndex({x, y, z});
+                        for (int k = start[cell]; k < start[cell + 1]; ++k) {
+                            const std::size_t i = std::size_t(members[k]);
+                            const Vec3& p = particles_.position[i];
+                            const double reach = particles_.radius[i] + skin;
+                            if ((closestPointOnTriangle(p, a, bb, c) - p).squaredNorm() < reach * reach)
+                                found.push_back({i, {int(b), int(t)}});
+                        }
+                    }
+        }
+    }
+    std::sort(found.begin(), found.end());
+    mesh_candidate_first_.assign(n + 1, 0);
+    mesh_candidates_.clear();
+    for (const auto& f : found) {
+        ++mesh_candidate_first_[f.first + 1];
+        mesh_candidates_.push_back(f.second);
+    }
+    for (std::size_t i = 0; i < n; ++i) mesh_candidate_first_[i + 1] += mesh_candidate_first_[i];
+    mesh_reference_position_ = particles_.position;
+    for (std::size_t b = 0; b < bodies_.size(); ++b) body_reference_[b] = bodies_[b].state();
+    candidates_stale_ = false;
+}
+
+// ---------------------------------------------------------------------------------------------
+// Forces
+
+void DemSystem::pairContacts() {
+    PhaseTimer::Scope scope(timer_, phase_.contacts);
+    const int threads = settings_.threads;
+    const std::size_t n = particles_.size();
+    const std::size_t nm = materials_.size();
+    const double dt = settings_.time_step_s;
+    auto& p = particles_;
+    withConcreteLaw(law_, [&](const auto& normal, const auto& damping, const auto& tangential,
+                              const auto& rolling, const auto& cohesion) {
+        using Normal = std::decay_t<decltype(normal)>;
+#pragma omp parallel num_threads(threads)
+        {
+            const int t = omp_get_thread_num();
+            // One thread writes straight into the store; with more, each sums into its own
+            // buffer and the buffers are added in thread order (deterministic).
+            Vec3* force = threads > 1 ? thread_force_[t].data() : p.force.data();
+            Vec3* torque = threads > 1 ? thread_torque_[t].data() : p.torque.data();
+            if (threads > 1) {
+                std::fill(thread_force_[t].begin(), thread_force_[t].end(), Vec3::Zero());
+                std::fill(thread_torque_[t].begin(), thread_torque_[t].end(), Vec3::Zero());
+            }
+            double max_ratio = 0.0;
+            std::pair<ParticleId, ParticleId> max_pair{0, 0};
+            const std::size_t begin = n * std::size_t(t) / std::size_t(threads);
+            const std::size_t end = n * std::size_t(t + 1) / std::size_t(threads);
+            ContactGeometry g;
+            ContactResult r;
+            for (std::size_t i = begin; i < end; ++i) {
+                const Vec3 xi = p.position[i];
+                const double ri = p.radius[i];
+                Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
+                for (std::size_t k = neighbours_.first[i]; k < neighbours_.first[i + 1]; ++k) {
+                    const std::size_t j = std::size_t(neighbours_.neighbour[k]);
+                    const Vec3 d = xi - p.position[j];
+                    const double dist_sq = d.squaredNorm();
+                    const double r_sum = ri + p.radius[j];
+                    ContactHistory& h = neighbours_.history[k];
+                    if (dist_sq >= r_sum * r_sum) {
+                        if (h.active()) h = ContactHistory{}; // contact lost: history lapses
+                        continue;
+                    }
+                    const double dist = std::sqrt(dist_sq);
+                    g.normal = d / dist;
+                    g.overlap_m = r_sum - dist;
+                    g.radius_eff_m = ri * p.radius[j] / r_sum;
+                    g.mass_eff_kg = p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]);
+                    g.arm_i_m = ri - 0.5 * g.overlap_m;
+                    g.arm_j_m = p.radius[j] - 0.5 * g.overlap_m;
+                    g.contact_velocity_m_s =
+                        p.velocity[i] - p.velocity[j] -
+                        (g.arm_i_m * p.angular_velocity[i] + g.arm_j_m * p.angular_velocity[j])
+                            .cross(g.normal);
+                    g.relative_spin_rad_s = p.angular_velocity[i] - p.angular_velocity[j];
+                    const PairProperties& props =
+                        pair_props_[std::size_t(p.material[i]) * nm + std::size_t(p.material[j])];
+                    evaluateContact<Normal>(damping, tangential, rolling, cohesion, props, g, dt, h,
+                                            r);
+                    fi += r.force_on_i_N;
+                    ti += r.torque_on_i_N_m;
+                    force[j] -= r.force_on_i_N;
+                    torque[j] += r.torque_on_j_N_m;
+                    const double ratio = g.overlap_m / std::min(ri, p.radius[j]);
+                    if (ratio > max_ratio) {
+                        max_ratio = ratio;
+                        max_pair = {p.id[i], p.id[j]};
+                    }
+                }
+                force[i] += fi;
+                torque[i] += ti;
+            }
+            thread_max_overlap_[t] = max_ratio;
+            thread_max_overlap_pair_[t] = max_pair;
+            if (threads > 1) {
+#pragma omp barrier
+#pragma omp for schedule(static)
+                for (std::size_t i = 0; i < n; ++i) {
+                    Vec3 f = thread_force_[0][i], tq = thread_torque_[0][i];
+                    for (int s = 1; s < threads; ++s) {
+                        f += thread_force_[s][i];
+                        tq += thread_torque_[s][i];
+                    }
+                    p.force[i] = f;
+                    p.torque[i] = tq;
+                }
+            }
+        }
+    });
+}
+
+void DemSystem::planeContacts() {
+    if (planes_.empty()) return;
+    PhaseTimer::Scope scope(timer_, phase_.walls);
+    const int threads = settings_.threads;
+    const std::size_t n = particles_.size(), np = planes_.size(), nm = materials_.size();
+    const double dt = settings_.time_step_s;
+    auto& p = particles_;
+    withConcreteLaw(law_, [&](const auto& normal, const auto& damping, const auto& tangential,
+                              const auto& rolling, const auto& cohesion) {
+        using Normal = std::decay_t<decltype(normal)>;
+#pragma omp parallel num_threads(threads)
+        {
+            const int t = omp_get_thread_num();
+            auto& plane_force = thread_plane_force_[t];
+            std::fill(plane_force.begin(), plane_force.end(), Vec3::Zero());
+            ContactGeometry g;
+            ContactResult r;
+#pragma omp for schedule(static)
+            for (std::size_t i = 0; i < n; ++i) {
+                for (std::size_t w = 0; w < np; ++w) {
+                    const PlaneWall& wall = planes_[w];
+                    ContactHistory& h = plane_history_[i * np + w];
+                    const double dist = (p.position[i] - wall.point_m).dot(wall.normal);
+                    if (dist >= p.radius[i]) {
+                        if (h.active()) h = ContactHistory{};
+                        continue;
+                    }
+                    g.normal = wall.normal;
+                    g.overlap_m = p.radius[i] - dist;
+                    g.radius_eff_m = p.radius[i];
+                    g.mass_eff_kg = p.mass[i];
+                    g.arm_i_m = dist;
+                    g.arm_j_m = 0.0;
+                    g.contact_velocity_m_s =
+                        p.velocity[i] - dist * p.angular_velocity[i].cross(g.normal);
+                    g.relative_spin_rad_s = p.angular_velocity[i];
+                    const Vec3 contact_point = p.position[i] - dist * wall.normal;
+                    std::size_t slot = std::size_t(p.material[i]);
+                    if (wall.track && wall.track->contains(contact_point)) slot += nm;
+                    evaluateContact<Normal>(damping, tangential, rolling, cohesion,
+                                            plane_props_[w][slot], g, dt, h, r);
+                    p.force[i] += r.force_on_i_N;
+                    p.torque[i] += r.torque_on_i_N_m;
+                    plane_force[w] -= r.force_on_i_N;
+                    const double ratio = g.overlap_m / p.radius[i];
+                    if (ratio > thread_max_overlap_[t]) {
+                        thread_max_overlap_[t] = ratio;
+                        thread_max_overlap_pair_[t] = {p.id[i], p.id[i]};
+                    }
+                }
+            }
+        }
+    });
+    for (std::size_t w = 0; w < np; ++w) {
+        plane_force_[w].setZero();
+        for (int t = 0; t < threads; ++t) plane_force_[w] += thread_plane_force_[t][w];
+    }
+}
+
+void DemSystem::meshContacts() {
+    if (bodies_.empty()) return;
+    PhaseTimer::Scope scope(timer_, phase_.meshes);
+    const int threads = settings_.threads;
+    const std::size_t n = particles_.size(), nb = bodies_.size();
+    const double dt = settings_.time_step_s;
+    auto& p = particles_;
+    withConcreteLaw(law_, [&](const auto& normal, const auto& damping, const auto& tangential,
+                              const auto& rolling, const auto& cohesion) {
+        using Normal = std::decay_t<decltype(normal)>;
+#pragma omp parallel num_threads(threads)
+        {
+            const int t = omp_get_thread_num();
+            auto& body_force = thread_body_force_[t];
+            auto& body_torque = thread_body_torque_[t];
+            auto& triangle_force = thread_triangle_force_[t];
+            std::fill(body_force.begin(), body_force.end(), Vec3::Zero());
+            std::fill(body_torque.begin(), body_torque.end(), Vec3::Zero());
+            for (auto& loads : triangle_force) std::fill(loads.begin(), loads.end(), Vec3::Zero());
+            struct Touch {
+                int body, triangle;
+                Vec3 point;
+                double dist;
+            };
+            constexpr int kMaxTouches = 16;
+            Touch touches[kMaxTouches];
+            MeshContactSlot next[kMeshSlots];
+            ContactGeometry g;
+            ContactResult r;
+#pragma omp for schedule(static)
+            for (std::size_t i = 0; i < n; ++i) {
+                MeshContactSlot* slots = &mesh_slots_[i * kMeshSlots];
+                const std::size_t c0 = mesh_candidate_first_[i], c1 = mesh_candidate_first_[i + 1];
+                if (c0 == c1) {
+                    if (slots[0].body >= 0)
+                        for (int s = 0; s < kMeshSlots; ++s) slots[s] = MeshContactSlot{};
+                    continue;
+                }
+                const Vec3 xi = p.position[i];
+                const double ri = p.radius[i];
+                int count = 0;
+                for (std::size_t c = c0; c < c1; ++c) {
+                    const auto [b, tri] = mesh_candidates_[c];
+                    const auto& v = bodies_[std::size_t(b)].worldVertices();
+                    const auto& ids = bodies_[std::size_t(b)].mesh().triangles[std::size_t(tri)];
+                    const Vec3 q = closestPointOnTriangle(xi, v[ids[0]], v[ids[1]], v[ids[2]]);
+                    const double dist_sq = (xi - q).squaredNorm();
+                    if (dist_sq >= ri * ri || count == kMaxTouches) continue;
+                    touches[count++] = {b, tri, q, std::sqrt(dist_sq)};
+                }
+                // Nearest first; a point shared by two triangles (edge, vertex) counts once.
+                std::sort(touches, touches + count, [](const Touch& a, const Touch& b) {
+                    return a.dist != b.dist ? a.dist < b.dist
+                                            : (a.body != b.body ? a.body < b.body
+                                                                : a.triangle < b.triangle);
+                });
+                int used = 0;
+                for (int k = 0; k < count; ++k) {
+                    const Touch& touch = touches[k];
+                    bool duplicate = false;
+                    for (int m = 0; m < k && !duplicate; ++m)
+                        duplicate = touches[m].body == touch.body &&
+                                    (touches[m].point - touch.point).squaredNorm() <
+                                        1e-18 + 1e-16 * ri * ri;
+                    if (duplicate) continue;
+                    // Same triangle, or a neighbour of it with the same normal, keeps history.
+                    const Vec3 n_c = touch.dist > 0.0 ? Vec3((xi - touch.point) / touch.dist)
+                                                      : Vec3::UnitZ();
+                    ContactHistory h;
+                    int best = -1;
+                    for (int s = 0; s < kMeshSlots; ++s)
+                        if (slots[s].body == touch.body && slots[s].triangle == touch.triangle)
+                            best = s;
+                    for (int s = 0; s < kMeshSlots && best < 0; ++s)
+                        if (slots[s].body == touch.body && slots[s].normal.dot(n_c) > 0.99)
+                            best = s;
+                    if (best >= 0) {
+                        h = slots[best].history;
+                        slots[best].body = -1; // consumed
+                    }
+                    const MeshBody& body = bodies_[std::size_t(touch.body)];
+                    g.normal = n_c;
+                    g.overlap_m = ri - touch.dist;
+                    g.radius_eff_m = ri;
+                    g.mass_eff_kg = p.mass[i];
+                    g.arm_i_m = touch.dist;
+                    g.arm_j_m = 0.0;
+                    g.contact_velocity_m_s =
+                        p.velocity[i] - touch.dist * p.angular_velocity[i].cross(n_c) -
+                        body.state().pointVelocity(touch.point);
+                    g.relative_spin_rad_s =
+                        p.angular_velocity[i] - body.state().angular_velocity_rad_s;
+                    const auto& props =
+                        body_props_[std::size_t(touch.body)][std::size_t(p.material[i])];
+                    evaluateContact<Normal>(damping, tangential, rolling, cohesion, props, g, dt,
+                                            h, r);
+                    p.force[i] += r.force_on_i_N;
+                    p.torque[i] += r.torque_on_i_N_m;
+                    body_force[std::size_t(touch.body)] -= r.force_on_i_N;
+                    body_torque[std::size_t(touch.body)] +=
+                        (touch.point - body.state().position_m).cross(-r.force_on_i_N) +
+                        r.torque_on_j_N_m;
+                    auto& loads = triangle_force[std::size_t(touch.body)];
+                    if (!loads.empty()) loads[std::size_t(touch.triangle)] -= r.force_on_i_N;
+                    const double ratio = g.overlap_m / ri;
+                    if (ratio > thread_max_overlap_[t]) {
+                        thread_max_overlap_[t] = ratio;
+                        thread_max_overlap_pair_[t] = {p.id[i], p.id[i]};
+                    }
+                    if (used < kMeshSlots) next[used++] = {touch.body, touch.triangle, n_c, h};
+                }
+                for (int s = 0; s < kMeshSlots; ++s) slots[s] = s < used ? next[s] : MeshContactSlot{};
+            }
+        }
+    });
+    for (std::size_t b = 0; b < nb; ++b) {
+        MeshBody& body = bodies_[b];
+        body.force_N.setZero();
+        body.torque_N_m.setZero();
+        for (int t = 0; t < threads; ++t) {
+            body.force_N += thread_body_force_[t][b];
+            body.torque_N_m += thread_body_torque_[t][b];
+        }
+        if (body.record_triangle_loads) {
+            std::fill(body.triangle_force_N.begin(), body.triangle_force_N.end(), Vec3::Zero());
+            for (int t = 0; t < threads; ++t)
+                for (std::size_t k = 0; k < body.triangle_force_N.size(); ++k)
+                    body.triangle_force_N[k] += thread_triangle_force_[t][b][k];
+        }
+        body.impulse_N_s += dt * body.force_N;
+        body.angular_impulse_N_m_s += dt * body.torque_N_m;
+        body.accumulated_time_s += dt;
+    }
+}
+
+void DemSystem::bodyForces() {
+    PhaseTimer::Scope scope(timer_, phase_.body_forces);
+    const Vec3 g = settings_.gravity_m_s2;
+    const double k_h = law_.background_damping_1_s;
+    auto& p = particles_;
+    const std::size_t n = p.size();
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+    for (std::size_t i = 0; i < n; ++i) {
+        p.force[i] += p.mass[i] * g;
+        if (k_h > 0.0) {
+            // Background damping k_h (docs/physics.md §2.8); mean moment for anisotropic grains.
+            p.force[i] -= (k_h * p.mass[i]) * p.velocity[i];
+            p.torque[i] -= (k_h * p.inertia[i].mean()) * p.angular_velocity[i];
+        }
+    }
+}
+
+void DemSystem::checkForces() {
+    PhaseTimer::Scope scope(timer_, phase_.check);
+    max_overlap_ratio_ = 0.0;
+    std::pair<ParticleId, ParticleId> worst{0, 0};
+    for (std::size_t t = 0; t < thread_max_overlap_.size(); ++t)
+        if (thread_max_overlap_[t] > max_overlap_ratio_) {
+            max_overlap_ratio_ = thread_max_overlap_[t];
+            worst = thread_max_overlap_pair_[t];
+        }
+    for (double& v : thread_max_overlap_) v = 0.0;
+    if (max_overlap_ratio_ > settings_.max_overlap_ratio) {
+        std::ostringstream msg;
+        msg << "= " << max_overlap_ratio_ << " of the radius"
+            << (worst.first != worst.second ? " against particle " + std::to_string(worst.second)
+                                            : std::string(" against a wall"))
+            << " exceeds max_overlap_ratio " << settings_.max_overlap_ratio
+            << " (time step too large or stiffness too low)";
+        throw SimulationError(step_ + 1, worst.first, "overlap", msg.str());
+    }
+    const auto& p = particles_;
+    const std::size_t n = p.size();
+    std::size_t bad = n;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : bad)
+    for (std::size_t i = 0; i < n; ++i)
+        if (!p.force[i].allFinite() || !p.torque[i].allFinite() || !p.position[i].allFinite())
+            bad = std::min(bad, i);
+    if (bad < n) {
+        const std::string what = !p.position[bad].allFinite() ? "position"
+                                 : !p.force[bad].allFinite()  ? "force"
+                                                              : "torque";
+        throw SimulationError(step_ + 1, p.id[bad], what, "is not finite");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Diagnostics and state
+
+std::size_t DemSystem::contactCount() const {
+    std::size_t count = 0;
+    const auto& p = particles_;
+    for (std::size_t i = 0; i + 1 < neighbours_.first.size(); ++i)
+        for (std::size_t k = neighbours_.first[i]; k < neighbours_.first[i + 1]; ++k) {
+            const std::size_t j = std::size_t(neighbours_.neighbour[k]);
+            const double r = p.radius[i] + p.radius[j];
+            if ((p.position[i] - p.position[j]).squaredNorm() < r * r) ++count;
+        }
+    return count;
+}
+
+std::size_t DemSystem::wallContactCount() const {
+    std::size_t count = 0;
+    for (const ContactHistory& h : plane_history_) count += h.active() ? 1 : 0;
+    for (const MeshContactSlot& s : mesh_slots_) count += s.body >= 0 ? 1 : 0;
+    return count;
+}
+
+Energies DemSystem::energies() const {
+    Energies e;
+    const auto& p = particles_;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        e.translational_J += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
+        const Mat3 rot = p.orientation[i].toRotationMatrix();
+        const Vec3 w = rot.transpose() * p.angular_velocity[i];
+        e.rotational_J += 0.5 * w.dot(p.inertia[i].cwiseProduct(w));
+        e.gravitational_J -= p.mass[i] * settings_.gravity_m_s2.dot(p.position[i]);
+    }
+    // Stored elastic energy: Hertz 8/15 E* sqrt(R*) delta^(5/2) plus 1/2 k_t |delta_t|^2.
+    const std::size_t nm = materials_.size();
+    auto tangential_energy = [&](const PairProperties& props, double r_eff, double overlap,
+                                 const ContactHistory& h) {
+        double k_t = 0.0;
+        if (const auto* lin = std::get_if<TangentialLinear>(&law_.tangential)) k_t = lin->stiffness_N_m;
+        else k_t = 8.0 * props.effective_shear_modulus_Pa * std::sqrt(r_eff * overlap);
+        return 0.5 * k_t * h.tangential_m.squaredNorm();
+    };
+    auto hertz_energy = [](const PairProperties& props, double r_eff, double overlap) {
+        return 8.0 / 15.0 * props.effective_modulus_Pa * std::sqrt(r_eff) * std::pow(overlap, 2.5);
+    };
+    for (std::size_t i = 0; i + 1 < neighbours_.first.size(); ++i)
+        for (std::size_t k = neighbours_.first[i]; k < neighbours_.first[i + 1]; ++k) {
+            const std::size_t j = std::size_t(neighbours_.neighbour[k]);
+            const double r_sum = p.radius[i] + p.radius[j];
+            const double overlap = r_sum - (p.position[i] - p.position[j]).norm();
+            if (overlap <= 0.0) continue;
+            const PairProperties& props =
+                pair_props_[std::size_t(p.material[i]) * nm + std::size_t(p.material[j])];
+            const double r_eff = p.radius[i] * p.radius[j] / r_sum;
+            e.elastic_J += hertz_energy(props, r_eff, overlap) +
+                           tangential_energy(props, r_eff, overlap, neighbours_.history[k]);
+        }
+    for (std::size_t i = 0; i < p.size() && !plane_props_.empty(); ++i)
+        for (std::size_t w = 0; w < planes_.size(); ++w) {
+            const double overlap =
+                p.radius[i] - (p.position[i] - planes_[w].point_m).dot(planes_[w].normal);
+            if (overlap <= 0.0) continue;
+            const PairProperties& props = plane_props_[w][std::size_t(p.material[i])];
+            e.elastic_J += hertz_energy(props, p.radius[i], overlap) +
+                           tangential_energy(props, p.radius[i], overlap,
+                                             plane_history_[i * planes_.size() + w]);
+        }
+    return e;
+}
+
+DemSystem::Internals DemSystem::saveInternals() const {
+    Internals s;
+    s.step = step_;
+    s.contacts = neighbours_.activeContacts();
+    s.plane_history = plane_history_;
+    s.mesh_slots = mesh_slots_;
+    s.reference_position = reference_position_;
+    s.mesh_reference_position = mesh_reference_position_;
+    for (const MeshBody& b : bodies_) s.body_states.push_back(b.state());
+    s.body_reference = body_reference_;
+    s.neighbour_builds = neighbours_.buildCount();
+    s.forces_valid = forces_valid_;
+    return s;
+}
+
+void DemSystem::restoreInternals(const Internals& s) {
+    if (s.body_states.size() != bodies_.size())
+        throw std::runtime_error("checkpoint has " + std::to_string(s.body_states.size()) +
+                                 " mesh bodies, the scenario defines " +
+                                 std::to_string(bodies_.size()));
+    step_ = s.step;
+    step_offset_ = s.step;
+    time_offset_s_ = double(s.step) * settings_.time_step_s;
+    plane_history_ = s.plane_history;
+    mesh_slots_ = s.mesh_slots;
+    reference_position_ = s.reference_position;
+    mesh_reference_position_ = s.mesh_reference_position;
+    for (std::size_t b = 0; b < bodies_.size(); ++b) bodies_[b].setState(s.body_states[b]);
+    body_reference_ = s.body_reference;
+    neighbours_ = NeighbourList{};
+    neighbours_.setPendingContacts(s.contacts);
+    neighbours_.restoreBuildCount(s.neighbour_builds);
+    forces_valid_ = s.forces_valid;
+    initialised_ = false;
+}
+
+} // namespace grainlink::dem
