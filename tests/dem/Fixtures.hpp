@@ -2,6 +2,10 @@
 // Small builders shared by the DEM tests.
 #include "grainlink/dem/DemSystem.hpp"
 
+#include <algorithm>
+#include <cmath>
+#include <random>
+
 namespace grainlink::dem::testing {
 
 inline Material soil(double youngs_modulus_Pa = 1e7, double poisson = 0.3, double density = 2500.0) {
@@ -58,5 +62,127 @@ struct HertzImpact {
     /// t_c = 2.94328 delta_max / v0 (integral of the Hertz energy equation).
     double duration() const { return 2.9432 * maxOverlap() / speed_m_s; }
 };
+
+/// Normal impact reduced to one degree of freedom, the overlap delta(t), with the force law of
+/// ContactKernel.hpp written out again independently:
+///   m* delta'' = -F,  F = max(4/3 E* sqrt(R*) delta^1.5 + c(delta) delta', 0)      (seed eq. 3)
+/// c = k_n (DampingViscous, seed eq. 4) or c = -2 sqrt(5/6) beta sqrt(2 E* sqrt(R* delta) m*)
+/// (DampingRestitution, Tsuji), beta = ln e / sqrt(ln^2 e + pi^2). The max(., 0) is the clamp the
+/// kernel applies: a separating dashpot never pulls. Integrated with classical RK4 at a step far
+/// below the DEM one, it is the reference the DEM impacts are compared with.
+struct NormalImpactOde {
+    double effective_modulus_Pa, radius_eff_m, mass_eff_kg;
+    double viscous_N_s_m = 0.0;    ///< k_n; used when restitution_set is 0
+    double restitution_set = 0.0;  ///< e of DampingRestitution; 0 selects the viscous dashpot
+    bool clamp = true;             ///< F >= 0 as in the kernel; false lets the dashpot pull
+
+    double force(double delta, double rate) const {
+        if (delta <= 0.0) return 0.0;
+        const double elastic = 4.0 / 3.0 * effective_modulus_Pa * std::sqrt(radius_eff_m) *
+                               std::pow(delta, 1.5);
+        double c = viscous_N_s_m;
+        if (restitution_set > 0.0) {
+            const double log_e = std::log(restitution_set);
+            const double beta = log_e / std::sqrt(log_e * log_e + M_PI * M_PI);
+            const double stiffness = 2.0 * effective_modulus_Pa * std::sqrt(radius_eff_m * delta);
+            c = -2.0 * std::sqrt(5.0 / 6.0) * beta * std::sqrt(stiffness * mass_eff_kg);
+        }
+        return clamp ? std::max(elastic + c * rate, 0.0) : elastic + c * rate;
+    }
+
+    struct Result {
+        double restitution;  ///< exit speed / impact speed
+        double duration_s;   ///< time with delta > 0
+        double max_overlap_m;
+    };
+
+    /// RK4 from delta = 0, delta' = speed until delta returns to 0; `steps` per elastic duration.
+    Result impact(double speed_m_s, int steps = 200000) const {
+        const HertzImpact elastic{effective_modulus_Pa, radius_eff_m, mass_eff_kg, speed_m_s};
+        const double h = elastic.duration() / steps;
+        double x = 0.0, u = speed_m_s, t = 0.0, x_max = 0.0;
+        auto acc = [&](double d, double r) { return -force(d, r) / mass_eff_kg; };
+        for (long k = 0; k < 100L * steps; ++k) {
+            const double k1x = u, k1u = acc(x, u);
+            const double k2x = u + 0.5 * h * k1u, k2u = acc(x + 0.5 * h * k1x, k2x);
+            const double k3x = u + 0.5 * h * k2u, k3u = acc(x + 0.5 * h * k2x, k3x);
+            const double k4x = u + h * k3u, k4u = acc(x + h * k3x, k4x);
+            const double x_new = x + h / 6.0 * (k1x + 2.0 * k2x + 2.0 * k3x + k4x);
+            const double u_new = u + h / 6.0 * (k1u + 2.0 * k2u + 2.0 * k3u + k4u);
+            if (x_new <= 0.0 && k > 0) {
+                // Crossing inside this step: interpolate time and rate linearly.
+                const double s = x / (x - x_new);
+                return {-(u + s * (u_new - u)) / speed_m_s, t + s * h, x_max};
+            }
+            x = x_new;
+            u = u_new;
+            t += h;
+            x_max = std::max(x_max, x);
+        }
+        return {std::nan(""), std::nan(""), x_max};
+    }
+};
+
+/// Effective modulus of two grains (or a grain and a wall) of the same material.
+inline double effectiveModulus(const Material& m) {
+    return m.youngs_modulus_Pa / (2.0 * (1.0 - m.poisson_ratio * m.poisson_ratio));
+}
+
+inline double sphereMass(double r, double rho) { return 4.0 / 3.0 * M_PI * r * r * r * rho; }
+
+/// Six planes enclosing [lower, upper], normals pointing inwards.
+inline void addBoxPlanes(DemSystem& sys, const Vec3& lower, const Vec3& upper) {
+    for (int d = 0; d < 3; ++d) {
+        PlaneWall low, high;
+        low.name = "low" + std::to_string(d);
+        high.name = "high" + std::to_string(d);
+        low.point_m = lower;
+        high.point_m = upper;
+        low.normal = Vec3::Unit(d);
+        high.normal = -Vec3::Unit(d);
+        sys.addPlane(low);
+        sys.addPlane(high);
+    }
+}
+
+/// Grains on a jittered cubic lattice filling [lower, upper] (radius r_min..r_max, random
+/// velocity of each component in +-speed); deterministic for a given seed.
+inline void addLattice(DemSystem& sys, const Vec3& lower, const Vec3& upper, double spacing_m,
+                       double r_min, double r_max, double rho, double speed_m_s,
+                       std::size_t max_count, unsigned seed = 7) {
+    std::mt19937_64 rng(seed);
+    std::uniform_real_distribution<double> unit(-1.0, 1.0);
+    const double margin = 0.5 * spacing_m;
+    for (double z = lower.z() + margin; z <= upper.z() - margin; z += spacing_m)
+        for (double y = lower.y() + margin; y <= upper.y() - margin; y += spacing_m)
+            for (double x = lower.x() + margin; x <= upper.x() - margin; x += spacing_m) {
+                if (sys.particles().size() >= max_count) return;
+                const double r = r_min + 0.5 * (unit(rng) + 1.0) * (r_max - r_min);
+                const double jitter = 0.5 * (0.5 * spacing_m - r_max);
+                const Vec3 x0 = Vec3(x, y, z) + jitter * Vec3(unit(rng), unit(rng), unit(rng));
+                const Vec3 v0 = speed_m_s * Vec3(unit(rng), unit(rng), unit(rng));
+                sys.particles().add(sphere(x0, r, rho, v0));
+            }
+}
+
+/// Copies the particle arrays and every contact history of `from` into `to`, which must have the
+/// same materials, planes and bodies; `to` keeps its own settings (time step, integrator, skin,
+/// re-sort schedule). Its lists are built at the current positions, so no contact is missed.
+inline void copyState(const DemSystem& from, DemSystem& to) {
+    to.particles() = from.particles();
+    DemSystem::Internals state = from.saveInternals();
+    state.reference_position = to.particles().position;
+    to.restoreInternals(state);
+}
+
+/// Translational plus rotational kinetic energy [J] (isotropic grains).
+inline double kineticEnergy(const DemSystem& sys) {
+    const ParticleStore& p = sys.particles();
+    double e = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+        e += 0.5 * p.mass[i] * p.velocity[i].squaredNorm() +
+             0.5 * p.inertia[i].x() * p.angular_velocity[i].squaredNorm();
+    return e;
+}
 
 } // namespace grainlink::dem::testing
