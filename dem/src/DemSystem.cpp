@@ -624,24 +624,34 @@ void DemSystem::meshContacts() {
                     if (dist_sq >= ri * ri || count == kMaxTouches) continue;
                     touches[count++] = {b, tri, q, std::sqrt(dist_sq)};
                 }
-                // Nearest first; a point shared by two triangles (edge, vertex) counts once.
+                // Nearest first. A touch whose point lies in (or behind) the tangent plane of a
+                // nearer accepted touch of the same body is that surface again, seen through a
+                // neighbouring triangle's edge or vertex (a point shared by two triangles is the
+                // extreme case): counting it would add a second, tilted force wherever a sphere
+                // overlaps a flat mesh near an edge. Concave corners keep both faces.
                 std::sort(touches, touches + count, [](const Touch& a, const Touch& b) {
                     return a.dist != b.dist ? a.dist < b.dist
                                             : (a.body != b.body ? a.body < b.body
                                                                 : a.triangle < b.triangle);
                 });
-                int used = 0;
+                int used = 0, accepted_count = 0;
+                int accepted[kMaxTouches];
+                Vec3 accepted_normal[kMaxTouches];
                 for (int k = 0; k < count; ++k) {
                     const Touch& touch = touches[k];
                     bool duplicate = false;
-                    for (int m = 0; m < k && !duplicate; ++m)
-                        duplicate = touches[m].body == touch.body &&
-                                    (touches[m].point - touch.point).squaredNorm() <
-                                        1e-18 + 1e-16 * ri * ri;
+                    for (int m = 0; m < accepted_count && !duplicate; ++m) {
+                        const Touch& nearer = touches[accepted[m]];
+                        duplicate = nearer.body == touch.body &&
+                                    (touch.point - nearer.point).dot(accepted_normal[m]) <=
+                                        1e-9 * ri;
+                    }
                     if (duplicate) continue;
                     // Same triangle, or a neighbour of it with the same normal, keeps history.
                     const Vec3 n_c = touch.dist > 0.0 ? Vec3((xi - touch.point) / touch.dist)
                                                       : Vec3::UnitZ();
+                    accepted[accepted_count] = k;
+                    accepted_normal[accepted_count++] = n_c;
                     ContactHistory h;
                     int best = -1;
                     for (int s = 0; s < kMeshSlots; ++s)
