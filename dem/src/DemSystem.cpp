@@ -320,11 +320,12 @@ void DemSystem::updateNeighbours() {
     const auto& x = particles_.position;
     double max_sq = 0.0, max_mesh_sq = 0.0;
     const bool have_bodies = !bodies_.empty();
+    const bool track_mesh = have_bodies && !candidates_stale_;
 #pragma omp parallel for schedule(static) num_threads(settings_.threads) \
     reduction(max : max_sq, max_mesh_sq)
     for (std::size_t i = 0; i < n; ++i) {
         max_sq = std::max(max_sq, (x[i] - reference_position_[i]).squaredNorm());
-        if (have_bodies)
+        if (track_mesh)
             max_mesh_sq = std::max(max_mesh_sq, (x[i] - mesh_reference_position_[i]).squaredNorm());
     }
     const double skin = settings_.skin_m;

@@ -1,0 +1,66 @@
+#pragma once
+// Strict reading of a YAML file: every error names the file, the key path and the line, and a
+// mapping whose keys were not all read is an error (unknown key, or a unit the key does not take).
+#include "grainlink/dem/Types.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <memory>
+#include <optional>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace grainlink::dem {
+
+class ConfigError : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+class ConfigNode {
+public:
+    /// Loads a file; a YAML syntax error is reported with its line.
+    static ConfigNode loadFile(const std::string& path);
+    static ConfigNode loadString(const std::string& text, const std::string& name);
+
+    const std::string& path() const { return path_; }
+    const std::string& file() const { return *file_; }
+    int line() const { return node_.Mark().line + 1; }
+    bool isMap() const { return node_.IsMap(); }
+    bool isSequence() const { return node_.IsSequence(); }
+    bool isScalar() const { return node_.IsScalar(); }
+
+    bool has(const std::string& key) const;
+    ConfigNode operator[](const std::string& key) const;               ///< required
+    std::optional<ConfigNode> optional(const std::string& key) const;  ///< may be absent
+    std::vector<ConfigNode> items() const;                             ///< a sequence
+
+    double number() const;
+    double positive() const;
+    long long integer() const;
+    bool boolean() const;
+    std::string text() const;
+    /// One of `choices`; otherwise an error listing them.
+    std::string choice(const std::vector<std::string>& choices) const;
+    Vec3 vec3() const;
+    std::vector<double> numbers() const;
+
+    double number(const std::string& key, double fallback) const;
+    std::string text(const std::string& key, const std::string& fallback) const;
+    bool boolean(const std::string& key, bool fallback) const;
+
+    /// Throws on the first key of this mapping that was never read, suggesting a near match.
+    void finish() const;
+    [[noreturn]] void fail(const std::string& message) const;
+
+private:
+    ConfigNode(YAML::Node node, std::shared_ptr<const std::string> file, std::string path);
+    YAML::Node node_;
+    std::shared_ptr<const std::string> file_;
+    std::string path_;
+    std::shared_ptr<std::set<std::string>> used_;
+};
+
+} // namespace grainlink::dem

@@ -1,0 +1,70 @@
+#pragma once
+// Particle generation and settling: the seed's step 1, run once per soil setup and cached.
+#include "grainlink/dem/DemSystem.hpp"
+
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace grainlink::dem {
+
+/// Grain radius distribution.
+struct RadiusDistribution {
+    enum class Kind { Constant, Uniform, Discrete } kind = Kind::Constant;
+    double min_m = 0.0, max_m = 0.0;  ///< Constant uses min_m; Uniform draws in [min, max]
+    std::vector<double> radii_m;      ///< Discrete: radii ...
+    std::vector<double> fractions;    ///< ... and their number fractions (normalised)
+    double largest() const;
+    void validate() const;
+};
+
+/// Deterministic random numbers (SplitMix64): the same seed gives the same packing everywhere.
+class Random {
+public:
+    explicit Random(std::uint64_t seed) : state_(seed) {}
+    std::uint64_t next();
+    double uniform(); ///< in [0, 1)
+    double uniform(double lo, double hi) { return lo + (hi - lo) * uniform(); }
+
+private:
+    std::uint64_t state_;
+};
+
+struct DepositionSpec {
+    enum class Method { Random, Rain } method = Method::Random;
+    Vec3 region_lower_m = Vec3::Zero(); ///< insertion region (particles lie fully inside)
+    Vec3 region_upper_m = Vec3::Zero();
+    std::size_t count = 0;
+    RadiusDistribution radius;
+    int material = 0;
+    std::uint64_t seed = 1;
+    /// Rain: the region is filled in `layers` batches, each after `layer_interval_s` of fall.
+    int layers = 1;
+    double layer_interval_s = 0.1;
+    /// Settling ends when the mean kinetic energy per particle is below this [J] ...
+    double settle_kinetic_energy_J = 1e-9;
+    double max_settle_time_s = 5.0; ///< ... or when this much time has passed (then a warning)
+    std::string describe() const;
+};
+
+struct DepositionReport {
+    std::size_t inserted = 0;
+    double settle_time_s = 0.0;
+    double final_kinetic_energy_per_particle_J = 0.0;
+    bool settled = false;
+};
+
+/// Inserts up to `count` non-overlapping spheres in the region (also avoiding existing
+/// particles); returns how many fitted. Throws if fewer than 99 % fit (region too small).
+std::size_t insertRandom(DemSystem& system, const DepositionSpec& spec, Random& random,
+                         std::size_t count, const Vec3& lower_m, const Vec3& upper_m);
+
+/// Inserts and settles; `progress` is called every few hundred steps with the report so far.
+DepositionReport deposit(DemSystem& system, const DepositionSpec& spec,
+                         const std::function<void(const DepositionReport&)>& progress = {});
+
+/// 64-bit FNV-1a of a text, as 16 hex digits (keys of the packing cache).
+std::string hashKey(const std::string& text);
+
+} // namespace grainlink::dem

@@ -1,0 +1,66 @@
+#pragma once
+// A DEM-only run described by one YAML file (every key in docs/scenario.md).
+#include "grainlink/dem/ConfigNode.hpp"
+#include "grainlink/dem/Deposition.hpp"
+#include "grainlink/dem/DemSystem.hpp"
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlink::dem {
+
+/// A stretch of constant linear and angular velocity of a prescribed body.
+struct MotionSegment {
+    double duration_s = 0.0;
+    Vec3 velocity_m_s = Vec3::Zero();
+    Vec3 angular_velocity_rad_s = Vec3::Zero();
+};
+
+/// Pose at time t (from the start of the run phase) of piecewise-constant velocity motion;
+/// the body rests after the last segment.
+RigidBodyState segmentedMotion(const RigidBodyState& start, const std::vector<MotionSegment>& motion,
+                               double t_s);
+
+struct BodySpec {
+    std::string name;
+    TriangleMesh mesh;
+    RigidBodyState start;
+    /// If set, the body's lowest point starts this far above the settled bed's surface.
+    std::optional<double> clearance_above_bed_m;
+    std::vector<MotionSegment> motion;
+    std::optional<double> friction_coefficient;
+    bool record_triangle_loads = false;
+};
+
+struct OutputSpec {
+    double series_interval_s = 0.01;
+    double snapshot_interval_s = 0.0;   ///< 0: no snapshots
+    double checkpoint_interval_s = 0.0; ///< 0: no periodic checkpoints
+};
+
+struct DemScenario {
+    std::string file;
+    std::string name;
+    DemSettings settings;
+    ContactLaw law;
+    Material material;
+    std::vector<PlaneWall> planes;
+    DepositionSpec deposition;
+    std::string packing_cache_directory; ///< empty: no caching
+    std::vector<BodySpec> bodies;
+    double duration_s = 0.0; ///< run phase after deposition
+    OutputSpec output;
+};
+
+/// Reads and validates a scenario; errors name the file, key and line.
+DemScenario loadScenario(const std::string& path);
+DemScenario parseScenario(const ConfigNode& root);
+
+/// The system without mesh bodies (deposition runs without them).
+std::unique_ptr<DemSystem> makeSystem(const DemScenario& scenario);
+/// Key of the settled packing: everything that shapes it, nothing that does not.
+std::string packingKey(const DemScenario& scenario);
+
+} // namespace grainlink::dem

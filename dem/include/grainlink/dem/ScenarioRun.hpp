@@ -1,0 +1,28 @@
+#pragma once
+// Drives a DEM scenario: cached deposition, the run phase with prescribed bodies, the time
+// series, snapshots, checkpoints, progress and the closing summary.
+#include "grainlink/dem/Scenario.hpp"
+
+#include <string>
+
+namespace grainlink::dem {
+
+struct RunOptions {
+    std::string output_directory;
+    bool resume = false;          ///< continue from output_directory/checkpoint.bin
+    double progress_interval_s = 5.0;
+};
+
+struct RunSummary {
+    std::size_t particles = 0;
+    std::uint64_t steps = 0;
+    double simulated_s = 0.0;
+    double wall_s = 0.0;
+    double particle_steps_per_s = 0.0;
+    bool packing_from_cache = false;
+};
+
+/// Runs to the end; throws (after saving what is readable) on bad input or a failed step.
+RunSummary runScenario(const DemScenario& scenario, const RunOptions& options);
+
+} // namespace grainlink::dem

@@ -1,0 +1,230 @@
+#include "grainlink/dem/Checkpoint.hpp"
+
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <stdexcept>
+#include <type_traits>
+
+namespace grainlink::dem {
+
+namespace {
+
+constexpr char kMagic[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '1'};
+
+class Writer {
+public:
+    explicit Writer(std::ofstream& out) : out_(out) {}
+    template <class T> void pod(const T& value) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        out_.write(reinterpret_cast<const char*>(&value), sizeof(T));
+    }
+    template <class T> void vec(const std::vector<T>& values) {
+        pod<std::uint64_t>(values.size());
+        for (const T& v : values) item(v);
+    }
+    void item(const Vec3& v) { pod(v.x()), pod(v.y()), pod(v.z()); }
+    void item(const Quat& q) { pod(q.w()), pod(q.x()), pod(q.y()), pod(q.z()); }
+    void item(const ContactHistory& h) {
+        item(h.tangential_m);
+        item(h.rolling_N_m);
+        pod<std::uint8_t>(h.sliding);
+    }
+    void item(const RigidBodyState& s) {
+        item(s.position_m);
+        item(s.orientation);
+        item(s.velocity_m_s);
+        item(s.angular_velocity_rad_s);
+    }
+    void item(const DemSystem::MeshContactSlot& s) {
+        pod<std::int32_t>(s.body);
+        pod<std::int32_t>(s.triangle);
+        item(s.normal);
+        item(s.history);
+    }
+    void item(const NeighbourList::StoredContact& c) {
+        pod<std::uint64_t>(c.i);
+        pod<std::uint64_t>(c.j);
+        item(c.history);
+    }
+    template <class T> std::enable_if_t<std::is_arithmetic_v<T>> item(const T& v) { pod(v); }
+    void text(const std::string& s) {
+        pod<std::uint64_t>(s.size());
+        out_.write(s.data(), std::streamsize(s.size()));
+    }
+
+private:
+    std::ofstream& out_;
+};
+
+class Reader {
+public:
+    Reader(std::ifstream& in, std::string path) : in_(in), path_(std::move(path)) {}
+    template <class T> T pod() {
+        T value;
+        in_.read(reinterpret_cast<char*>(&value), sizeof(T));
+        if (!in_) throw std::runtime_error("checkpoint '" + path_ + "' is truncated");
+        return value;
+    }
+    template <class T> void vec(std::vector<T>& values) {
+        const auto n = pod<std::uint64_t>();
+        if (n > (std::uint64_t(1) << 40)) throw std::runtime_error("checkpoint '" + path_ + "' is corrupt");
+        values.resize(n);
+        for (T& v : values) item(v);
+    }
+    void item(Vec3& v) { v.x() = pod<double>(), v.y() = pod<double>(), v.z() = pod<double>(); }
+    void item(Quat& q) {
+        q.w() = pod<double>(), q.x() = pod<double>(), q.y() = pod<double>(), q.z() = pod<double>();
+    }
+    void item(ContactHistory& h) {
+        item(h.tangential_m);
+        item(h.rolling_N_m);
+        h.sliding = pod<std::uint8_t>() != 0;
+    }
+    void item(RigidBodyState& s) {
+        item(s.position_m);
+        item(s.orientation);
+        item(s.velocity_m_s);
+        item(s.angular_velocity_rad_s);
+    }
+    void item(DemSystem::MeshContactSlot& s) {
+        s.body = pod<std::int32_t>();
+        s.triangle = pod<std::int32_t>();
+        item(s.normal);
+        item(s.history);
+    }
+    void item(NeighbourList::StoredContact& c) {
+        c.i = pod<std::uint64_t>();
+        c.j = pod<std::uint64_t>();
+        item(c.history);
+    }
+    template <class T> std::enable_if_t<std::is_arithmetic_v<T>> item(T& v) { v = pod<T>(); }
+    std::string text() {
+        const auto n = pod<std::uint64_t>();
+        if (n > 4096) throw std::runtime_error("checkpoint '" + path_ + "' is corrupt");
+        std::string s(n, '\0');
+        in_.read(s.data(), std::streamsize(n));
+        return s;
+    }
+
+private:
+    std::ifstream& in_;
+    std::string path_;
+};
+
+} // namespace
+
+void writeCheckpoint(const DemSystem& system, const std::string& path,
+                     const CheckpointExtras& extras) {
+    const std::string temporary = path + ".partial";
+    {
+        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
+        if (!out) throw std::runtime_error("cannot write checkpoint '" + temporary + "'");
+        Writer w(out);
+        out.write(kMagic, sizeof kMagic);
+        const ParticleStore& p = system.particles();
+        w.pod<std::uint64_t>(p.nextId());
+        w.vec(p.id);
+        w.vec(p.position);
+        w.vec(p.velocity);
+        w.vec(p.angular_velocity);
+        w.vec(p.orientation);
+        w.vec(p.force);
+        w.vec(p.torque);
+        w.vec(p.radius);
+        w.vec(p.mass);
+        w.vec(p.inertia);
+        w.vec(p.material);
+        const DemSystem::Internals s = system.saveInternals();
+        w.pod(s.step);
+        w.vec(s.contacts);
+        w.vec(s.plane_history);
+        w.vec(s.mesh_slots);
+        w.vec(s.reference_position);
+        w.vec(s.mesh_reference_position);
+        w.vec(s.body_states);
+        w.vec(s.body_reference);
+        w.pod(s.neighbour_builds);
+        w.pod<std::uint8_t>(s.forces_valid);
+        w.pod<std::uint64_t>(extras.size());
+        for (const auto& [key, value] : extras) {
+            w.text(key);
+            w.pod(value);
+        }
+        out.write(kMagic, sizeof kMagic); // trailer: proves the file is complete
+        if (!out) throw std::runtime_error("failed writing checkpoint '" + temporary + "'");
+    }
+    if (std::rename(temporary.c_str(), path.c_str()) != 0)
+        throw std::runtime_error("cannot move checkpoint into place at '" + path + "'");
+}
+
+namespace {
+
+CheckpointExtras load(const std::string& path, ParticleStore& p, DemSystem::Internals& s) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot open checkpoint '" + path + "'");
+    char magic[8];
+    in.read(magic, sizeof magic);
+    if (!in || std::memcmp(magic, kMagic, sizeof magic) != 0)
+        throw std::runtime_error("'" + path + "' is not a grainlink DEM checkpoint (version 1)");
+    Reader r(in, path);
+    p.setNextId(r.pod<std::uint64_t>());
+    r.vec(p.id);
+    r.vec(p.position);
+    r.vec(p.velocity);
+    r.vec(p.angular_velocity);
+    r.vec(p.orientation);
+    r.vec(p.force);
+    r.vec(p.torque);
+    r.vec(p.radius);
+    r.vec(p.mass);
+    r.vec(p.inertia);
+    r.vec(p.material);
+    p.inv_mass.resize(p.mass.size());
+    for (std::size_t i = 0; i < p.mass.size(); ++i) p.inv_mass[i] = 1.0 / p.mass[i];
+    const std::size_t n = p.id.size();
+    if (p.position.size() != n || p.radius.size() != n || p.material.size() != n)
+        throw std::runtime_error("checkpoint '" + path + "' has inconsistent particle arrays");
+    s.step = r.pod<std::uint64_t>();
+    r.vec(s.contacts);
+    r.vec(s.plane_history);
+    r.vec(s.mesh_slots);
+    r.vec(s.reference_position);
+    r.vec(s.mesh_reference_position);
+    r.vec(s.body_states);
+    r.vec(s.body_reference);
+    s.neighbour_builds = r.pod<std::uint64_t>();
+    s.forces_valid = r.pod<std::uint8_t>() != 0;
+    CheckpointExtras extras;
+    const auto count = r.pod<std::uint64_t>();
+    for (std::uint64_t k = 0; k < count; ++k) {
+        std::string key = r.text();
+        extras[key] = r.pod<double>();
+    }
+    in.read(magic, sizeof magic);
+    if (!in || std::memcmp(magic, kMagic, sizeof magic) != 0)
+        throw std::runtime_error("checkpoint '" + path + "' is truncated (no trailer)");
+    for (const auto& c : s.contacts)
+        if (c.i >= n || c.j >= n)
+            throw std::runtime_error("checkpoint '" + path + "' has a contact beyond the particles");
+    return extras;
+}
+
+} // namespace
+
+CheckpointExtras readCheckpoint(DemSystem& system, const std::string& path) {
+    ParticleStore particles;
+    DemSystem::Internals internals;
+    CheckpointExtras extras = load(path, particles, internals);
+    system.particles() = std::move(particles);
+    system.restoreInternals(internals);
+    return extras;
+}
+
+CheckpointExtras readCheckpointExtras(const std::string& path) {
+    ParticleStore particles;
+    DemSystem::Internals internals;
+    return load(path, particles, internals);
+}
+
+} // namespace grainlink::dem

@@ -1,0 +1,311 @@
+#include "grainlink/dem/Scenario.hpp"
+
+#include <sstream>
+
+namespace grainlink::dem {
+
+RigidBodyState segmentedMotion(const RigidBodyState& start,
+                               const std::vector<MotionSegment>& motion, double t_s) {
+    RigidBodyState s = start;
+    s.velocity_m_s.setZero();
+    s.angular_velocity_rad_s.setZero();
+    double remaining = std::max(t_s, 0.0);
+    for (const MotionSegment& seg : motion) {
+        const double span = std::min(remaining, seg.duration_s);
+        s.position_m += seg.velocity_m_s * span;
+        s.orientation = rotationFromVector(seg.angular_velocity_rad_s * span) * s.orientation;
+        remaining -= span;
+        if (remaining <= 0.0) {
+            s.velocity_m_s = seg.velocity_m_s;
+            s.angular_velocity_rad_s = seg.angular_velocity_rad_s;
+            break;
+        }
+    }
+    s.orientation.normalize();
+    return s;
+}
+
+namespace {
+
+Vec3 gravityOf(const ConfigNode& node) {
+    if (node.isSequence()) return node.vec3();
+    const std::string body = node.choice({"earth", "mars", "moon", "none"});
+    if (body == "earth") return Vec3(0, 0, -9.81);
+    if (body == "mars") return Vec3(0, 0, -3.71);
+    if (body == "moon") return Vec3(0, 0, -1.62);
+    return Vec3::Zero();
+}
+
+Material parseMaterial(const ConfigNode& node) {
+    Material m;
+    m.name = node.text("name", "soil");
+    m.youngs_modulus_Pa = node["youngs_modulus_Pa"].positive();
+    m.poisson_ratio = node["poisson_ratio"].number();
+    m.density_kg_m3 = node["density_kg_m3"].positive();
+    node.finish();
+    try {
+        m.validate();
+    } catch (const std::invalid_argument& e) {
+        node.fail(e.what());
+    }
+    return m;
+}
+
+ContactLaw parseContact(const ConfigNode& node) {
+    ContactLaw law;
+    const ConfigNode damping = node["damping"];
+    if (damping["model"].choice({"restitution", "viscous"}) == "restitution")
+        law.damping = DampingRestitution{damping["restitution"].number()};
+    else
+        law.damping = DampingViscous{damping["coefficient_N_s_m"].number()};
+    damping.finish();
+
+    const ConfigNode tangential = node["tangential"];
+    if (tangential["model"].choice({"mindlin", "linear"}) == "mindlin") {
+        law.tangential = TangentialMindlin{tangential["friction_coefficient"].number()};
+    } else {
+        TangentialLinear t;
+        t.stiffness_N_m = tangential["stiffness_N_m"].number();
+        t.damping_N_s_m = tangential.number("damping_N_s_m", 0.0);
+        t.stick_angle_deg = tangential["stick_angle_deg"].number();
+        t.slip_angle_deg = tangential.number("slip_angle_deg", t.stick_angle_deg);
+        law.tangential = t;
+    }
+    tangential.finish();
+
+    if (const auto rolling = node.optional("rolling")) {
+        if ((*rolling)["model"].choice({"none", "epsd"}) == "epsd")
+            law.rolling = RollingEpsd{(*rolling)["coefficient"].number()};
+        rolling->finish();
+    }
+    if (const auto cohesion = node.optional("cohesion")) {
+        if ((*cohesion)["model"].choice({"none", "linear"}) == "linear")
+            law.cohesion = CohesionLinear{(*cohesion)["energy_density_J_m3"].number()};
+        cohesion->finish();
+    }
+    law.background_damping_1_s = node.number("background_damping_1_s", 0.0);
+    node.finish();
+    try {
+        law.finalize();
+    } catch (const std::invalid_argument& e) {
+        node.fail(e.what());
+    }
+    return law;
+}
+
+void parseWall(const ConfigNode& node, const Material& material, std::vector<PlaneWall>& out) {
+    const std::string name = node["name"].text();
+    const std::string type = node["type"].choice({"plane", "box"});
+    std::optional<double> friction;
+    if (const auto f = node.optional("friction_coefficient")) friction = f->number();
+    if (type == "plane") {
+        PlaneWall wall;
+        wall.name = name;
+        wall.point_m = node["point_m"].vec3();
+        wall.normal = node["normal"].vec3();
+        if (wall.normal.norm() == 0.0) node["normal"].fail("normal must not be zero");
+        wall.friction_coefficient = friction;
+        wall.material = material;
+        if (const auto track = node.optional("track")) {
+            FrictionTrack t;
+            t.lower_m = (*track)["lower_m"].vec3();
+            t.upper_m = (*track)["upper_m"].vec3();
+            t.friction_coefficient = (*track)["friction_coefficient"].number();
+            track->finish();
+            wall.track = t;
+        }
+        out.push_back(wall);
+    } else {
+        // Axis-aligned box: six inward-facing planes, the top one optional.
+        const Vec3 lo = node["lower_m"].vec3(), hi = node["upper_m"].vec3();
+        if ((hi - lo).minCoeff() <= 0.0) node["upper_m"].fail("upper_m must exceed lower_m on every axis");
+        const bool open_top = node.boolean("open_top", true);
+        const char* side[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+        for (int k = 0; k < 6; ++k) {
+            if (k == 5 && open_top) continue;
+            const int axis = k / 2;
+            PlaneWall wall;
+            wall.name = name + "." + side[k];
+            wall.point_m = (k % 2 == 0) ? lo : hi;
+            wall.normal = Vec3::Zero();
+            wall.normal[axis] = (k % 2 == 0) ? 1.0 : -1.0;
+            wall.friction_coefficient = friction;
+            wall.material = material;
+            out.push_back(wall);
+        }
+    }
+    node.finish();
+}
+
+RadiusDistribution parseRadius(const ConfigNode& node) {
+    RadiusDistribution d;
+    const std::string kind = node["distribution"].choice({"constant", "uniform", "discrete"});
+    if (kind == "constant") {
+        d.kind = RadiusDistribution::Kind::Constant;
+        d.min_m = d.max_m = node["value_m"].positive();
+    } else if (kind == "uniform") {
+        d.kind = RadiusDistribution::Kind::Uniform;
+        d.min_m = node["min_m"].positive();
+        d.max_m = node["max_m"].positive();
+    } else {
+        d.kind = RadiusDistribution::Kind::Discrete;
+        d.radii_m = node["radii_m"].numbers();
+        d.fractions = node["fractions"].numbers();
+    }
+    node.finish();
+    try {
+        d.validate();
+    } catch (const std::invalid_argument& e) {
+        node.fail(e.what());
+    }
+    return d;
+}
+
+DepositionSpec parseDeposition(const ConfigNode& node) {
+    DepositionSpec d;
+    d.method = node.text("method", "random") == "rain" ? DepositionSpec::Method::Rain
+                                                       : DepositionSpec::Method::Random;
+    if (const auto m = node.optional("method")) m->choice({"random", "rain"});
+    const ConfigNode region = node["region"];
+    d.region_lower_m = region["lower_m"].vec3();
+    d.region_upper_m = region["upper_m"].vec3();
+    region.finish();
+    if ((d.region_upper_m - d.region_lower_m).minCoeff() <= 0.0)
+        region.fail("upper_m must exceed lower_m on every axis");
+    d.count = std::size_t(node["count"].integer());
+    if (d.count == 0) node["count"].fail("must be > 0");
+    d.radius = parseRadius(node["radius"]);
+    d.seed = std::uint64_t(node.number("seed", 1.0));
+    d.layers = int(node.number("layers", 1.0));
+    d.layer_interval_s = node.number("layer_interval_s", 0.1);
+    d.settle_kinetic_energy_J = node.number("settle_kinetic_energy_J", 1e-9);
+    d.max_settle_time_s = node.number("max_settle_time_s", 5.0);
+    node.finish();
+    return d;
+}
+
+TriangleMesh parseMesh(const ConfigNode& node, const std::string& scenario_dir) {
+    const std::string type = node["type"].choice({"cylinder", "stl"});
+    TriangleMesh mesh;
+    if (type == "cylinder") {
+        mesh = makeCylinder(node["radius_m"].positive(), node["width_m"].positive(),
+                            int(node.number("segments", 72)));
+    } else {
+        std::string file = node["file"].text();
+        if (!file.empty() && file[0] != '/') file = scenario_dir + file;
+        try {
+            mesh = readStl(file);
+        } catch (const std::exception& e) {
+            node["file"].fail(e.what());
+        }
+        mesh.transform(node.number("scale", 1.0), Vec3::Zero());
+    }
+    node.finish();
+    return mesh;
+}
+
+BodySpec parseBody(const ConfigNode& node, const std::string& scenario_dir) {
+    BodySpec b;
+    b.name = node["name"].text();
+    b.mesh = parseMesh(node["mesh"], scenario_dir);
+    b.start.position_m = node["position_m"].vec3();
+    if (const auto rot = node.optional("rotation_deg")) {
+        const Vec3 r = rot->vec3() * (M_PI / 180.0); // about fixed x, then y, then z
+        b.start.orientation = Eigen::AngleAxisd(r.z(), Vec3::UnitZ()) *
+                              Eigen::AngleAxisd(r.y(), Vec3::UnitY()) *
+                              Eigen::AngleAxisd(r.x(), Vec3::UnitX());
+    }
+    if (const auto c = node.optional("clearance_above_bed_m")) b.clearance_above_bed_m = c->number();
+    if (const auto f = node.optional("friction_coefficient")) b.friction_coefficient = f->number();
+    b.record_triangle_loads = node.boolean("record_triangle_loads", false);
+    if (const auto motion = node.optional("motion"))
+        for (const ConfigNode& seg : motion->items()) {
+            MotionSegment m;
+            m.duration_s = seg["duration_s"].positive();
+            m.velocity_m_s = seg.optional("velocity_m_s") ? seg["velocity_m_s"].vec3() : Vec3::Zero();
+            m.angular_velocity_rad_s = seg.optional("angular_velocity_rad_s")
+                                           ? seg["angular_velocity_rad_s"].vec3()
+                                           : Vec3::Zero();
+            seg.finish();
+            b.motion.push_back(m);
+        }
+    node.finish();
+    return b;
+}
+
+} // namespace
+
+DemScenario loadScenario(const std::string& path) {
+    DemScenario s = parseScenario(ConfigNode::loadFile(path));
+    s.file = path;
+    return s;
+}
+
+DemScenario parseScenario(const ConfigNode& root) {
+    DemScenario s;
+    s.name = root["name"].text();
+    // Mesh files are found relative to the scenario file.
+    const auto slash = root.file().rfind('/');
+    const std::string dir = slash == std::string::npos ? "" : root.file().substr(0, slash + 1);
+    const ConfigNode sim = root["simulation"];
+    s.settings.time_step_s = sim["time_step_s"].positive();
+    s.settings.integrator = sim.text("integrator", "velocity_verlet") == "newmark"
+                                ? Integrator::Newmark
+                                : Integrator::VelocityVerlet;
+    if (const auto i = sim.optional("integrator")) i->choice({"velocity_verlet", "newmark"});
+    s.settings.newmark_beta = sim.number("newmark_beta", 0.25);
+    s.settings.newmark_gamma = sim.number("newmark_gamma", 0.5);
+    if (const auto g = sim.optional("gravity")) s.settings.gravity_m_s2 = gravityOf(*g);
+    if (const auto g = sim.optional("gravity_m_s2")) s.settings.gravity_m_s2 = g->vec3();
+    s.settings.threads = int(sim.number("threads", 1.0));
+    if (s.settings.threads < 1) sim["threads"].fail("must be >= 1");
+    s.settings.skin_m = sim.number("skin_m", 0.0);
+    s.settings.resort_every_builds = int(sim.number("resort_every_builds", 25.0));
+    s.settings.max_overlap_ratio = sim.number("max_overlap_ratio", 0.4);
+    s.settings.check_time_step = sim.boolean("check_time_step", true);
+    sim.finish();
+
+    s.material = parseMaterial(root["material"]);
+    s.law = parseContact(root["contact"]);
+    if (const auto walls = root.optional("walls"))
+        for (const ConfigNode& w : walls->items()) parseWall(w, s.material, s.planes);
+    s.deposition = parseDeposition(root["deposition"]);
+    s.packing_cache_directory = root.text("packing_cache_directory", ".cache/packings");
+    if (const auto bodies = root.optional("bodies"))
+        for (const ConfigNode& b : bodies->items()) s.bodies.push_back(parseBody(b, dir));
+    const ConfigNode run = root["run"];
+    s.duration_s = run["duration_s"].positive();
+    run.finish();
+    if (const auto out = root.optional("output")) {
+        s.output.series_interval_s = out->number("series_interval_s", 0.01);
+        s.output.snapshot_interval_s = out->number("snapshot_interval_s", 0.0);
+        s.output.checkpoint_interval_s = out->number("checkpoint_interval_s", 0.0);
+        out->finish();
+        if (!(s.output.series_interval_s > 0.0)) (*out)["series_interval_s"].fail("must be > 0");
+    }
+    root.finish();
+    return s;
+}
+
+std::unique_ptr<DemSystem> makeSystem(const DemScenario& s) {
+    auto system = std::make_unique<DemSystem>(s.law, std::vector<Material>{s.material}, s.settings);
+    for (const PlaneWall& w : s.planes) system->addPlane(w);
+    return system;
+}
+
+std::string packingKey(const DemScenario& s) {
+    std::ostringstream key;
+    key.precision(17);
+    key << "v1|" << s.law.describe() << "|E=" << s.material.youngs_modulus_Pa
+        << " nu=" << s.material.poisson_ratio << " rho=" << s.material.density_kg_m3
+        << "|dt=" << s.settings.time_step_s << " int=" << int(s.settings.integrator) << ','
+        << s.settings.newmark_beta << ',' << s.settings.newmark_gamma
+        << " g=" << s.settings.gravity_m_s2.transpose() << " threads=" << s.settings.threads
+        << "|" << s.deposition.describe();
+    for (const PlaneWall& w : s.planes)
+        key << "|wall " << w.name << ' ' << w.point_m.transpose() << ' ' << w.normal.transpose()
+            << ' ' << w.friction_coefficient.value_or(-1.0);
+    return hashKey(key.str());
+}
+
+} // namespace grainlink::dem

@@ -1,0 +1,267 @@
+#include "grainlink/dem/ScenarioRun.hpp"
+
+#include "grainlink/dem/Checkpoint.hpp"
+#include "grainlink/dem/Progress.hpp"
+#include "grainlink/dem/VtkWriter.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+namespace grainlink::dem {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// Height of the settled bed's surface: 98th percentile of grain tops (robust to stray grains).
+double bedSurface(const ParticleStore& p) {
+    if (p.empty()) return 0.0;
+    std::vector<double> tops(p.size());
+    for (std::size_t i = 0; i < p.size(); ++i) tops[i] = p.position[i].z() + p.radius[i];
+    const std::size_t k = std::min(p.size() - 1, std::size_t(0.98 * double(p.size())));
+    std::nth_element(tops.begin(), tops.begin() + std::ptrdiff_t(k), tops.end());
+    return tops[k];
+}
+
+std::string seriesHeader(const DemSystem& sys) {
+    std::string h = "time_s,run_time_s,step,kinetic_J,rotational_J,gravitational_J,elastic_J,"
+                    "contacts,wall_contacts,max_overlap_ratio";
+    for (int b = 0; b < sys.bodyCount(); ++b) {
+        const std::string& n = sys.body(b).name();
+        for (const char* c : {"x_m", "y_m", "z_m", "vx_m_s", "vz_m_s", "wy_rad_s", "Fx_N", "Fy_N",
+                              "Fz_N", "Tx_N_m", "Ty_N_m", "Tz_N_m"})
+            h += "," + n + "_" + c;
+    }
+    return h;
+}
+
+/// One row; body forces are averaged over the interval since the last row (impulse / time).
+std::string seriesRow(DemSystem& sys, double run_time_s) {
+    const Energies e = sys.energies();
+    std::ostringstream row;
+    row.precision(10);
+    row << sys.time() << ',' << run_time_s << ',' << sys.stepCount() << ',' << e.translational_J
+        << ',' << e.rotational_J << ',' << e.gravitational_J << ',' << e.elastic_J << ','
+        << sys.contactCount() << ',' << sys.wallContactCount() << ',' << sys.maxOverlapRatio();
+    for (int b = 0; b < sys.bodyCount(); ++b) {
+        MeshBody& body = sys.body(b);
+        const RigidBodyState& s = body.state();
+        const double span = body.accumulated_time_s > 0.0 ? body.accumulated_time_s : 1.0;
+        const Vec3 f = body.impulse_N_s / span, t = body.angular_impulse_N_m_s / span;
+        row << ',' << s.position_m.x() << ',' << s.position_m.y() << ',' << s.position_m.z() << ','
+            << s.velocity_m_s.x() << ',' << s.velocity_m_s.z() << ','
+            << s.angular_velocity_rad_s.y() << ',' << f.x() << ',' << f.y() << ',' << f.z() << ','
+            << t.x() << ',' << t.y() << ',' << t.z();
+        body.resetAccumulatedImpulse();
+    }
+    return row.str();
+}
+
+/// Keeps the header and the rows up to `last_step` (rows after a checkpoint are redone).
+void truncateSeries(const std::string& path, std::uint64_t last_step) {
+    std::ifstream in(path);
+    if (!in) return;
+    std::vector<std::string> keep;
+    std::string line;
+    while (std::getline(in, line)) {
+        if (keep.empty()) {
+            keep.push_back(line);
+            continue;
+        }
+        std::istringstream fields(line);
+        std::string t, rt, step;
+        std::getline(fields, t, ',');
+        std::getline(fields, rt, ',');
+        std::getline(fields, step, ',');
+        if (!step.empty() && std::stoull(step) <= last_step) keep.push_back(line);
+    }
+    in.close();
+    std::ofstream out(path, std::ios::trunc);
+    for (const std::string& l : keep) out << l << '\n';
+}
+
+void addBody(DemSystem& sys, const BodySpec& spec, const RigidBodyState& start,
+             double run_start_s) {
+    MeshBody body(spec.name, spec.mesh, start);
+    body.friction_coefficient = spec.friction_coefficient;
+    body.record_triangle_loads = spec.record_triangle_loads;
+    const auto motion = spec.motion;
+    sys.addBody(std::move(body), [start, motion, run_start_s](double t) {
+        return segmentedMotion(start, motion, t - run_start_s);
+    });
+}
+
+/// Start poses: a clearance above the bed puts the lowest mesh point that far above the surface.
+std::vector<RigidBodyState> startPoses(const DemSystem& sys, const DemScenario& scenario) {
+    const double surface = bedSurface(sys.particles());
+    std::vector<RigidBodyState> starts;
+    for (const BodySpec& spec : scenario.bodies) {
+        RigidBodyState start = spec.start;
+        if (spec.clearance_above_bed_m) {
+            double lowest = 1e300;
+            for (const Vec3& v : spec.mesh.vertices_m)
+                lowest = std::min(lowest, (start.orientation * v).z());
+            start.position_m.z() = surface + *spec.clearance_above_bed_m - lowest;
+        }
+        starts.push_back(start);
+    }
+    return starts;
+}
+
+} // namespace
+
+RunSummary runScenario(const DemScenario& scenario, const RunOptions& options) {
+    RunSummary summary;
+    const fs::path out = options.output_directory;
+    fs::create_directories(out);
+    const std::string checkpoint = (out / "checkpoint.bin").string();
+    const std::string series_path = (out / "series.csv").string();
+    auto sys = makeSystem(scenario);
+    const double dt = scenario.settings.time_step_s;
+
+    // --- phase 1: deposition, or the cached packing of an identical soil setup ---------------
+    CheckpointExtras extras;
+    double run_start_s = 0.0;
+    std::vector<RigidBodyState> starts;
+    if (options.resume) {
+        if (!fs::exists(checkpoint))
+            throw std::runtime_error("cannot resume: no checkpoint at '" + checkpoint + "'");
+        // Bodies must exist before their state is restored; their start is stored in extras.
+        extras = readCheckpointExtras(checkpoint);
+        run_start_s = extras.at("run_start_s");
+        for (std::size_t b = 0; b < scenario.bodies.size(); ++b) {
+            RigidBodyState start = scenario.bodies[b].start;
+            start.position_m.z() = extras.at("body" + std::to_string(b) + "_start_z_m");
+            starts.push_back(start);
+            addBody(*sys, scenario.bodies[b], start, run_start_s);
+        }
+        readCheckpoint(*sys, checkpoint);
+        std::fprintf(stderr, "[resume] from %s at t = %.4f s (step %llu)\n", checkpoint.c_str(),
+                     sys->time(), static_cast<unsigned long long>(sys->stepCount()));
+    } else {
+        const std::string key = packingKey(scenario);
+        const fs::path cache =
+            scenario.packing_cache_directory.empty()
+                ? fs::path()
+                : fs::path(scenario.packing_cache_directory) / ("packing-" + key + ".bin");
+        if (!cache.empty() && fs::exists(cache)) {
+            readCheckpoint(*sys, cache.string());
+            summary.packing_from_cache = true;
+            std::fprintf(stderr, "[deposition] reusing cached packing %s (%zu particles)\n",
+                         cache.c_str(), sys->particles().size());
+        } else {
+            Progress progress("deposition", options.progress_interval_s);
+            const auto report = deposit(*sys, scenario.deposition, [&](const DepositionReport& r) {
+                progress.update(sys->time(),
+                                std::min(1.0, r.settle_time_s / scenario.deposition.max_settle_time_s),
+                                sys->stepCount() * sys->particles().size(),
+                                "KE/particle " + std::to_string(r.final_kinetic_energy_per_particle_J) + " J");
+            });
+            std::fprintf(stderr, "[deposition] %zu particles, settled %s after %.3f s (KE/particle %.3g J)\n",
+                         report.inserted, report.settled ? "" : "NOT (time limit)",
+                         report.settle_time_s, report.final_kinetic_energy_per_particle_J);
+            if (!cache.empty()) {
+                fs::create_directories(cache.parent_path());
+                writeCheckpoint(*sys, cache.string());
+            }
+        }
+        run_start_s = sys->time();
+        starts = startPoses(*sys, scenario);
+        for (std::size_t b = 0; b < scenario.bodies.size(); ++b)
+            addBody(*sys, scenario.bodies[b], starts[b], run_start_s);
+        if (fs::exists(series_path)) fs::remove(series_path);
+    }
+
+    // --- phase 2: the run -----------------------------------------------------------------
+    const auto steps_per_row = std::max<std::uint64_t>(1, std::llround(scenario.output.series_interval_s / dt));
+    const auto rows_per_checkpoint =
+        scenario.output.checkpoint_interval_s > 0.0
+            ? std::max<std::uint64_t>(1, std::llround(scenario.output.checkpoint_interval_s /
+                                                      (double(steps_per_row) * dt)))
+            : 0;
+    const auto steps_per_snapshot =
+        scenario.output.snapshot_interval_s > 0.0
+            ? std::max<std::uint64_t>(1, std::llround(scenario.output.snapshot_interval_s / dt))
+            : 0;
+    const auto run_start_step = std::uint64_t(std::llround(run_start_s / dt));
+    const auto run_steps = std::uint64_t(std::llround(scenario.duration_s / dt));
+    const std::uint64_t first_step = sys->stepCount();
+
+    VtkWriter vtk(out.string());
+    if (options.resume) {
+        truncateSeries(series_path, sys->stepCount());
+        std::vector<double> times;
+        for (int k = 0; k < int(extras.at("snapshots")); ++k)
+            times.push_back(extras.at("snapshot" + std::to_string(k) + "_s"));
+        vtk.resumeAt(int(times.size()), times);
+    }
+    std::ofstream series(series_path, std::ios::app);
+    if (!series) throw std::runtime_error("cannot write '" + series_path + "'");
+    if (!options.resume) series << seriesHeader(*sys) << '\n' << seriesRow(*sys, 0.0) << '\n';
+    if (!options.resume && steps_per_snapshot) vtk.write(*sys, 0.0);
+
+    auto saveCheckpoint = [&] {
+        CheckpointExtras e;
+        e["run_start_s"] = run_start_s;
+        for (std::size_t b = 0; b < starts.size(); ++b)
+            e["body" + std::to_string(b) + "_start_z_m"] = starts[b].position_m.z();
+        e["snapshots"] = vtk.count();
+        for (int k = 0; k < vtk.count(); ++k) e["snapshot" + std::to_string(k) + "_s"] = vtk.times()[std::size_t(k)];
+        writeCheckpoint(*sys, checkpoint, e);
+    };
+
+    Progress progress("run", options.progress_interval_s);
+    std::uint64_t rows = 0;
+    try {
+        while (sys->stepCount() < run_start_step + run_steps) {
+            sys->step();
+            const std::uint64_t done = sys->stepCount() - run_start_step;
+            if (done % steps_per_row == 0) {
+                series << seriesRow(*sys, double(done) * dt) << '\n';
+                series.flush();
+                ++rows;
+                if (rows_per_checkpoint && rows % rows_per_checkpoint == 0) saveCheckpoint();
+            }
+            if (steps_per_snapshot && done % steps_per_snapshot == 0) vtk.write(*sys, double(done) * dt);
+            progress.update(double(done) * dt, double(done) / double(run_steps),
+                            (sys->stepCount() - first_step) * sys->particles().size());
+        }
+    } catch (const SimulationError& e) {
+        // Keep what is readable: the series so far, and the last finite particle state.
+        series.flush();
+        const std::string snapshot = (out / "failure_particles.vtu").string();
+        VtkWriter::writeParticles(sys->particles(), snapshot);
+        std::ostringstream msg;
+        msg << e.what() << "; series so far in " << series_path << ", state at failure in "
+            << snapshot;
+        if (fs::exists(checkpoint)) msg << ", resume from " << checkpoint << " with --resume";
+        throw std::runtime_error(msg.str());
+    }
+    saveCheckpoint();
+
+    summary.particles = sys->particles().size();
+    summary.steps = sys->stepCount() - first_step;
+    summary.simulated_s = double(summary.steps) * dt;
+    summary.wall_s = progress.wallSeconds();
+    summary.particle_steps_per_s = progress.rate(summary.steps * summary.particles);
+    std::ostringstream text;
+    text << "grainlink dem: scenario '" << scenario.name << "' finished\n"
+         << "  particles            " << summary.particles << "\n"
+         << "  steps                " << summary.steps << " (dt = " << dt << " s)\n"
+         << "  simulated time       " << summary.simulated_s << " s\n"
+         << "  wall time            " << formatDuration(summary.wall_s) << "\n"
+         << "  particle-steps/s     " << summary.particle_steps_per_s / 1e6 << " M\n"
+         << "  neighbour builds     " << sys->neighbourBuilds() << "\n"
+         << "  outputs              " << series_path << ", " << vtk.count()
+         << " snapshots (particles.pvd), " << checkpoint << "\n\n"
+         << sys->timer().table();
+    std::fprintf(stderr, "%s", text.str().c_str());
+    std::ofstream(out / "summary.txt") << text.str();
+    return summary;
+}
+
+} // namespace grainlink::dem
