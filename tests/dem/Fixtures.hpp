@@ -152,11 +152,17 @@ inline void addLattice(DemSystem& sys, const Vec3& lower, const Vec3& upper, dou
                        std::size_t max_count, unsigned seed = 7) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
-    const double margin = 0.5 * spacing_m;
-    for (double z = lower.z() + margin; z <= upper.z() - margin; z += spacing_m)
-        for (double y = lower.y() + margin; y <= upper.y() - margin; y += spacing_m)
-            for (double x = lower.x() + margin; x <= upper.x() - margin; x += spacing_m) {
+    const Eigen::Vector3i cells = ((upper - lower) / spacing_m + Vec3::Constant(1e-9))
+                                      .array()
+                                      .floor()
+                                      .cast<int>();
+    for (int iz = 0; iz < cells.z(); ++iz)
+        for (int iy = 0; iy < cells.y(); ++iy)
+            for (int ix = 0; ix < cells.x(); ++ix) {
                 if (sys.particles().size() >= max_count) return;
+                const double x = lower.x() + (ix + 0.5) * spacing_m;
+                const double y = lower.y() + (iy + 0.5) * spacing_m;
+                const double z = lower.z() + (iz + 0.5) * spacing_m;
                 const double r = r_min + 0.5 * (unit(rng) + 1.0) * (r_max - r_min);
                 const double jitter = 0.5 * (0.5 * spacing_m - r_max);
                 const Vec3 x0 = Vec3(x, y, z) + jitter * Vec3(unit(rng), unit(rng), unit(rng));
