@@ -181,6 +181,29 @@ inline void copyState(const DemSystem& from, DemSystem& to) {
     to.restoreInternals(state);
 }
 
+/// Open box (floor and four walls, no lid) of side `width_m` and `height_m`, floor at z = 0,
+/// centred on the z axis; each face split into cells x cells rectangles of two triangles.
+inline TriangleMesh makeOpenBox(double width_m, double height_m, int cells) {
+    TriangleMesh box;
+    auto append = [&box](const TriangleMesh& face, const Mat3& rotation, const Vec3& offset) {
+        const int base = int(box.vertices_m.size());
+        for (const Vec3& v : face.vertices_m) box.vertices_m.push_back(rotation * v + offset);
+        for (const auto& t : face.triangles)
+            box.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
+    };
+    const TriangleMesh floor = makeRectangle(width_m, width_m, cells, cells);
+    const TriangleMesh wall = makeRectangle(width_m, height_m, cells, cells);
+    const Mat3 upright = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitX()).toRotationMatrix();
+    const Mat3 turned = Eigen::AngleAxisd(M_PI / 2, Vec3::UnitZ()).toRotationMatrix() * upright;
+    const double h = 0.5 * width_m, z = 0.5 * height_m;
+    append(floor, Mat3::Identity(), Vec3::Zero());
+    append(wall, upright, Vec3(0, -h, z));
+    append(wall, upright, Vec3(0, h, z));
+    append(wall, turned, Vec3(-h, 0, z));
+    append(wall, turned, Vec3(h, 0, z));
+    return box;
+}
+
 /// Translational plus rotational kinetic energy [J] (isotropic grains).
 inline double kineticEnergy(const DemSystem& sys) {
     const ParticleStore& p = sys.particles();
