@@ -146,6 +146,9 @@ void writeCheckpoint(const DemSystem& system, const std::string& path,
         w.vec(s.body_reference);
         w.pod(s.neighbour_builds);
         w.pod<std::uint8_t>(s.forces_valid);
+        w.pod(s.step_offset);
+        w.pod(s.time_offset_s);
+        w.pod(s.max_overlap_ratio);
         w.pod<std::uint64_t>(extras.size());
         for (const auto& [key, value] : extras) {
             w.text(key);
@@ -195,6 +198,9 @@ CheckpointExtras load(const std::string& path, ParticleStore& p, DemSystem::Inte
     r.vec(s.body_reference);
     s.neighbour_builds = r.pod<std::uint64_t>();
     s.forces_valid = r.pod<std::uint8_t>() != 0;
+    s.step_offset = r.pod<std::uint64_t>();
+    s.time_offset_s = r.pod<double>();
+    s.max_overlap_ratio = r.pod<double>();
     CheckpointExtras extras;
     const auto count = r.pod<std::uint64_t>();
     for (std::uint64_t k = 0; k < count; ++k) {

@@ -51,6 +51,17 @@ ConfigNode ConfigNode::operator[](const std::string& key) const {
     const YAML::Node child = node_[key];
     const std::string child_path = path_.empty() ? key : path_ + "." + key;
     if (!child || child.IsNull()) {
+        // A key with the same stem but another unit suffix is a wrong unit, not a missing key.
+        for (const auto& entry : node_) {
+            const std::string other = entry.first.as<std::string>();
+            if (other != key && stem(other) == stem(key)) {
+                std::ostringstream out;
+                out << *file_ << ":" << entry.first.Mark().line + 1 << ": unknown key '"
+                    << (path_.empty() ? other : path_ + "." + other)
+                    << "' (wrong unit? this key is '" << key << "')";
+                throw ConfigError(out.str());
+            }
+        }
         std::ostringstream out;
         out << *file_ << ":" << line() << ": missing key '" << child_path << "'";
         throw ConfigError(out.str());

@@ -131,7 +131,10 @@ void DemSystem::initialise() {
     else {
         // Restored: rebuild the pair list at the saved reference so the rebuild schedule and
         // the storage order continue exactly as in the run that wrote the checkpoint.
+        // This rebuild only recreates the list: it does not count towards the re-sort schedule.
+        const std::uint64_t builds = neighbours_.buildCount();
         neighbours_.build(reference_position_, particles_.radius, settings_.skin_m, {}, threads);
+        neighbours_.restoreBuildCount(builds);
     }
     candidates_stale_ = true;
 }
@@ -852,6 +855,9 @@ DemSystem::Internals DemSystem::saveInternals() const {
     s.body_reference = body_reference_;
     s.neighbour_builds = neighbours_.buildCount();
     s.forces_valid = forces_valid_;
+    s.step_offset = step_offset_;
+    s.time_offset_s = time_offset_s_;
+    s.max_overlap_ratio = max_overlap_ratio_;
     return s;
 }
 
@@ -861,8 +867,9 @@ void DemSystem::restoreInternals(const Internals& s) {
                                  " mesh bodies, the scenario defines " +
                                  std::to_string(bodies_.size()));
     step_ = s.step;
-    step_offset_ = s.step;
-    time_offset_s_ = double(s.step) * settings_.time_step_s;
+    step_offset_ = s.step_offset;
+    time_offset_s_ = s.time_offset_s;
+    max_overlap_ratio_ = s.max_overlap_ratio;
     plane_history_ = s.plane_history;
     mesh_slots_ = s.mesh_slots;
     reference_position_ = s.reference_position;

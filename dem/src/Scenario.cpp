@@ -51,6 +51,15 @@ Material parseMaterial(const ConfigNode& node) {
     return m;
 }
 
+/// Runs a model's own parameter check and reports a failure at that model's key.
+template <class Model> void validateAt(const ConfigNode& node, const Model& model) {
+    try {
+        std::visit([](const auto& m) { m.validate(); }, model);
+    } catch (const std::invalid_argument& e) {
+        node.fail(e.what());
+    }
+}
+
 ContactLaw parseContact(const ConfigNode& node) {
     ContactLaw law;
     const ConfigNode damping = node["damping"];
@@ -59,6 +68,7 @@ ContactLaw parseContact(const ConfigNode& node) {
     else
         law.damping = DampingViscous{damping["coefficient_N_s_m"].number()};
     damping.finish();
+    validateAt(damping, law.damping);
 
     const ConfigNode tangential = node["tangential"];
     if (tangential["model"].choice({"mindlin", "linear"}) == "mindlin") {
@@ -72,16 +82,19 @@ ContactLaw parseContact(const ConfigNode& node) {
         law.tangential = t;
     }
     tangential.finish();
+    validateAt(tangential, law.tangential);
 
     if (const auto rolling = node.optional("rolling")) {
         if ((*rolling)["model"].choice({"none", "epsd"}) == "epsd")
             law.rolling = RollingEpsd{(*rolling)["coefficient"].number()};
         rolling->finish();
+        validateAt(*rolling, law.rolling);
     }
     if (const auto cohesion = node.optional("cohesion")) {
         if ((*cohesion)["model"].choice({"none", "linear"}) == "linear")
             law.cohesion = CohesionLinear{(*cohesion)["energy_density_J_m3"].number()};
         cohesion->finish();
+        validateAt(*cohesion, law.cohesion);
     }
     law.background_damping_1_s = node.number("background_damping_1_s", 0.0);
     node.finish();

@@ -41,6 +41,7 @@ std::string seriesHeader(const DemSystem& sys) {
 
 /// One row; body forces are averaged over the interval since the last row (impulse / time).
 std::string seriesRow(DemSystem& sys, double run_time_s) {
+    sys.prepare(); // contacts are counted from the neighbour list
     const Energies e = sys.energies();
     std::ostringstream row;
     row.precision(10);

@@ -72,6 +72,10 @@ public:
     /// Reaction force of the particles on plane k during the last step [N].
     const Vec3& planeForce(int k) const { return plane_force_[std::size_t(k)]; }
 
+    /// Builds neighbour lists and wall data now rather than at the first step (idempotent).
+    void prepare() {
+        if (!initialised_) initialise();
+    }
     /// One time step of the chosen integrator.
     void step();
     void run(std::uint64_t steps);
@@ -184,6 +188,9 @@ struct DemSystem::Internals {
     std::vector<RigidBodyState> body_reference;
     std::uint64_t neighbour_builds = 0;
     bool forces_valid = false;
+    std::uint64_t step_offset = 0; ///< clock: t = time_offset + (step - step_offset) dt
+    double time_offset_s = 0.0;
+    double max_overlap_ratio = 0.0;
 };
 
 } // namespace grainlink::dem

@@ -44,8 +44,8 @@ public:
     std::size_t pairCount() const { return neighbour.size(); }
     const CellGrid& grid() const { return grid_; }
     std::uint64_t buildCount() const { return builds_; }
-    /// Continues a checkpointed run's build counter; the next build brings it to `count`.
-    void restoreBuildCount(std::uint64_t count) { builds_ = count > 0 ? count - 1 : 0; }
+    /// Sets the build counter (it schedules re-sorts), e.g. to continue a checkpointed run.
+    void restoreBuildCount(std::uint64_t count) { builds_ = count; }
 
     /// Entries of particle i are [first[i], first[i+1]).
     std::vector<std::size_t> first;

@@ -1,0 +1,201 @@
+// Checkpoint/restart continues bit-identically; a failed run keeps its results and resumes.
+#include "Fixtures.hpp"
+
+#include "grainlink/dem/Checkpoint.hpp"
+#include "grainlink/dem/Deposition.hpp"
+#include "grainlink/dem/ScenarioRun.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+using namespace grainlink::dem;
+using namespace grainlink::dem::testing;
+namespace fs = std::filesystem;
+
+namespace {
+
+fs::path scratch(const std::string& name) {
+    const fs::path dir = fs::temp_directory_path() / ("grainlink-test-" + name);
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    return dir;
+}
+
+/// A falling, colliding bed in a box with a cylinder ploughing through it: every kind of
+/// history (pairs, planes, mesh) is active when the checkpoint is taken.
+std::unique_ptr<DemSystem> busySystem(int threads) {
+    DemSettings settings;
+    settings.time_step_s = 5e-5;
+    settings.threads = threads;
+    settings.resort_every_builds = 3; // re-sorts happen between checkpoint and end
+    ContactLaw law = hertzViscous(0.02, 400.0, 32.0, 28.0);
+    law.rolling = RollingEpsd{0.2};
+    auto sys = std::make_unique<DemSystem>(law, std::vector<Material>{soil(3e6, 0.2, 2400)}, settings);
+    const char* names[5] = {"floor", "x0", "x1", "y0", "y1"};
+    const Vec3 normals[5] = {Vec3::UnitZ(), Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY()};
+    const Vec3 points[5] = {Vec3::Zero(), Vec3::Zero(), Vec3(0.1, 0, 0), Vec3::Zero(), Vec3(0, 0.06, 0)};
+    for (int k = 0; k < 5; ++k) {
+        PlaneWall w;
+        w.name = names[k];
+        w.point_m = points[k];
+        w.normal = normals[k];
+        w.friction_coefficient = k == 0 ? 0.5 : 0.0;
+        sys->addPlane(w);
+    }
+    DepositionSpec spec;
+    spec.region_lower_m = Vec3(0, 0, 0);
+    spec.region_upper_m = Vec3(0.1, 0.06, 0.08);
+    spec.count = 400;
+    spec.radius.kind = RadiusDistribution::Kind::Uniform;
+    spec.radius.min_m = 0.0025;
+    spec.radius.max_m = 0.0035;
+    spec.seed = 3;
+    Random random(spec.seed);
+    insertRandom(*sys, spec, random, spec.count, spec.region_lower_m, spec.region_upper_m);
+    RigidBodyState start;
+    start.position_m = Vec3(-0.03, 0.03, 0.035); // enters the box from the side
+    start.velocity_m_s = Vec3(0.2, 0, 0);
+    start.angular_velocity_rad_s = Vec3(0, 10, 0);
+    sys->addBody(MeshBody("drum", makeCylinder(0.025, 0.04, 24), start),
+                 [start](double t) { return constantVelocityMotion(start, t); });
+    return sys;
+}
+
+bool sameState(const ParticleStore& a, const ParticleStore& b) {
+    if (a.size() != b.size()) return false;
+    for (std::size_t i = 0; i < a.size(); ++i)
+        if (a.id[i] != b.id[i] || a.position[i] != b.position[i] || a.velocity[i] != b.velocity[i] ||
+            a.angular_velocity[i] != b.angular_velocity[i])
+            return false;
+    return true;
+}
+
+} // namespace
+
+TEST_CASE("a run restarted from a checkpoint continues bit-identically", "[dem][checkpoint]") {
+    const int threads = GENERATE(1, 2);
+    const fs::path dir = scratch("checkpoint-" + std::to_string(threads));
+    const std::string file = (dir / "state.bin").string();
+
+    auto straight = busySystem(threads);
+    straight->run(1500);
+    writeCheckpoint(*straight, file, {{"answer", 42.0}});
+    straight->run(1500);
+
+    auto resumed = busySystem(threads);
+    const CheckpointExtras extras = readCheckpoint(*resumed, file);
+    CHECK(extras.at("answer") == 42.0);
+    CHECK(resumed->stepCount() == 1500);
+    resumed->run(1500);
+
+    CHECK(straight->neighbourBuilds() > 6); // rebuilds and re-sorts happened after the restart
+    CHECK(straight->wallContactCount() > 0);
+    CHECK(resumed->time() == straight->time());
+    CHECK(sameState(straight->particles(), resumed->particles()));
+    CHECK(straight->body(0).force_N.norm() > 0.0); // the drum is ploughing
+    CHECK(resumed->body(0).force_N == straight->body(0).force_N);
+}
+
+TEST_CASE("damaged checkpoints are refused with the file named", "[dem][checkpoint]") {
+    const fs::path dir = scratch("checkpoint-damaged");
+    const std::string file = (dir / "state.bin").string();
+    auto sys = busySystem(1);
+    sys->run(10);
+    writeCheckpoint(*sys, file);
+    const auto size = fs::file_size(file);
+    fs::resize_file(file, size - 20);
+    auto target = busySystem(1);
+    CHECK_THROWS_WITH(readCheckpoint(*target, file), Catch::Contains(file) && Catch::Contains("truncated"));
+    std::ofstream(file) << "not a checkpoint";
+    CHECK_THROWS_WITH(readCheckpoint(*target, file), Catch::Contains("is not a grainlink DEM checkpoint"));
+}
+
+namespace {
+
+DemScenario smallScenario(const fs::path& dir, double duration_s) {
+    std::ostringstream text;
+    text << R"(name: small
+simulation: {time_step_s: 1.0e-4, threads: 1}
+material: {youngs_modulus_Pa: 3.0e6, poisson_ratio: 0.2, density_kg_m3: 2400}
+contact:
+  damping: {model: restitution, restitution: 0.3}
+  tangential: {model: mindlin, friction_coefficient: 0.5}
+walls:
+  - {name: bin, type: box, lower_m: [0, 0, 0], upper_m: [0.12, 0.06, 0.3]}
+deposition:
+  region: {lower_m: [0, 0, 0], upper_m: [0.12, 0.06, 0.1]}
+  count: 300
+  radius: {distribution: constant, value_m: 0.004}
+  settle_kinetic_energy_J: 1.0e-7
+  max_settle_time_s: 0.4
+bodies:
+  - name: wheel
+    mesh: {type: cylinder, radius_m: 0.03, width_m: 0.04, segments: 32}
+    position_m: [0.035, 0.03, 0]
+    clearance_above_bed_m: 0.001
+    motion:
+      - {duration_s: 0.1, velocity_m_s: [0, 0, -0.05]}
+      - {duration_s: 1.0, velocity_m_s: [0.1, 0, 0], angular_velocity_rad_s: [0, 2.5, 0]}
+output: {series_interval_s: 0.01, checkpoint_interval_s: 0.05, snapshot_interval_s: 0.1}
+)" << "packing_cache_directory: " << (dir / "cache").string() << "\n"
+         << "run: {duration_s: " << duration_s << "}\n";
+    return parseScenario(ConfigNode::loadString(text.str(), "small.yaml"));
+}
+
+std::vector<std::string> lines(const fs::path& file) {
+    std::ifstream in(file);
+    std::vector<std::string> out;
+    for (std::string line; std::getline(in, line);) out.push_back(line);
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("an interrupted scenario run resumes to the same series as an uninterrupted one",
+          "[dem][checkpoint][scenario]") {
+    const fs::path dir = scratch("resume");
+    RunOptions straight{(dir / "straight").string(), false, 1e9};
+    const RunSummary first = runScenario(smallScenario(dir, 0.3), straight);
+    CHECK_FALSE(first.packing_from_cache);
+
+    // The "interrupted" run stopped at 0.15 s; resuming it with the full duration finishes it.
+    RunOptions broken{(dir / "broken").string(), false, 1e9};
+    const RunSummary partial = runScenario(smallScenario(dir, 0.15), broken);
+    CHECK(partial.packing_from_cache); // same soil setup: the packing is reused
+    // A crash after the last checkpoint leaves rows the resumed run must not duplicate.
+    std::ofstream(dir / "broken" / "series.csv", std::ios::app) << "0.2,0.2,99999999,junk\n";
+    broken.resume = true;
+    runScenario(smallScenario(dir, 0.3), broken);
+
+    const auto a = lines(dir / "straight" / "series.csv");
+    const auto b = lines(dir / "broken" / "series.csv");
+    REQUIRE(a.size() == 32); // header + rows at 0, 0.01, ..., 0.30
+    CHECK(a == b);
+    CHECK(fs::exists(dir / "broken" / "particles.pvd"));
+}
+
+TEST_CASE("a failing run reports step, particle and quantity and keeps its results",
+          "[dem][checkpoint][scenario]") {
+    const fs::path dir = scratch("failure");
+    DemScenario s = smallScenario(dir, 0.3);
+    // Drive the wheel straight down into the floor: overlaps run away.
+    s.bodies[0].motion = {{1.0, Vec3(0, 0, -1.0), Vec3::Zero()}};
+    RunOptions options{(dir / "run").string(), false, 1e9};
+    try {
+        runScenario(s, options);
+        FAIL("expected the run to stop");
+    } catch (const std::runtime_error& e) {
+        const std::string msg = e.what();
+        CHECK(msg.find("step ") == 0);
+        CHECK(msg.find("particle ") != std::string::npos);
+        CHECK(msg.find("overlap") != std::string::npos);
+        CHECK(msg.find("failure_particles.vtu") != std::string::npos);
+    }
+    const auto rows = lines(dir / "run" / "series.csv");
+    CHECK(rows.size() > 2);
+    for (const std::string& row : rows) CHECK(row.find("nan") == std::string::npos);
+    CHECK(fs::exists(dir / "run" / "failure_particles.vtu"));
+}

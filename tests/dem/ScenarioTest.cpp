@@ -1,0 +1,125 @@
+// Scenario files: strict validation with file, key and line in every error (docs/scenario.md).
+#include "grainlink/dem/Scenario.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <string>
+
+using namespace grainlink::dem;
+
+namespace {
+
+const std::string kValid = R"(name: tiny
+simulation:
+  time_step_s: 1.0e-4
+  gravity: mars
+material: {youngs_modulus_Pa: 3.0e6, poisson_ratio: 0.2, density_kg_m3: 2400}
+contact:
+  damping: {model: restitution, restitution: 0.3}
+  tangential: {model: linear, stiffness_N_m: 300, stick_angle_deg: 32, slip_angle_deg: 30}
+walls:
+  - {name: bin, type: box, lower_m: [0, 0, 0], upper_m: [0.1, 0.1, 0.2], friction_coefficient: 0}
+deposition:
+  region: {lower_m: [0, 0, 0], upper_m: [0.1, 0.1, 0.1]}
+  count: 100
+  radius: {distribution: uniform, min_m: 0.004, max_m: 0.005}
+run: {duration_s: 0.1}
+)";
+
+/// The message of the ConfigError that parsing `text` throws.
+std::string errorOf(const std::string& text) {
+    try {
+        parseScenario(ConfigNode::loadString(text, "bad.yaml"));
+    } catch (const ConfigError& e) {
+        return e.what();
+    }
+    return "no error";
+}
+
+std::string replaced(std::string text, const std::string& from, const std::string& to) {
+    const auto at = text.find(from);
+    REQUIRE(at != std::string::npos);
+    return text.replace(at, from.size(), to);
+}
+
+} // namespace
+
+TEST_CASE("a valid scenario parses into the documented settings", "[dem][scenario]") {
+    const DemScenario s = parseScenario(ConfigNode::loadString(kValid, "tiny.yaml"));
+    CHECK(s.name == "tiny");
+    CHECK(s.settings.gravity_m_s2.z() == Approx(-3.71));
+    CHECK(s.planes.size() == 5); // open-top box
+    CHECK(std::holds_alternative<TangentialLinear>(s.law.tangential));
+    CHECK(std::get<TangentialLinear>(s.law.tangential).slip_angle_deg == 30.0);
+    CHECK(s.deposition.count == 100);
+    CHECK(s.duration_s == 0.1);
+}
+
+TEST_CASE("scenario errors name the file, the key and the line", "[dem][scenario]") {
+    SECTION("unknown key") {
+        const std::string msg = errorOf(replaced(kValid, "gravity: mars", "gravity: mars\n  gravty: 3"));
+        CHECK(msg == "bad.yaml:5: unknown key 'simulation.gravty'");
+    }
+    SECTION("wrong unit is recognised as such") {
+        const std::string msg = errorOf(replaced(kValid, "time_step_s", "time_step_ms"));
+        CHECK(msg.find("bad.yaml:3: unknown key 'simulation.time_step_ms'") == 0);
+        CHECK(msg.find("wrong unit? this key is 'time_step_s'") != std::string::npos);
+    }
+    SECTION("missing key") {
+        const std::string msg = errorOf(replaced(kValid, "  count: 100\n", ""));
+        CHECK(msg.find("missing key 'deposition.count'") != std::string::npos);
+        CHECK(msg.find("bad.yaml:12:") == 0); // the deposition mapping
+    }
+    SECTION("not a number") {
+        const std::string msg = errorOf(replaced(kValid, "count: 100", "count: many"));
+        CHECK(msg == "bad.yaml:13: key 'deposition.count': expected a number, got 'many'");
+    }
+    SECTION("unknown model") {
+        const std::string msg = errorOf(replaced(kValid, "model: restitution", "model: hooke"));
+        CHECK(msg.find("key 'contact.damping.model': 'hooke' is not one of: restitution, viscous") !=
+              std::string::npos);
+    }
+    SECTION("non-physical parameter") {
+        const std::string msg = errorOf(replaced(kValid, "slip_angle_deg: 30", "slip_angle_deg: 40"));
+        CHECK(msg.find("bad.yaml:8:") == 0);
+        CHECK(msg.find("slip_angle_deg") != std::string::npos);
+    }
+    SECTION("YAML syntax error") {
+        const std::string msg = errorOf(replaced(kValid, "run: {duration_s: 0.1}", "run: {duration_s: 0.1"));
+        CHECK(msg.find("bad.yaml:") == 0);
+        CHECK(msg.find("YAML syntax error") != std::string::npos);
+    }
+}
+
+TEST_CASE("a time step above the stability estimate is refused with both numbers",
+          "[dem][scenario]") {
+    DemScenario s = parseScenario(ConfigNode::loadString(kValid, "tiny.yaml"));
+    s.settings.time_step_s = 1e-2;
+    auto system = makeSystem(s);
+    ParticleSpec p;
+    p.radius_m = 0.004;
+    p.density_kg_m3 = 2400;
+    p.position_m = Vec3(0.05, 0.05, 0.05);
+    system->particles().add(p);
+    try {
+        system->step();
+        FAIL("expected an error");
+    } catch (const std::invalid_argument& e) {
+        const std::string msg = e.what();
+        CHECK(msg.find("time_step_s = 0.01 s is above the stability estimate") == 0);
+    }
+}
+
+TEST_CASE("the packing key changes with the soil and not with the run", "[dem][scenario]") {
+    const DemScenario a = parseScenario(ConfigNode::loadString(kValid, "tiny.yaml"));
+    DemScenario b = a;
+    b.duration_s = 5.0;
+    b.bodies.push_back(BodySpec{});
+    CHECK(packingKey(a) == packingKey(b));
+    DemScenario c = a;
+    c.material.youngs_modulus_Pa = 4e6;
+    CHECK(packingKey(a) != packingKey(c));
+    DemScenario d = a;
+    d.deposition.seed = 99;
+    CHECK(packingKey(a) != packingKey(d));
+}
