@@ -13,7 +13,7 @@
 #      KEEP_LOG=FILE to keep the full LIGGGHTS screen output.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
-[ $# -ge 3 ] || { sed -n '2,14p' "$0" >&2; exit 2; }
+[ $# -ge 3 ] || { sed -n '2,13p' "$0" >&2; exit 2; }
 case=$1; data=$(realpath "$2"); np=$3; steps=${4:-2000}
 [ -f "$here/$case.in" ] || { echo "unknown case '$case'" >&2; exit 2; }
 
