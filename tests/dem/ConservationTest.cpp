@@ -13,9 +13,9 @@ const Material kMaterial = soil(1e7, 0.3, 2500.0);
 
 struct Momenta {
     Vec3 linear = Vec3::Zero();
-    Vec3 angular = Vec3::Zero();  ///< about the origin: sum m x × v + I w
-    double linear_scale = 0.0;    ///< sum m |v|
-    double angular_scale = 0.0;   ///< sum m |x||v| + I |w|
+    Vec3 angular = Vec3::Zero(); ///< about the origin: sum m x × v + I w
+    double linear_scale = 0.0;   ///< sum m |v|
+    double angular_scale = 0.0;  ///< sum m |x||v| + I |w|
 };
 
 Momenta momenta(const ParticleStore& p) {
@@ -23,8 +23,8 @@ Momenta momenta(const ParticleStore& p) {
     for (std::size_t i = 0; i < p.size(); ++i) {
         const double inertia = p.inertia[i].x(); // solid spheres: isotropic
         out.linear += p.mass[i] * p.velocity[i];
-        out.angular += p.mass[i] * p.position[i].cross(p.velocity[i]) +
-                       inertia * p.angular_velocity[i];
+        out.angular +=
+            p.mass[i] * p.position[i].cross(p.velocity[i]) + inertia * p.angular_velocity[i];
         out.linear_scale += p.mass[i] * p.velocity[i].norm();
         out.angular_scale += p.mass[i] * p.position[i].norm() * p.velocity[i].norm() +
                              inertia * p.angular_velocity[i].norm();

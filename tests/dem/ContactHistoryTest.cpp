@@ -66,18 +66,22 @@ std::unique_ptr<DemSystem> carried(const DemSettings& settings, bool keep_histor
         DemSystem::Internals bare = packing.saveInternals();
         bare.reference_position = packing.particles().position;
         bare.contacts.clear();
-        for (auto& h : bare.plane_history) h = ContactHistory{};
-        for (auto& slot : bare.mesh_slots) slot = DemSystem::MeshContactSlot{};
+        for (auto& h : bare.plane_history)
+            h = ContactHistory{};
+        for (auto& slot : bare.mesh_slots)
+            slot = DemSystem::MeshContactSlot{};
         sys->restoreInternals(bare);
     }
-    for (Vec3& v : sys->particles().velocity) v += kBoxVelocity;
+    for (Vec3& v : sys->particles().velocity)
+        v += kBoxVelocity;
     return sys;
 }
 
 /// Largest force difference between runs, matched by particle id.
 double maxForceDifference(const DemSystem& a, const DemSystem& b) {
     std::unordered_map<ParticleId, std::size_t> where;
-    for (std::size_t i = 0; i < b.particles().size(); ++i) where[b.particles().id[i]] = i;
+    for (std::size_t i = 0; i < b.particles().size(); ++i)
+        where[b.particles().id[i]] = i;
     double worst = 0.0;
     for (std::size_t i = 0; i < a.particles().size(); ++i) {
         const std::size_t j = where.at(a.particles().id[i]);
@@ -99,9 +103,9 @@ TEST_CASE("Contact history survives neighbour-list rebuilds and spatial re-sorts
     REQUIRE(kineticEnergy(packing) < 1e-7); // settled (measured 4e-9 J)
 
     const int steps = 3000; // the box travels 0.17 mm = 70 x the small skin
-    auto reference = carried(settingsWith(4e-3, 0));   // skin > travel: few rebuilds
-    auto rebuilding = carried(settingsWith(2e-6, 0));  // rebuilds (nearly) every step
-    auto resorting = carried(settingsWith(2e-6, 1));   // and re-sorts at each rebuild
+    auto reference = carried(settingsWith(4e-3, 0));        // skin > travel: few rebuilds
+    auto rebuilding = carried(settingsWith(2e-6, 0));       // rebuilds (nearly) every step
+    auto resorting = carried(settingsWith(2e-6, 1));        // and re-sorts at each rebuild
     auto forgetful = carried(settingsWith(4e-3, 0), false); // control: histories dropped
     for (DemSystem* sys : {reference.get(), rebuilding.get(), resorting.get(), forgetful.get()})
         sys->run(steps);

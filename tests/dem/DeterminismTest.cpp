@@ -52,6 +52,10 @@ void requireIdentical(const ParticleStore& a, const ParticleStore& b) {
 
 TEST_CASE("Two identical runs give bit-identical particles, one and two threads",
           "[dem][determinism]") {
-    SECTION("threads = 1") { requireIdentical(pour(1), pour(1)); }
-    SECTION("threads = 2") { requireIdentical(pour(2), pour(2)); }
+    SECTION("threads = 1") {
+        requireIdentical(pour(1), pour(1));
+    }
+    SECTION("threads = 2") {
+        requireIdentical(pour(2), pour(2));
+    }
 }

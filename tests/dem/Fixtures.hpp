@@ -8,7 +8,8 @@
 
 namespace grainlink::dem::testing {
 
-inline Material soil(double youngs_modulus_Pa = 1e7, double poisson = 0.3, double density = 2500.0) {
+inline Material soil(double youngs_modulus_Pa = 1e7, double poisson = 0.3,
+                     double density = 2500.0) {
     Material m;
     m.name = "test";
     m.youngs_modulus_Pa = youngs_modulus_Pa;
@@ -24,7 +25,8 @@ inline ContactLaw hertzRestitution(double restitution, double friction) {
     return law;
 }
 
-inline ContactLaw hertzViscous(double damping_N_s_m, double c_t, double stick_deg, double slip_deg) {
+inline ContactLaw hertzViscous(double damping_N_s_m, double c_t, double stick_deg,
+                               double slip_deg) {
     ContactLaw law;
     law.damping = DampingViscous{damping_N_s_m};
     TangentialLinear t;
@@ -72,14 +74,15 @@ struct HertzImpact {
 /// below the DEM one, it is the reference the DEM impacts are compared with.
 struct NormalImpactOde {
     double effective_modulus_Pa, radius_eff_m, mass_eff_kg;
-    double viscous_N_s_m = 0.0;    ///< k_n; used when restitution_set is 0
-    double restitution_set = 0.0;  ///< e of DampingRestitution; 0 selects the viscous dashpot
-    bool clamp = true;             ///< F >= 0 as in the kernel; false lets the dashpot pull
+    double viscous_N_s_m = 0.0;   ///< k_n; used when restitution_set is 0
+    double restitution_set = 0.0; ///< e of DampingRestitution; 0 selects the viscous dashpot
+    bool clamp = true;            ///< F >= 0 as in the kernel; false lets the dashpot pull
 
     double force(double delta, double rate) const {
-        if (delta <= 0.0) return 0.0;
-        const double elastic = 4.0 / 3.0 * effective_modulus_Pa * std::sqrt(radius_eff_m) *
-                               std::pow(delta, 1.5);
+        if (delta <= 0.0)
+            return 0.0;
+        const double elastic =
+            4.0 / 3.0 * effective_modulus_Pa * std::sqrt(radius_eff_m) * std::pow(delta, 1.5);
         double c = viscous_N_s_m;
         if (restitution_set > 0.0) {
             const double log_e = std::log(restitution_set);
@@ -91,8 +94,8 @@ struct NormalImpactOde {
     }
 
     struct Result {
-        double restitution;  ///< exit speed / impact speed
-        double duration_s;   ///< time with delta > 0
+        double restitution; ///< exit speed / impact speed
+        double duration_s;  ///< time with delta > 0
         double max_overlap_m;
     };
 
@@ -128,7 +131,9 @@ inline double effectiveModulus(const Material& m) {
     return m.youngs_modulus_Pa / (2.0 * (1.0 - m.poisson_ratio * m.poisson_ratio));
 }
 
-inline double sphereMass(double r, double rho) { return 4.0 / 3.0 * M_PI * r * r * r * rho; }
+inline double sphereMass(double r, double rho) {
+    return 4.0 / 3.0 * M_PI * r * r * r * rho;
+}
 
 /// Six planes enclosing [lower, upper], normals pointing inwards.
 inline void addBoxPlanes(DemSystem& sys, const Vec3& lower, const Vec3& upper) {
@@ -152,14 +157,13 @@ inline void addLattice(DemSystem& sys, const Vec3& lower, const Vec3& upper, dou
                        std::size_t max_count, unsigned seed = 7) {
     std::mt19937_64 rng(seed);
     std::uniform_real_distribution<double> unit(-1.0, 1.0);
-    const Eigen::Vector3i cells = ((upper - lower) / spacing_m + Vec3::Constant(1e-9))
-                                      .array()
-                                      .floor()
-                                      .cast<int>();
+    const Eigen::Vector3i cells =
+        ((upper - lower) / spacing_m + Vec3::Constant(1e-9)).array().floor().cast<int>();
     for (int iz = 0; iz < cells.z(); ++iz)
         for (int iy = 0; iy < cells.y(); ++iy)
             for (int ix = 0; ix < cells.x(); ++ix) {
-                if (sys.particles().size() >= max_count) return;
+                if (sys.particles().size() >= max_count)
+                    return;
                 const double x = lower.x() + (ix + 0.5) * spacing_m;
                 const double y = lower.y() + (iy + 0.5) * spacing_m;
                 const double z = lower.z() + (iz + 0.5) * spacing_m;
@@ -187,7 +191,8 @@ inline TriangleMesh makeOpenBox(double width_m, double height_m, int cells) {
     TriangleMesh box;
     auto append = [&box](const TriangleMesh& face, const Mat3& rotation, const Vec3& offset) {
         const int base = int(box.vertices_m.size());
-        for (const Vec3& v : face.vertices_m) box.vertices_m.push_back(rotation * v + offset);
+        for (const Vec3& v : face.vertices_m)
+            box.vertices_m.push_back(rotation * v + offset);
         for (const auto& t : face.triangles)
             box.triangles.push_back({t[0] + base, t[1] + base, t[2] + base});
     };

@@ -13,7 +13,9 @@ const Material kMaterial = soil(1e7, 0.3, 2500.0);
 constexpr double kRadius = 0.005;
 constexpr double kG = 9.81;
 
-double deg(double degrees) { return degrees * M_PI / 180.0; }
+double deg(double degrees) {
+    return degrees * M_PI / 180.0;
+}
 
 /// Overlap of a grain pressed on a wall of its own material by `load_N`.
 double restingOverlap(double load_N) {
@@ -44,8 +46,8 @@ TEST_CASE("TangentialLinear: sticks up to F_N tan(phi_h), slides at F_N tan(phi_
     sys.addPlane(floor);
     const double m = sphereMass(kRadius, kMaterial.density_kg_m3);
     const double weight = m * kG;
-    ParticleSpec spec = sphere(Vec3(0, 0, kRadius - restingOverlap(weight)), kRadius,
-                               kMaterial.density_kg_m3);
+    ParticleSpec spec =
+        sphere(Vec3(0, 0, kRadius - restingOverlap(weight)), kRadius, kMaterial.density_kg_m3);
     spec.inertia_kg_m2 = Vec3::Constant(1e3); // ~1e11 x the solid sphere's: rotation held
     sys.particles().add(spec);
     auto& p = sys.particles();
@@ -90,7 +92,8 @@ TEST_CASE("TangentialLinear: sticks up to F_N tan(phi_h), slides at F_N tan(phi_
 
     // 3. Drop the pull back to midway: below the stick limit, yet it keeps sliding, accelerating
     // at (P - W tan phi_g) / m. Acceleration over 45 ms after a 5 ms transient: 1 %.
-    for (int k = 0; k < 500; ++k) pulled(mid);
+    for (int k = 0; k < 500; ++k)
+        pulled(mid);
     const double v0 = p.velocity[0].x();
     double worst_ratio_error = 0.0;
     for (int k = 0; k < 4500; ++k) {
@@ -106,13 +109,16 @@ TEST_CASE("TangentialLinear: sticks up to F_N tan(phi_h), slides at F_N tan(phi_
     // and the wall takes the pull again (damped spring at rest: 1e-3).
     const double low = 0.5 * slide_force;
     const double v1 = p.velocity[0].x();
-    for (int k = 0; k < 1000; ++k) pulled(low);
+    for (int k = 0; k < 1000; ++k)
+        pulled(low);
     CHECK((p.velocity[0].x() - v1) / (1000 * dt) == Approx((low - slide_force) / m).epsilon(1e-2));
-    for (int k = 0; k < 20000; ++k) pulled(low);
+    for (int k = 0; k < 20000; ++k)
+        pulled(low);
     // At rest: the end-of-step velocity carries the pull's impulse P dt / m (2.5e-5 m/s), so
     // judge by the drift over 0.1 s; sliding at even 1 mm/s would move 1e-4 m.
     const double x_stuck = p.position[0].x();
-    for (int k = 0; k < 10000; ++k) pulled(low);
+    for (int k = 0; k < 10000; ++k)
+        pulled(low);
     CHECK(std::abs(p.position[0].x() - x_stuck) < 1e-8);
     CHECK(sys.planeForce(0).x() == Approx(low).epsilon(1e-3));
 }
@@ -132,8 +138,8 @@ TEST_CASE("Sphere on an incline rolls at 5/7 g sin(theta) or slips at g(sin - mu
         {20.0, 0.5, true}, {30.0, 0.18, true}, {30.0, 0.15, false}, {40.0, 0.2, false}};
     for (const Case& c : cases) {
         const double theta = deg(c.theta_deg);
-        INFO("theta = " << c.theta_deg << " deg, mu = " << c.mu << ", 2/7 tan(theta) = "
-                        << 2.0 / 7.0 * std::tan(theta));
+        INFO("theta = " << c.theta_deg << " deg, mu = " << c.mu
+                        << ", 2/7 tan(theta) = " << 2.0 / 7.0 * std::tan(theta));
         REQUIRE(c.rolls == (std::tan(theta) <= 3.5 * c.mu));
         DemSettings settings;
         settings.time_step_s = 1e-5;

@@ -14,9 +14,13 @@ using namespace grainlink::dem::testing;
 namespace {
 
 /// Table 1 soil of the seed paper.
-Material table1Soil() { return soil(3e6, 0.2, 2400.0); }
+Material table1Soil() {
+    return soil(3e6, 0.2, 2400.0);
+}
 
-ContactLaw bedLaw() { return hertzRestitution(0.5, 0.5); }
+ContactLaw bedLaw() {
+    return hertzRestitution(0.5, 0.5);
+}
 
 /// ~500 grains of r = 2.5 mm settled under gravity in a 48 mm square box of planes.
 const DemSystem& settledBed() {
@@ -26,8 +30,7 @@ const DemSystem& settledBed() {
         DemSystem sys(bedLaw(), {table1Soil()}, settings);
         const Vec3 lower(-0.024, -0.024, 0.0);
         addBoxPlanes(sys, lower, Vec3(0.024, 0.024, 0.2));
-        addLattice(sys, lower, Vec3(0.024, 0.024, 0.048), 0.006, 0.0025, 0.0025, 2400.0, 0.05,
-                   500);
+        addLattice(sys, lower, Vec3(0.024, 0.024, 0.048), 0.006, 0.0025, 0.0025, 2400.0, 0.05, 500);
         sys.run(8000);
         return sys;
     }();
@@ -102,7 +105,8 @@ TEST_CASE("Largest stable step: velocity Verlet vs Newmark (beta 1/4, gamma 1/2)
     // Table 1's 5e-5 s is stable with a margin of 3.
     const DemSystem& bed = settledBed();
     double bed_mass = 0.0;
-    for (double m : bed.particles().mass) bed_mass += m;
+    for (double m : bed.particles().mass)
+        bed_mass += m;
     const double lift_J = bed_mass * 9.81 * 0.0025;
     REQUIRE(kineticEnergy(bed) < 3e-4 * lift_J); // settled (measured 1.1e-4)
 

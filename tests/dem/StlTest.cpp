@@ -25,8 +25,8 @@ double maxCornerDistance(const TriangleMesh& a, const TriangleMesh& b) {
     double worst = 0.0;
     for (std::size_t t = 0; t < a.triangleCount(); ++t)
         for (int k = 0; k < 3; ++k)
-            worst = std::max(worst, (a.vertices_m[a.triangles[t][k]] -
-                                     b.vertices_m[b.triangles[t][k]]).norm());
+            worst = std::max(
+                worst, (a.vertices_m[a.triangles[t][k]] - b.vertices_m[b.triangles[t][k]]).norm());
     return worst;
 }
 
@@ -51,8 +51,8 @@ TEST_CASE("STL round trip of the wheel cylinder, ASCII and binary", "[dem][stl]"
     const auto [closure, volume] = closureAndVolume(wheel);
     // Closed, outward-facing surface; a 360-gon cylinder holds pi r^2 w sin(2pi/n) n / (2pi).
     CHECK(closure < 1e-12);
-    CHECK(volume == Approx(0.5 * 360 * std::sin(2 * M_PI / 360) * 0.125 * 0.125 * 0.1)
-                        .epsilon(1e-12));
+    CHECK(volume ==
+          Approx(0.5 * 360 * std::sin(2 * M_PI / 360) * 0.125 * 0.125 * 0.1).epsilon(1e-12));
 
     TempFile ascii("wheel_ascii.stl"), binary("wheel_binary.stl");
     writeStlAscii(wheel, ascii.path, "wheel");
@@ -81,13 +81,11 @@ TEST_CASE("A malformed STL names the file and the line", "[dem][stl]") {
 
     write(head + "   vertex 0 0 0\n   vertex 1 zero 0\n   vertex 0 1 0\n  endloop\n endfacet\n"
                  "endsolid broken\n");
-    CHECK_THROWS_WITH(readStl(file.path), Catch::Contains(file.path) &&
-                                              Catch::Contains("line 5") &&
+    CHECK_THROWS_WITH(readStl(file.path), Catch::Contains(file.path) && Catch::Contains("line 5") &&
                                               Catch::Contains("malformed vertex"));
 
     write(head + "   vertex 0 0 0\n   vertex 1 0 0\n  endloop\n endfacet\nendsolid broken\n");
-    CHECK_THROWS_WITH(readStl(file.path), Catch::Contains(file.path) &&
-                                              Catch::Contains("line 6") &&
+    CHECK_THROWS_WITH(readStl(file.path), Catch::Contains(file.path) && Catch::Contains("line 6") &&
                                               Catch::Contains("2 vertices"));
 
     write("neither ascii nor binary");

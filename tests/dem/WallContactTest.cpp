@@ -45,8 +45,8 @@ struct Impact {
 Impact dropOn(Floor floor, double restitution, const Vec3& at, double speed, double dt) {
     DemSystem sys = makeFloor(floor, hertzRestitution(restitution, 0.0), quietSettings(dt));
     const double gap = 0.01 * kRadius;
-    sys.particles().add(sphere(at + Vec3(0, 0, kRadius + gap), kRadius,
-                               kMaterial.density_kg_m3, {0, 0, -speed}));
+    sys.particles().add(
+        sphere(at + Vec3(0, 0, kRadius + gap), kRadius, kMaterial.density_kg_m3, {0, 0, -speed}));
     Impact out;
     bool touching = false;
     double start = 0.0;
@@ -145,7 +145,8 @@ TEST_CASE("A flat mesh acts exactly like its plane for a sliding and rolling sph
                     worst_force, (plane.particles().force[0] - mesh.particles().force[0]).norm());
                 worst_reaction =
                     std::max(worst_reaction, (floorForce(plane) - floorForce(mesh)).norm());
-                if (k % 100 != 0) continue; // a 5 mm cell takes >= 2000 steps to cross
+                if (k % 100 != 0)
+                    continue; // a 5 mm cell takes >= 2000 steps to cross
                 const auto& v = mesh.body(0).worldVertices();
                 const Vec3& x = mesh.particles().position[0];
                 for (std::size_t t = 0; t < loaded.size(); ++t) {
@@ -162,7 +163,8 @@ TEST_CASE("A flat mesh acts exactly like its plane for a sliding and rolling sph
             CHECK((a.velocity[0] - b.velocity[0]).norm() < 1e-9 * path.velocity.norm());
             CHECK((a.angular_velocity[0] - b.angular_velocity[0]).norm() <
                   1e-9 * path.velocity.norm() / kRadius);
-            // The test is only as good as the ground it covers: several cm, tens of triangles touched.
+            // The test is only as good as the ground it covers: several cm, tens of triangles
+            // touched.
             CHECK(travelled > 0.035);
             CHECK(std::count(loaded.begin(), loaded.end(), true) >= 20);
             // And it has gone from sliding (slip ~ v) to rolling: contact point nearly at rest,
