@@ -162,6 +162,10 @@ int run(const fs::path& dir, const std::string& which, int threads, std::uint64_
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double rate = double(sys->particles().size()) * double(steps) / seconds;
     std::fprintf(stderr, "%s", sys->timer().table().c_str());
+    std::fprintf(stderr, "per particle: %.2f listed pairs, %.2f contacts; %llu list builds\n",
+                 double(sys->neighbourPairs()) / double(sys->particles().size()),
+                 double(sys->contactCount()) / double(sys->particles().size()),
+                 static_cast<unsigned long long>(sys->neighbourBuilds()));
     std::printf("GRAINLINK case=%s threads=%d particles=%zu steps=%llu seconds=%.4f "
                 "particle_steps_per_s=%.0f\n",
                 which.c_str(), threads, sys->particles().size(),
