@@ -124,6 +124,7 @@ PairProperties pairProperties(const Material& a, const Material& b, const Contac
     const double sa = 2.0 * (2.0 - a.poisson_ratio) * (1.0 + a.poisson_ratio) / a.youngs_modulus_Pa;
     const double sb = 2.0 * (2.0 - b.poisson_ratio) * (1.0 + b.poisson_ratio) / b.youngs_modulus_Pa;
     p.effective_shear_modulus_Pa = 1.0 / (sa + sb);
+    p.root_shear_ratio = std::sqrt(4.0 * p.effective_shear_modulus_Pa / p.effective_modulus_Pa);
     std::visit(
         [&](const auto& t) {
             using T = std::decay_t<decltype(t)>;

@@ -34,18 +34,19 @@ DemSystem::DemSystem(ContactLaw law, std::vector<Material> materials, DemSetting
     for (std::size_t a = 0; a < nm; ++a)
         for (std::size_t b = 0; b < nm; ++b)
             pair_props_[a * nm + b] = pairProperties(materials_[a], materials_[b], law_);
-    phase_.kick = timer_.phase("halfKick");
-    phase_.drift = timer_.phase("drift");
-    phase_.predict = timer_.phase("newmarkPredict");
-    phase_.correct = timer_.phase("newmarkCorrect");
+    // Phases in step order; the two passes over all particles fuse the cheap per-particle work.
+    phase_.kick_drift = timer_.phase(settings_.integrator == Integrator::Newmark
+                                         ? "predict+clearForces"
+                                         : "halfKick+drift+clearForces");
     phase_.bodies = timer_.phase("moveBodies");
     phase_.neighbours = timer_.phase("updateNeighbours");
-    phase_.clear = timer_.phase("clearForces");
     phase_.contacts = timer_.phase("pairContacts");
     phase_.walls = timer_.phase("planeContacts");
     phase_.meshes = timer_.phase("meshContacts");
-    phase_.body_forces = timer_.phase("bodyForces");
-    phase_.check = timer_.phase("checkForces");
+    phase_.check = timer_.phase("checkOverlaps");
+    phase_.finish = timer_.phase(settings_.integrator == Integrator::Newmark
+                                     ? "bodyForces+correct"
+                                     : "bodyForces+halfKick");
 }
 
 int DemSystem::addPlane(PlaneWall wall) {
@@ -110,8 +111,9 @@ void DemSystem::initialise() {
     if (settings_.check_time_step) validateTimeStep();
     const int threads = settings_.threads;
     const std::size_t n = particles_.size();
-    thread_force_.assign(threads, std::vector<Vec3>(threads > 1 ? n : 0, Vec3::Zero()));
-    thread_torque_.assign(threads, std::vector<Vec3>(threads > 1 ? n : 0, Vec3::Zero()));
+    side_.assign(std::size_t(threads), {});
+    if (planes_.size() > 64)
+        throw std::invalid_argument("at most 64 planes are supported; use a mesh for more");
     thread_body_force_.assign(threads, std::vector<Vec3>(bodies_.size()));
     thread_body_torque_.assign(threads, std::vector<Vec3>(bodies_.size()));
     thread_plane_force_.assign(threads, std::vector<Vec3>(planes_.size()));
@@ -135,6 +137,7 @@ void DemSystem::initialise() {
         const std::uint64_t builds = neighbours_.buildCount();
         neighbours_.build(reference_position_, particles_.radius, settings_.skin_m, {}, threads);
         neighbours_.restoreBuildCount(builds);
+        updatePlaneMasks();
     }
     candidates_stale_ = true;
 }
@@ -188,23 +191,27 @@ void DemSystem::setTimeStep(double dt_s) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// The step
+// The step: few fused passes over the particle arrays (each pass is one timed phase).
 
 void DemSystem::step() {
     if (!initialised_) initialise();
     if (!forces_valid_) {
+        // Forces at the initial state, needed by the first half kick / predictor.
         moveBodies(time());
+        clearForces();
+        displacement_known_ = false;
         computeForces();
+        finishForces(0.0);
         forces_valid_ = true;
     }
     const double t_next = time() + settings_.time_step_s;
     if (settings_.integrator == Integrator::VelocityVerlet) {
-        kickDrift(0.5, true); // halfKick + drift
+        kickDriftClear();
         moveBodies(t_next);
         computeForces();
-        kickDrift(0.5, false); // halfKick
+        finishForces(0.5);
     } else {
-        newmarkPredict();
+        newmarkPredictClear();
         moveBodies(t_next);
         computeForces();
         newmarkCorrect();
@@ -231,67 +238,150 @@ void DemSystem::angularAcceleration(std::size_t i, Vec3& alpha) const {
     alpha = rot * body_alpha;
 }
 
-void DemSystem::kickDrift(double kick_fraction, bool drift) {
-    const double dt = settings_.time_step_s;
-    const std::size_t n = particles_.size();
+namespace {
+/// Turns q by the rotation vector `turn` (world frame). Small turns, the rule in a DEM step,
+/// use the exact series of the exponential map and so need no trigonometric functions.
+inline void rotate(Quat& q, const Vec3& turn) {
+    const Vec3 half = 0.5 * turn;
+    const double s2 = half.squaredNorm();
+    Quat dq;
+    if (s2 < 1e-6) { // |half| < 1e-3: series truncation error below 1e-19
+        dq.w() = 1.0 - s2 * (0.5 - s2 / 24.0);
+        dq.vec() = half * (1.0 - s2 * (1.0 / 6.0 - s2 / 120.0));
+    } else {
+        dq = rotationFromVector(turn);
+    }
+    q = dq * q;
+    if (s2 >= 1e-6) q.normalize(); // the series keeps |dq| = 1 to round-off
+}
+} // namespace
+
+void DemSystem::kickDriftClear() {
+    PhaseTimer::Scope scope(timer_, phase_.kick_drift);
+    const double dt = settings_.time_step_s, h = 0.5 * dt;
     auto& p = particles_;
-    {
-        PhaseTimer::Scope scope(timer_, phase_.kick);
-#pragma omp parallel for schedule(static) num_threads(settings_.threads)
-        for (std::size_t i = 0; i < n; ++i) {
-            p.velocity[i] += (kick_fraction * dt * p.inv_mass[i]) * p.force[i];
-            Vec3 alpha;
-            angularAcceleration(i, alpha);
-            p.angular_velocity[i] += (kick_fraction * dt) * alpha;
-        }
-    }
-    if (!drift) return;
-    PhaseTimer::Scope scope(timer_, phase_.drift);
-#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+    const std::size_t n = p.size();
+    const bool track_mesh = !bodies_.empty() && !candidates_stale_;
+    double max_sq = 0.0, max_mesh_sq = 0.0;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads) \
+    reduction(max : max_sq, max_mesh_sq)
     for (std::size_t i = 0; i < n; ++i) {
+        p.velocity[i] += (h * p.inv_mass[i]) * p.force[i];
+        Vec3 alpha;
+        angularAcceleration(i, alpha);
+        p.angular_velocity[i] += h * alpha;
         p.position[i] += dt * p.velocity[i];
-        p.orientation[i] = rotationFromVector(dt * p.angular_velocity[i]) * p.orientation[i];
-        p.orientation[i].normalize();
+        rotate(p.orientation[i], dt * p.angular_velocity[i]);
+        p.force[i].setZero();
+        p.torque[i].setZero();
+        max_sq = std::max(max_sq, (p.position[i] - reference_position_[i]).squaredNorm());
+        if (track_mesh)
+            max_mesh_sq =
+                std::max(max_mesh_sq, (p.position[i] - mesh_reference_position_[i]).squaredNorm());
     }
+    max_displacement_sq_ = max_sq;
+    max_mesh_displacement_sq_ = max_mesh_sq;
+    displacement_known_ = true;
 }
 
-void DemSystem::newmarkPredict() {
-    PhaseTimer::Scope scope(timer_, phase_.predict);
+void DemSystem::newmarkPredictClear() {
+    PhaseTimer::Scope scope(timer_, phase_.kick_drift);
     const double dt = settings_.time_step_s, beta = settings_.newmark_beta,
                  gamma = settings_.newmark_gamma;
     auto& p = particles_;
     const std::size_t n = p.size();
-#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+    const bool track_mesh = !bodies_.empty() && !candidates_stale_;
+    double max_sq = 0.0, max_mesh_sq = 0.0;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads) \
+    reduction(max : max_sq, max_mesh_sq)
     for (std::size_t i = 0; i < n; ++i) {
         const Vec3 a = p.inv_mass[i] * p.force[i];
         p.position[i] += dt * p.velocity[i] + (dt * dt * (0.5 - beta)) * a;
         p.velocity[i] += (dt * (1.0 - gamma)) * a;
         Vec3 alpha;
         angularAcceleration(i, alpha);
-        p.orientation[i] = rotationFromVector(dt * p.angular_velocity[i] +
-                                              (dt * dt * (0.5 - beta)) * alpha) *
-                           p.orientation[i];
+        rotate(p.orientation[i], dt * p.angular_velocity[i] + (dt * dt * (0.5 - beta)) * alpha);
         p.angular_velocity[i] += (dt * (1.0 - gamma)) * alpha;
+        p.force[i].setZero();
+        p.torque[i].setZero();
+        max_sq = std::max(max_sq, (p.position[i] - reference_position_[i]).squaredNorm());
+        if (track_mesh)
+            max_mesh_sq =
+                std::max(max_mesh_sq, (p.position[i] - mesh_reference_position_[i]).squaredNorm());
     }
+    max_displacement_sq_ = max_sq;
+    max_mesh_displacement_sq_ = max_mesh_sq;
+    displacement_known_ = true;
 }
 
 void DemSystem::newmarkCorrect() {
-    PhaseTimer::Scope scope(timer_, phase_.correct);
+    PhaseTimer::Scope scope(timer_, phase_.finish);
     const double dt = settings_.time_step_s, beta = settings_.newmark_beta,
                  gamma = settings_.newmark_gamma;
     auto& p = particles_;
     const std::size_t n = p.size();
-#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+    std::size_t bad = n;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : bad)
     for (std::size_t i = 0; i < n; ++i) {
+        addBodyForces(i);
+        if (!p.force[i].allFinite() || !p.torque[i].allFinite() || !p.position[i].allFinite())
+            bad = std::min(bad, i);
         const Vec3 a = p.inv_mass[i] * p.force[i];
         p.position[i] += (beta * dt * dt) * a;
         p.velocity[i] += (gamma * dt) * a;
         Vec3 alpha;
         angularAcceleration(i, alpha);
-        p.orientation[i] = rotationFromVector((beta * dt * dt) * alpha) * p.orientation[i];
-        p.orientation[i].normalize();
+        rotate(p.orientation[i], (beta * dt * dt) * alpha);
         p.angular_velocity[i] += (gamma * dt) * alpha;
     }
+    if (bad < n) reportNonFinite(bad);
+}
+
+void DemSystem::finishForces(double kick_fraction) {
+    PhaseTimer::Scope scope(timer_, phase_.finish);
+    const double h = kick_fraction * settings_.time_step_s;
+    auto& p = particles_;
+    const std::size_t n = p.size();
+    std::size_t bad = n;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : bad)
+    for (std::size_t i = 0; i < n; ++i) {
+        addBodyForces(i);
+        // Checked before the kick: the state stays finite for the failure snapshot.
+        if (!p.force[i].allFinite() || !p.torque[i].allFinite() || !p.position[i].allFinite()) {
+            bad = std::min(bad, i);
+            continue;
+        }
+        if (h == 0.0) continue;
+        p.velocity[i] += (h * p.inv_mass[i]) * p.force[i];
+        Vec3 alpha;
+        angularAcceleration(i, alpha);
+        p.angular_velocity[i] += h * alpha;
+    }
+    if (bad < n) reportNonFinite(bad);
+}
+
+inline void DemSystem::addBodyForces(std::size_t i) {
+    auto& p = particles_;
+    p.force[i] += p.mass[i] * settings_.gravity_m_s2;
+    const double k_h = law_.background_damping_1_s;
+    if (k_h > 0.0) {
+        // Background damping k_h (docs/physics.md §2.8); mean moment for anisotropic grains.
+        p.force[i] -= (k_h * p.mass[i]) * p.velocity[i];
+        p.torque[i] -= (k_h * p.inertia[i].mean()) * p.angular_velocity[i];
+    }
+}
+
+void DemSystem::reportNonFinite(std::size_t i) const {
+    const auto& p = particles_;
+    const std::string what = !p.position[i].allFinite() ? "position"
+                             : !p.force[i].allFinite()  ? "force"
+                                                        : "torque";
+    throw SimulationError(step_ + 1, p.id[i], what, "is not finite");
+}
+
+void DemSystem::clearForces() {
+    std::fill(particles_.force.begin(), particles_.force.end(), Vec3::Zero());
+    std::fill(particles_.torque.begin(), particles_.torque.end(), Vec3::Zero());
 }
 
 void DemSystem::moveBodies(double t_s) {
@@ -302,16 +392,10 @@ void DemSystem::moveBodies(double t_s) {
 
 void DemSystem::computeForces() {
     updateNeighbours();
-    {
-        PhaseTimer::Scope scope(timer_, phase_.clear);
-        std::fill(particles_.force.begin(), particles_.force.end(), Vec3::Zero());
-        std::fill(particles_.torque.begin(), particles_.torque.end(), Vec3::Zero());
-    }
     pairContacts();
     planeContacts();
     meshContacts();
-    bodyForces();
-    checkForces();
+    checkOverlaps();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -321,29 +405,34 @@ void DemSystem::updateNeighbours() {
     PhaseTimer::Scope scope(timer_, phase_.neighbours);
     const std::size_t n = particles_.size();
     const auto& x = particles_.position;
-    double max_sq = 0.0, max_mesh_sq = 0.0;
     const bool have_bodies = !bodies_.empty();
-    const bool track_mesh = have_bodies && !candidates_stale_;
-#pragma omp parallel for schedule(static) num_threads(settings_.threads) \
-    reduction(max : max_sq, max_mesh_sq)
-    for (std::size_t i = 0; i < n; ++i) {
-        max_sq = std::max(max_sq, (x[i] - reference_position_[i]).squaredNorm());
-        if (track_mesh)
-            max_mesh_sq = std::max(max_mesh_sq, (x[i] - mesh_reference_position_[i]).squaredNorm());
+    if (!displacement_known_) {
+        // Only at the first force evaluation; later the kick-drift pass measures this.
+        const bool track_mesh = have_bodies && !candidates_stale_;
+        max_displacement_sq_ = max_mesh_displacement_sq_ = 0.0;
+        for (std::size_t i = 0; i < n; ++i) {
+            max_displacement_sq_ =
+                std::max(max_displacement_sq_, (x[i] - reference_position_[i]).squaredNorm());
+            if (track_mesh)
+                max_mesh_displacement_sq_ = std::max(
+                    max_mesh_displacement_sq_, (x[i] - mesh_reference_position_[i]).squaredNorm());
+        }
     }
+    displacement_known_ = false;
     const double skin = settings_.skin_m;
-    if (2.0 * std::sqrt(max_sq) > skin) rebuildNeighbours();
+    if (2.0 * std::sqrt(max_displacement_sq_) > skin) rebuildNeighbours();
     if (!have_bodies) return;
     // A particle-triangle pair may approach by the particle's and the mesh's displacement.
     double body_move = 0.0;
     for (std::size_t b = 0; b < bodies_.size() && !candidates_stale_; ++b) {
         const RigidBodyState &now = bodies_[b].state(), &ref = body_reference_[b];
         const double angle = 2.0 * std::acos(std::min(
-                                        1.0, std::abs((now.orientation * ref.orientation.conjugate()).w())));
+                                       1.0, std::abs((now.orientation * ref.orientation.conjugate()).w())));
         body_move = std::max(body_move, (now.position_m - ref.position_m).norm() +
                                             angle * bodies_[b].boundingRadius());
     }
-    if (candidates_stale_ || std::sqrt(max_mesh_sq) + body_move > skin) rebuildMeshCandidates();
+    if (candidates_stale_ || std::sqrt(max_mesh_displacement_sq_) + body_move > skin)
+        rebuildMeshCandidates();
 }
 
 void DemSystem::rebuildNeighbours() {
@@ -369,6 +458,25 @@ void DemSystem::rebuildNeighbours() {
     neighbours_.build(particles_.position, particles_.radius, settings_.skin_m, old_to_new,
                       settings_.threads);
     reference_position_ = particles_.position;
+    updatePlaneMasks();
+}
+
+void DemSystem::updatePlaneMasks() {
+    // Planes within reach (radius + skin) of each particle; the others cannot touch it before
+    // the next rebuild, so their history lapses now.
+    const std::size_t n = particles_.size(), np = planes_.size();
+    plane_mask_.assign(n, 0);
+    const double skin = settings_.skin_m;
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)
+    for (std::size_t i = 0; i < n; ++i) {
+        std::uint64_t mask = 0;
+        for (std::size_t w = 0; w < np; ++w) {
+            const double dist = (particles_.position[i] - planes_[w].point_m).dot(planes_[w].normal);
+            if (dist < particles_.radius[i] + skin) mask |= std::uint64_t(1) << w;
+            else if (plane_history_[i * np + w].active()) plane_history_[i * np + w] = ContactHistory{};
+        }
+        plane_mask_[i] = mask;
+    }
 }
 
 void DemSystem::permuteWallHistories(const std::vector<std::size_t>& order) {
@@ -400,6 +508,7 @@ void DemSystem::rebuildMeshCandidates() {
             const Vec3 pad = Vec3::Constant(r_max + skin);
             const Eigen::Vector3i lo = mesh_grid_.cellCoords(a.cwiseMin(bb).cwiseMin(c) - pad);
             const Eigen::Vector3i hi = mesh_grid_.cellCoords(a.cwiseMax(bb).cwiseMax(c) + pad);
+            const Vec3 normal = (bb - a).cross(c - a).normalized();
             for (int z = lo.z(); z <= hi.z(); ++z)
                 for (int y = lo.y(); y <= hi.y(); ++y)
                     for (int x = lo.x(); x <= hi.x(); ++x) {
@@ -408,6 +517,8 @@ void DemSystem::rebuildMeshCandidates() {
                             const std::size_t i = std::size_t(members[k]);
                             const Vec3& p = particles_.position[i];
                             const double reach = particles_.radius[i] + skin;
+                            // Cheap plane test first: most cell members are far off the plane.
+                            if (std::abs((p - a).dot(normal)) >= reach) continue;
                             if ((closestPointOnTriangle(p, a, bb, c) - p).squaredNorm() < reach * reach)
                                 found.push_back({i, {int(b), int(t)}});
                         }
@@ -415,13 +526,25 @@ void DemSystem::rebuildMeshCandidates() {
         }
     }
     std::sort(found.begin(), found.end());
-    mesh_candidate_first_.assign(n + 1, 0);
+    std::vector<std::size_t> first(n + 1, 0);
     mesh_candidates_.clear();
     for (const auto& f : found) {
-        ++mesh_candidate_first_[f.first + 1];
+        ++first[f.first + 1];
         mesh_candidates_.push_back(f.second);
     }
-    for (std::size_t i = 0; i < n; ++i) mesh_candidate_first_[i + 1] += mesh_candidate_first_[i];
+    for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
+    // Particles out of every mesh's reach drop their mesh histories (they cannot touch).
+    for (std::size_t i = 0; i < n; ++i)
+        if (first[i] == first[i + 1] && mesh_slots_[i * kMeshSlots].body >= 0)
+            for (int s = 0; s < kMeshSlots; ++s) mesh_slots_[i * kMeshSlots + s] = MeshContactSlot{};
+    mesh_particles_.clear();
+    mesh_candidate_first_.clear();
+    for (std::size_t i = 0; i < n; ++i)
+        if (first[i] < first[i + 1]) {
+            mesh_particles_.push_back(i);
+            mesh_candidate_first_.push_back(first[i]);
+        }
+    mesh_candidate_first_.push_back(first[n]);
     mesh_reference_position_ = particles_.position;
     for (std::size_t b = 0; b < bodies_.size(); ++b) body_reference_[b] = bodies_[b].state();
     candidates_stale_ = false;
@@ -442,78 +565,92 @@ void DemSystem::pairContacts() {
         using Normal = std::decay_t<decltype(normal)>;
 #pragma omp parallel num_threads(threads)
         {
+            // Thread t owns particles [begin, end) and writes their forces directly. The
+            // reaction on a particle of a later thread goes to a side list, added after the
+            // barrier in thread order: deterministic and without full-size buffers.
             const int t = omp_get_thread_num();
-            // One thread writes straight into the store; with more, each sums into its own
-            // buffer and the buffers are added in thread order (deterministic).
-            Vec3* force = threads > 1 ? thread_force_[t].data() : p.force.data();
-            Vec3* torque = threads > 1 ? thread_torque_[t].data() : p.torque.data();
-            if (threads > 1) {
-                std::fill(thread_force_[t].begin(), thread_force_[t].end(), Vec3::Zero());
-                std::fill(thread_torque_[t].begin(), thread_torque_[t].end(), Vec3::Zero());
-            }
-            double max_ratio = 0.0;
-            std::pair<ParticleId, ParticleId> max_pair{0, 0};
             const std::size_t begin = n * std::size_t(t) / std::size_t(threads);
             const std::size_t end = n * std::size_t(t + 1) / std::size_t(threads);
+            auto& side = side_[std::size_t(t)];
+            side.clear();
+            // Raw, non-aliasing pointers: the stores to forces then cannot force reloads of
+            // the arrays' addresses from the store object inside the loop.
+            Vec3* __restrict force = p.force.data();
+            Vec3* __restrict torque = p.torque.data();
+            const Vec3* __restrict position = p.position.data();
+            const Vec3* __restrict velocity = p.velocity.data();
+            const Vec3* __restrict spin = p.angular_velocity.data();
+            const double* __restrict radius = p.radius.data();
+            const double* __restrict inv_mass = p.inv_mass.data();
+            const int* __restrict material = p.material.data();
+            double max_ratio = 0.0;
+            std::pair<ParticleId, ParticleId> max_pair{0, 0};
+            const std::size_t* __restrict first = neighbours_.first.data();
+            const int* __restrict neighbour = neighbours_.neighbour.data();
+            std::uint8_t* __restrict touching = neighbours_.touching.data();
+            ContactHistory* __restrict history = neighbours_.history.data();
             ContactGeometry g;
             ContactResult r;
             for (std::size_t i = begin; i < end; ++i) {
-                const Vec3 xi = p.position[i];
-                const double ri = p.radius[i];
+                const Vec3 xi = position[i];
+                const double ri = radius[i];
                 Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
-                for (std::size_t k = neighbours_.first[i]; k < neighbours_.first[i + 1]; ++k) {
-                    const std::size_t j = std::size_t(neighbours_.neighbour[k]);
-                    const Vec3 d = xi - p.position[j];
+                for (std::size_t k = first[i]; k < first[i + 1]; ++k) {
+                    const std::size_t j = std::size_t(neighbour[k]);
+                    const Vec3 d = xi - position[j];
                     const double dist_sq = d.squaredNorm();
-                    const double r_sum = ri + p.radius[j];
-                    ContactHistory& h = neighbours_.history[k];
+                    const double rj = radius[j];
+                    const double r_sum = ri + rj;
                     if (dist_sq >= r_sum * r_sum) {
-                        if (h.active()) h = ContactHistory{}; // contact lost: history lapses
+                        if (touching[k]) { // contact lost: its history lapses
+                            touching[k] = 0;
+                            history[k] = ContactHistory{};
+                        }
                         continue;
                     }
+                    touching[k] = 1;
                     const double dist = std::sqrt(dist_sq);
-                    g.normal = d / dist;
+                    g.normal = d * (1.0 / dist);
                     g.overlap_m = r_sum - dist;
-                    g.radius_eff_m = ri * p.radius[j] / r_sum;
-                    g.mass_eff_kg = p.mass[i] * p.mass[j] / (p.mass[i] + p.mass[j]);
+                    g.radius_eff_m = ri * rj / r_sum;
+                    g.mass_eff_kg = 1.0 / (inv_mass[i] + inv_mass[j]);
                     g.arm_i_m = ri - 0.5 * g.overlap_m;
-                    g.arm_j_m = p.radius[j] - 0.5 * g.overlap_m;
+                    g.arm_j_m = rj - 0.5 * g.overlap_m;
                     g.contact_velocity_m_s =
-                        p.velocity[i] - p.velocity[j] -
-                        (g.arm_i_m * p.angular_velocity[i] + g.arm_j_m * p.angular_velocity[j])
-                            .cross(g.normal);
-                    g.relative_spin_rad_s = p.angular_velocity[i] - p.angular_velocity[j];
+                        velocity[i] - velocity[j] -
+                        (g.arm_i_m * spin[i] + g.arm_j_m * spin[j]).cross(g.normal);
+                    g.relative_spin_rad_s = spin[i] - spin[j];
                     const PairProperties& props =
-                        pair_props_[std::size_t(p.material[i]) * nm + std::size_t(p.material[j])];
-                    evaluateContact<Normal>(damping, tangential, rolling, cohesion, props, g, dt, h,
-                                            r);
+                        pair_props_[std::size_t(material[i]) * nm + std::size_t(material[j])];
+                    evaluateContact<Normal>(damping, tangential, rolling, cohesion, props, g, dt,
+                                            history[k], r);
                     fi += r.force_on_i_N;
                     ti += r.torque_on_i_N_m;
-                    force[j] -= r.force_on_i_N;
-                    torque[j] += r.torque_on_j_N_m;
-                    const double ratio = g.overlap_m / std::min(ri, p.radius[j]);
-                    if (ratio > max_ratio) {
-                        max_ratio = ratio;
+                    if (j < end) {
+                        force[j] -= r.force_on_i_N;
+                        torque[j] += r.torque_on_j_N_m;
+                    } else {
+                        side.push_back({j, -r.force_on_i_N, r.torque_on_j_N_m});
+                    }
+                    const double r_min = std::min(ri, rj);
+                    if (g.overlap_m > max_ratio * r_min) {
+                        max_ratio = g.overlap_m / r_min;
                         max_pair = {p.id[i], p.id[j]};
                     }
                 }
                 force[i] += fi;
                 torque[i] += ti;
             }
-            thread_max_overlap_[t] = max_ratio;
-            thread_max_overlap_pair_[t] = max_pair;
+            thread_max_overlap_[std::size_t(t)] = max_ratio;
+            thread_max_overlap_pair_[std::size_t(t)] = max_pair;
             if (threads > 1) {
 #pragma omp barrier
-#pragma omp for schedule(static)
-                for (std::size_t i = 0; i < n; ++i) {
-                    Vec3 f = thread_force_[0][i], tq = thread_torque_[0][i];
-                    for (int s = 1; s < threads; ++s) {
-                        f += thread_force_[s][i];
-                        tq += thread_torque_[s][i];
-                    }
-                    p.force[i] = f;
-                    p.torque[i] = tq;
-                }
+                for (int s = 0; s < t; ++s)
+                    for (const SideContribution& c : side_[std::size_t(s)])
+                        if (c.particle >= begin && c.particle < end) {
+                            force[c.particle] += c.force_N;
+                            torque[c.particle] += c.torque_N_m;
+                        }
             }
         }
     });
@@ -538,7 +675,8 @@ void DemSystem::planeContacts() {
             ContactResult r;
 #pragma omp for schedule(static)
             for (std::size_t i = 0; i < n; ++i) {
-                for (std::size_t w = 0; w < np; ++w) {
+                for (std::uint64_t mask = plane_mask_[i]; mask != 0; mask &= mask - 1) {
+                    const std::size_t w = std::size_t(__builtin_ctzll(mask));
                     const PlaneWall& wall = planes_[w];
                     ContactHistory& h = plane_history_[i * np + w];
                     const double dist = (p.position[i] - wall.point_m).dot(wall.normal);
@@ -582,7 +720,7 @@ void DemSystem::meshContacts() {
     if (bodies_.empty()) return;
     PhaseTimer::Scope scope(timer_, phase_.meshes);
     const int threads = settings_.threads;
-    const std::size_t n = particles_.size(), nb = bodies_.size();
+    const std::size_t nb = bodies_.size();
     const double dt = settings_.time_step_s;
     auto& p = particles_;
     withConcreteLaw(law_, [&](const auto& normal, const auto& damping, const auto& tangential,
@@ -607,15 +745,13 @@ void DemSystem::meshContacts() {
             MeshContactSlot next[kMeshSlots];
             ContactGeometry g;
             ContactResult r;
+            const std::size_t candidates = mesh_particles_.size();
 #pragma omp for schedule(static)
-            for (std::size_t i = 0; i < n; ++i) {
+            for (std::size_t c_index = 0; c_index < candidates; ++c_index) {
+                const std::size_t i = mesh_particles_[c_index];
                 MeshContactSlot* slots = &mesh_slots_[i * kMeshSlots];
-                const std::size_t c0 = mesh_candidate_first_[i], c1 = mesh_candidate_first_[i + 1];
-                if (c0 == c1) {
-                    if (slots[0].body >= 0)
-                        for (int s = 0; s < kMeshSlots; ++s) slots[s] = MeshContactSlot{};
-                    continue;
-                }
+                const std::size_t c0 = mesh_candidate_first_[c_index];
+                const std::size_t c1 = mesh_candidate_first_[c_index + 1];
                 const Vec3 xi = p.position[i];
                 const double ri = p.radius[i];
                 int count = 0;
@@ -723,24 +859,7 @@ void DemSystem::meshContacts() {
     }
 }
 
-void DemSystem::bodyForces() {
-    PhaseTimer::Scope scope(timer_, phase_.body_forces);
-    const Vec3 g = settings_.gravity_m_s2;
-    const double k_h = law_.background_damping_1_s;
-    auto& p = particles_;
-    const std::size_t n = p.size();
-#pragma omp parallel for schedule(static) num_threads(settings_.threads)
-    for (std::size_t i = 0; i < n; ++i) {
-        p.force[i] += p.mass[i] * g;
-        if (k_h > 0.0) {
-            // Background damping k_h (docs/physics.md §2.8); mean moment for anisotropic grains.
-            p.force[i] -= (k_h * p.mass[i]) * p.velocity[i];
-            p.torque[i] -= (k_h * p.inertia[i].mean()) * p.angular_velocity[i];
-        }
-    }
-}
-
-void DemSystem::checkForces() {
+void DemSystem::checkOverlaps() {
     PhaseTimer::Scope scope(timer_, phase_.check);
     max_overlap_ratio_ = 0.0;
     std::pair<ParticleId, ParticleId> worst{0, 0};
@@ -758,19 +877,6 @@ void DemSystem::checkForces() {
             << " exceeds max_overlap_ratio " << settings_.max_overlap_ratio
             << " (time step too large or stiffness too low)";
         throw SimulationError(step_ + 1, worst.first, "overlap", msg.str());
-    }
-    const auto& p = particles_;
-    const std::size_t n = p.size();
-    std::size_t bad = n;
-#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : bad)
-    for (std::size_t i = 0; i < n; ++i)
-        if (!p.force[i].allFinite() || !p.torque[i].allFinite() || !p.position[i].allFinite())
-            bad = std::min(bad, i);
-    if (bad < n) {
-        const std::string what = !p.position[bad].allFinite() ? "position"
-                                 : !p.force[bad].allFinite()  ? "force"
-                                                              : "torque";
-        throw SimulationError(step_ + 1, p.id[bad], what, "is not finite");
     }
 }
 

@@ -52,7 +52,7 @@ std::vector<NeighbourList::StoredContact> NeighbourList::activeContacts() const 
     std::vector<StoredContact> out;
     for (std::size_t i = 0; i + 1 < first.size(); ++i)
         for (std::size_t k = first[i]; k < first[i + 1]; ++k)
-            if (history[k].active()) out.push_back({i, std::size_t(neighbour[k]), history[k]});
+            if (touching[k]) out.push_back({i, std::size_t(neighbour[k]), history[k]});
     return out;
 }
 
@@ -139,13 +139,16 @@ void NeighbourList::build(const std::vector<Vec3>& positions, const std::vector<
     for (int t = 0; t < threads; ++t)
         neighbour.insert(neighbour.end(), chunk_neighbours[t].begin(), chunk_neighbours[t].end());
     history.assign(neighbour.size(), ContactHistory{});
+    touching.assign(neighbour.size(), 0);
     for (std::size_t i = 0; i < n; ++i)
         for (std::size_t c = carried_first[i]; c < carried_first[i + 1]; ++c) {
             const auto begin = neighbour.begin() + first[i], end = neighbour.begin() + first[i + 1];
             const auto it = std::lower_bound(begin, end, int(carried[c].j));
             // A pair beyond the search radius cannot be in contact: its history lapses.
-            if (it != end && *it == int(carried[c].j))
+            if (it != end && *it == int(carried[c].j)) {
                 history[std::size_t(it - neighbour.begin())] = carried[c].history;
+                touching[std::size_t(it - neighbour.begin())] = 1;
+            }
         }
     ++builds_;
 }

@@ -35,9 +35,16 @@ constexpr double kSqrtFiveSixths = 0.91287092917527685576;
 inline void rotateIntoPlane(Vec3& history, const Vec3& normal) {
     const double length_sq = history.squaredNorm();
     if (length_sq == 0.0) return;
-    history -= history.dot(normal) * normal;
-    const double new_sq = history.squaredNorm();
-    if (new_sq > 0.0) history *= std::sqrt(length_sq / new_sq);
+    const double along = history.dot(normal);
+    history -= along * normal;
+    // Rescale by 1/sqrt(1 - x), x = along^2 / length^2. Within one step the plane turns by a
+    // tiny angle, x ~ angle^2, and the series to x^2 is exact to 1e-16 for x < 1e-5.
+    const double x = along * along / length_sq;
+    if (x < 1e-5) {
+        history *= 1.0 + x * (0.5 + 0.375 * x);
+    } else if (x < 1.0) {
+        history *= 1.0 / std::sqrt(1.0 - x);
+    }
 }
 } // namespace detail
 
@@ -54,12 +61,15 @@ inline void evaluateContact(const Damping& damping, const Tangential& tangential
     const double elastic = (2.0 / 3.0) * normal_stiffness * g.overlap_m;
 
     const double v_normal = g.contact_velocity_m_s.dot(n); // < 0 while approaching
+    // sqrt(S_n m*) serves the restitution dashpot and, scaled, Mindlin's tangential one.
+    constexpr bool kNeedsRoot = std::is_same_v<Damping, DampingRestitution> ||
+                                std::is_same_v<Tangential, TangentialMindlin>;
+    const double root_stiffness_mass = kNeedsRoot ? std::sqrt(normal_stiffness * g.mass_eff_kg) : 0.0;
     double damping_coefficient;
     if constexpr (std::is_same_v<Damping, DampingViscous>) {
         damping_coefficient = damping.coefficient_N_s_m; // seed eq. 4
     } else {
-        damping_coefficient = -2.0 * detail::kSqrtFiveSixths * damping.beta *
-                              std::sqrt(normal_stiffness * g.mass_eff_kg);
+        damping_coefficient = -2.0 * detail::kSqrtFiveSixths * damping.beta * root_stiffness_mass;
     }
     // No tensile force from the dashpot: a separating contact cannot pull (§2.2).
     const double normal_force = std::max(elastic - damping_coefficient * v_normal, 0.0);
@@ -80,8 +90,10 @@ inline void evaluateContact(const Damping& damping, const Tangential& tangential
         k_t = tangential.stiffness_N_m;
         c_t = tangential.damping_N_s_m;
     } else {
+        // k_t = 8 G* sqrt(R* delta) = (4 G*/E*) S_n, so sqrt(k_t m*) needs no second root.
         k_t = 8.0 * pair.effective_shear_modulus_Pa * sqrt_r_delta;
-        c_t = -2.0 * detail::kSqrtFiveSixths * tangential.beta * std::sqrt(k_t * g.mass_eff_kg);
+        c_t = -2.0 * detail::kSqrtFiveSixths * tangential.beta * pair.root_shear_ratio *
+              root_stiffness_mass;
     }
     Vec3 f_tangential = -k_t * history.tangential_m - c_t * v_tangential;
     const double limit = (history.sliding ? pair.tan_slip : pair.tan_stick) * normal_force;

@@ -25,6 +25,7 @@ struct PairProperties {
     double effective_shear_modulus_Pa = 0.0; ///< G* : 1/G* = 2(2-nu1)(1+nu1)/E1 + ...
     double tan_stick = 0.0; ///< tan(phi_h), Coulomb limit while sticking
     double tan_slip = 0.0;  ///< tan(phi_g), friction while sliding
+    double root_shear_ratio = 0.0; ///< sqrt(4 G*/E*): Mindlin's k_t over Hertz's S_n, rooted
 };
 
 // ---- normal elastic slot ---------------------------------------------------------------------

@@ -116,19 +116,23 @@ private:
     void initialise();
     void prepareWalls();
     void validateTimeStep() const;
-    void kickDrift(double kick_fraction, bool drift);
-    void newmarkPredict();
+    void kickDriftClear();
+    void newmarkPredictClear();
     void newmarkCorrect();
+    void finishForces(double kick_fraction);
+    void addBodyForces(std::size_t i);
+    [[noreturn]] void reportNonFinite(std::size_t i) const;
+    void clearForces();
     void moveBodies(double t_s);
     void updateNeighbours();
     void rebuildNeighbours();
+    void updatePlaneMasks();
     void rebuildMeshCandidates();
     void computeForces();
     void pairContacts();
     void planeContacts();
     void meshContacts();
-    void bodyForces();
-    void checkForces();
+    void checkOverlaps();
     void angularAcceleration(std::size_t i, Vec3& alpha) const;
     void resizeWallHistories();
     void permuteWallHistories(const std::vector<std::size_t>& order);
@@ -149,14 +153,24 @@ private:
     std::vector<Vec3> reference_position_;      ///< positions at the last list build
     std::vector<Vec3> mesh_reference_position_; ///< positions at the last mesh-candidate build
     std::vector<RigidBodyState> body_reference_;
-    std::vector<std::size_t> mesh_candidate_first_;
+    std::vector<std::size_t> mesh_particles_;        ///< particles with mesh candidates
+    std::vector<std::size_t> mesh_candidate_first_;  ///< per entry of mesh_particles_, + end
     std::vector<std::pair<int, int>> mesh_candidates_; ///< (body, triangle)
+    std::vector<std::uint64_t> plane_mask_;          ///< planes within reach, bit per plane
+    double max_displacement_sq_ = 0.0, max_mesh_displacement_sq_ = 0.0;
+    bool displacement_known_ = false;
     CellGrid mesh_grid_;
     std::vector<ContactHistory> plane_history_;  ///< [particle * planes + plane]
     std::vector<MeshContactSlot> mesh_slots_;     ///< [particle * kMeshSlots + slot]
     bool candidates_stale_ = true;
 
-    std::vector<std::vector<Vec3>> thread_force_, thread_torque_;
+    /// Reaction on a particle owned by a later thread, added after the pair loop.
+    struct SideContribution {
+        std::size_t particle;
+        Vec3 force_N;
+        Vec3 torque_N_m;
+    };
+    std::vector<std::vector<SideContribution>> side_; // [thread]
     std::vector<std::vector<Vec3>> thread_body_force_, thread_body_torque_; // [thread][body]
     std::vector<std::vector<std::vector<Vec3>>> thread_triangle_force_;    // [thread][body][tri]
     std::vector<std::vector<Vec3>> thread_plane_force_;
@@ -171,8 +185,7 @@ private:
     double max_overlap_ratio_ = 0.0;
     PhaseTimer timer_;
     struct PhaseIds {
-        int kick, drift, predict, correct, bodies, neighbours, clear, contacts, walls, meshes,
-            body_forces, check;
+        int kick_drift, bodies, neighbours, contacts, walls, meshes, check, finish;
     } phase_{};
 };
 

@@ -51,6 +51,9 @@ public:
     std::vector<std::size_t> first;
     std::vector<int> neighbour;
     std::vector<ContactHistory> history;
+    /// 1 while the pair overlaps: the contact loop reads one byte, not the history, for the
+    /// many listed pairs that do not touch.
+    std::vector<std::uint8_t> touching;
 
     /// Active contact histories with their particles, for checkpoints.
     struct StoredContact {
