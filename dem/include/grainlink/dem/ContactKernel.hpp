@@ -25,7 +25,7 @@ struct ContactResult {
     Vec3 force_on_i_N;
     Vec3 torque_on_i_N_m;
     Vec3 torque_on_j_N_m;
-    double normal_force_N; ///< repulsive normal force (elastic + damping, >= 0)
+    double normal_force_N; ///< compressive normal force (elastic + damping, >= 0)
 };
 
 namespace detail {
@@ -71,8 +71,13 @@ inline void evaluateContact(const Damping& damping, const Tangential& tangential
     } else {
         damping_coefficient = -2.0 * detail::kSqrtFiveSixths * damping.beta * root_stiffness_mass;
     }
-    // No tensile force from the dashpot: a separating contact cannot pull (§2.2).
-    const double normal_force = std::max(elastic - damping_coefficient * v_normal, 0.0);
+    // The seed's viscous dashpot may not pull a separating contact together (§2.2). The
+    // restitution dashpot is left unclamped as in LIGGGHTS and EDEM, so that a restitution
+    // entered there gives the same rebound here (§2.3); friction sees only compression.
+    const double normal_total = elastic - damping_coefficient * v_normal;
+    const double normal_force = std::max(normal_total, 0.0);
+    const double normal_applied =
+        std::is_same_v<Damping, DampingViscous> ? normal_force : normal_total;
 
     double cohesive = 0.0;
     if constexpr (std::is_same_v<Cohesion, CohesionLinear>) {
@@ -108,7 +113,7 @@ inline void evaluateContact(const Damping& damping, const Tangential& tangential
         history.sliding = false;
     }
 
-    out.force_on_i_N = (normal_force - cohesive) * n + f_tangential;
+    out.force_on_i_N = (normal_applied - cohesive) * n + f_tangential;
     const Vec3 n_cross_ft = n.cross(f_tangential);
     out.torque_on_i_N_m = -g.arm_i_m * n_cross_ft;
     out.torque_on_j_N_m = -g.arm_j_m * n_cross_ft;
