@@ -41,7 +41,7 @@ TEST_CASE("Energy is conserved by elastic frictionless collisions in a box",
     // Velocity Verlet with Hertz contacts resolved in ~50 steps has a bounded O(dt^2) error in
     // each contact and no secular drift in a smooth system; the kink in force at touch-down
     // (delta^1.5) leaves a small error per collision. Bound: 1e-3 of the initial kinetic energy
-    // over ~2.5e4 collisions (measured 1.6e-4).
+    // over ~2.5e4 collisions (measured 2.7e-4).
     DemSettings settings;
     settings.time_step_s = 2e-5;
     settings.gravity_m_s2 = Vec3(0, 0, -9.81);
@@ -75,7 +75,7 @@ TEST_CASE("Free granular gas conserves linear and angular momentum to round-off"
     // the moment of the force pair (arms r_i - delta/2 and r_j - delta/2 add up to the centre
     // distance), so velocity Verlet conserves P and L = sum m x × v + I w exactly up to
     // round-off: 1e-12 of sum m|v| and of sum (m |x||v| + I |w|) after 1e4 steps (measured
-    // P 1e-16, L 5e-15). Two threads: the per-thread force buffers must not lose anything either.
+    // P 1e-16, L 8e-15). Two threads: the threaded force accumulation must not lose anything either.
     DemSettings settings = quietSettings(2e-5);
     settings.threads = 2;
     ContactLaw law = hertzRestitution(0.5, 0.5);
