@@ -75,7 +75,7 @@ TEST_CASE("Free granular gas conserves linear and angular momentum to round-off"
     // the moment of the force pair (arms r_i - delta/2 and r_j - delta/2 add up to the centre
     // distance), so velocity Verlet conserves P and L = sum m x × v + I w exactly up to
     // round-off: 1e-12 of sum m|v| and of sum (m |x||v| + I |w|) after 1e4 steps (measured
-    // P 1e-16, L 8e-15). Two threads: the threaded force accumulation must not lose anything either.
+    // P 1e-16, L 8e-15). Two threads: the threaded force accumulation must lose nothing either.
     DemSettings settings = quietSettings(2e-5);
     settings.threads = 2;
     ContactLaw law = hertzRestitution(0.5, 0.5);
