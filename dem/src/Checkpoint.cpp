@@ -14,115 +14,121 @@ constexpr char kMagic[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '1'};
 
 class Writer {
 public:
-    explicit Writer(std::ofstream& out) : out_(out) {}
-    template <class T> void pod(const T& value) {
+    explicit Writer(std::ofstream &out) : out_(out) {}
+    template <class T> void pod(const T &value) {
         static_assert(std::is_trivially_copyable_v<T>);
-        out_.write(reinterpret_cast<const char*>(&value), sizeof(T));
+        out_.write(reinterpret_cast<const char *>(&value), sizeof(T));
     }
-    template <class T> void vec(const std::vector<T>& values) {
+    template <class T> void vec(const std::vector<T> &values) {
         pod<std::uint64_t>(values.size());
-        for (const T& v : values) item(v);
+        for (const T &v : values)
+            item(v);
     }
-    void item(const Vec3& v) { pod(v.x()), pod(v.y()), pod(v.z()); }
-    void item(const Quat& q) { pod(q.w()), pod(q.x()), pod(q.y()), pod(q.z()); }
-    void item(const ContactHistory& h) {
+    void item(const Vec3 &v) { pod(v.x()), pod(v.y()), pod(v.z()); }
+    void item(const Quat &q) { pod(q.w()), pod(q.x()), pod(q.y()), pod(q.z()); }
+    void item(const ContactHistory &h) {
         item(h.tangential_m);
         item(h.rolling_N_m);
         pod<std::uint8_t>(h.sliding);
     }
-    void item(const RigidBodyState& s) {
+    void item(const RigidBodyState &s) {
         item(s.position_m);
         item(s.orientation);
         item(s.velocity_m_s);
         item(s.angular_velocity_rad_s);
     }
-    void item(const DemSystem::MeshContactSlot& s) {
+    void item(const DemSystem::MeshContactSlot &s) {
         pod<std::int32_t>(s.body);
         pod<std::int32_t>(s.triangle);
         item(s.normal);
         item(s.history);
     }
-    void item(const NeighbourList::StoredContact& c) {
+    void item(const NeighbourList::StoredContact &c) {
         pod<std::uint64_t>(c.i);
         pod<std::uint64_t>(c.j);
         item(c.history);
     }
-    template <class T> std::enable_if_t<std::is_arithmetic_v<T>> item(const T& v) { pod(v); }
-    void text(const std::string& s) {
+    template <class T> std::enable_if_t<std::is_arithmetic_v<T>> item(const T &v) { pod(v); }
+    void text(const std::string &s) {
         pod<std::uint64_t>(s.size());
         out_.write(s.data(), std::streamsize(s.size()));
     }
 
 private:
-    std::ofstream& out_;
+    std::ofstream &out_;
 };
 
 class Reader {
 public:
-    Reader(std::ifstream& in, std::string path) : in_(in), path_(std::move(path)) {}
+    Reader(std::ifstream &in, std::string path) : in_(in), path_(std::move(path)) {}
     template <class T> T pod() {
         T value;
-        in_.read(reinterpret_cast<char*>(&value), sizeof(T));
-        if (!in_) throw std::runtime_error("checkpoint '" + path_ + "' is truncated");
+        in_.read(reinterpret_cast<char *>(&value), sizeof(T));
+        if (!in_)
+            throw std::runtime_error("checkpoint '" + path_ + "' is truncated");
         return value;
     }
-    template <class T> void vec(std::vector<T>& values) {
+    template <class T> void vec(std::vector<T> &values) {
         const auto n = pod<std::uint64_t>();
-        if (n > (std::uint64_t(1) << 40)) throw std::runtime_error("checkpoint '" + path_ + "' is corrupt");
+        if (n > (std::uint64_t(1) << 40))
+            throw std::runtime_error("checkpoint '" + path_ + "' is corrupt");
         values.resize(n);
-        for (T& v : values) item(v);
+        for (T &v : values)
+            item(v);
     }
-    void item(Vec3& v) { v.x() = pod<double>(), v.y() = pod<double>(), v.z() = pod<double>(); }
-    void item(Quat& q) {
+    void item(Vec3 &v) { v.x() = pod<double>(), v.y() = pod<double>(), v.z() = pod<double>(); }
+    void item(Quat &q) {
         q.w() = pod<double>(), q.x() = pod<double>(), q.y() = pod<double>(), q.z() = pod<double>();
     }
-    void item(ContactHistory& h) {
+    void item(ContactHistory &h) {
         item(h.tangential_m);
         item(h.rolling_N_m);
         h.sliding = pod<std::uint8_t>() != 0;
     }
-    void item(RigidBodyState& s) {
+    void item(RigidBodyState &s) {
         item(s.position_m);
         item(s.orientation);
         item(s.velocity_m_s);
         item(s.angular_velocity_rad_s);
     }
-    void item(DemSystem::MeshContactSlot& s) {
+    void item(DemSystem::MeshContactSlot &s) {
         s.body = pod<std::int32_t>();
         s.triangle = pod<std::int32_t>();
         item(s.normal);
         item(s.history);
     }
-    void item(NeighbourList::StoredContact& c) {
+    void item(NeighbourList::StoredContact &c) {
         c.i = pod<std::uint64_t>();
         c.j = pod<std::uint64_t>();
         item(c.history);
     }
-    template <class T> std::enable_if_t<std::is_arithmetic_v<T>> item(T& v) { v = pod<T>(); }
+    template <class T> std::enable_if_t<std::is_arithmetic_v<T>> item(T &v) { v = pod<T>(); }
     std::string text() {
         const auto n = pod<std::uint64_t>();
-        if (n > 4096) throw std::runtime_error("checkpoint '" + path_ + "' is corrupt");
+        if (n > 4096)
+            throw std::runtime_error("checkpoint '" + path_ + "' is corrupt");
         std::string s(n, '\0');
         in_.read(s.data(), std::streamsize(n));
         return s;
     }
 
 private:
-    std::ifstream& in_;
+    std::ifstream &in_;
     std::string path_;
 };
 
 } // namespace
 
-void writeCheckpoint(const DemSystem& system, const std::string& path,
-                     const CheckpointExtras& extras) {
+void writeCheckpoint(const DemSystem &system, const std::string &path,
+                     const CheckpointExtras &extras) {
     const std::string temporary = path + ".partial";
     {
         std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        if (!out) throw std::runtime_error("cannot write checkpoint '" + temporary + "'");
+        if (!out)
+            throw std::runtime_error("cannot write checkpoint '" + temporary + "'");
         Writer w(out);
         out.write(kMagic, sizeof kMagic);
-        const ParticleStore& p = system.particles();
+        const ParticleStore &p = system.particles();
         w.pod<std::uint64_t>(p.nextId());
         w.vec(p.id);
         w.vec(p.position);
@@ -150,12 +156,13 @@ void writeCheckpoint(const DemSystem& system, const std::string& path,
         w.pod(s.time_offset_s);
         w.pod(s.max_overlap_ratio);
         w.pod<std::uint64_t>(extras.size());
-        for (const auto& [key, value] : extras) {
+        for (const auto &[key, value] : extras) {
             w.text(key);
             w.pod(value);
         }
         out.write(kMagic, sizeof kMagic); // trailer: proves the file is complete
-        if (!out) throw std::runtime_error("failed writing checkpoint '" + temporary + "'");
+        if (!out)
+            throw std::runtime_error("failed writing checkpoint '" + temporary + "'");
     }
     if (std::rename(temporary.c_str(), path.c_str()) != 0)
         throw std::runtime_error("cannot move checkpoint into place at '" + path + "'");
@@ -163,9 +170,10 @@ void writeCheckpoint(const DemSystem& system, const std::string& path,
 
 namespace {
 
-CheckpointExtras load(const std::string& path, ParticleStore& p, DemSystem::Internals& s) {
+CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Internals &s) {
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error("cannot open checkpoint '" + path + "'");
+    if (!in)
+        throw std::runtime_error("cannot open checkpoint '" + path + "'");
     char magic[8];
     in.read(magic, sizeof magic);
     if (!in || std::memcmp(magic, kMagic, sizeof magic) != 0)
@@ -184,7 +192,8 @@ CheckpointExtras load(const std::string& path, ParticleStore& p, DemSystem::Inte
     r.vec(p.inertia);
     r.vec(p.material);
     p.inv_mass.resize(p.mass.size());
-    for (std::size_t i = 0; i < p.mass.size(); ++i) p.inv_mass[i] = 1.0 / p.mass[i];
+    for (std::size_t i = 0; i < p.mass.size(); ++i)
+        p.inv_mass[i] = 1.0 / p.mass[i];
     const std::size_t n = p.id.size();
     if (p.position.size() != n || p.radius.size() != n || p.material.size() != n)
         throw std::runtime_error("checkpoint '" + path + "' has inconsistent particle arrays");
@@ -210,15 +219,16 @@ CheckpointExtras load(const std::string& path, ParticleStore& p, DemSystem::Inte
     in.read(magic, sizeof magic);
     if (!in || std::memcmp(magic, kMagic, sizeof magic) != 0)
         throw std::runtime_error("checkpoint '" + path + "' is truncated (no trailer)");
-    for (const auto& c : s.contacts)
+    for (const auto &c : s.contacts)
         if (c.i >= n || c.j >= n)
-            throw std::runtime_error("checkpoint '" + path + "' has a contact beyond the particles");
+            throw std::runtime_error("checkpoint '" + path +
+                                     "' has a contact beyond the particles");
     return extras;
 }
 
 } // namespace
 
-CheckpointExtras readCheckpoint(DemSystem& system, const std::string& path) {
+CheckpointExtras readCheckpoint(DemSystem &system, const std::string &path) {
     ParticleStore particles;
     DemSystem::Internals internals;
     CheckpointExtras extras = load(path, particles, internals);
@@ -227,7 +237,7 @@ CheckpointExtras readCheckpoint(DemSystem& system, const std::string& path) {
     return extras;
 }
 
-CheckpointExtras readCheckpointExtras(const std::string& path) {
+CheckpointExtras readCheckpointExtras(const std::string &path) {
     ParticleStore particles;
     DemSystem::Internals internals;
     return load(path, particles, internals);

@@ -7,7 +7,7 @@ namespace grainlink::dem {
 
 namespace {
 /// "time_step_ms" and "time_step_s" share the stem "time_step": a wrong unit, not a typo.
-std::string stem(const std::string& key) {
+std::string stem(const std::string &key) {
     const auto cut = key.rfind('_');
     return cut == std::string::npos ? key : key.substr(0, cut);
 }
@@ -17,42 +17,48 @@ ConfigNode::ConfigNode(YAML::Node node, std::shared_ptr<const std::string> file,
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)),
       used_(std::make_shared<std::set<std::string>>()) {}
 
-ConfigNode ConfigNode::loadFile(const std::string& path) {
+ConfigNode ConfigNode::loadFile(const std::string &path) {
     try {
         return ConfigNode(YAML::LoadFile(path), std::make_shared<std::string>(path), "");
-    } catch (const YAML::BadFile&) {
+    } catch (const YAML::BadFile &) {
         throw ConfigError(path + ": cannot open file");
-    } catch (const YAML::ParserException& e) {
-        throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    } catch (const YAML::ParserException &e) {
+        throw ConfigError(path + ":" + std::to_string(e.mark.line + 1) +
+                          ": YAML syntax error: " + e.msg);
     }
 }
 
-ConfigNode ConfigNode::loadString(const std::string& text, const std::string& name) {
+ConfigNode ConfigNode::loadString(const std::string &text, const std::string &name) {
     try {
         return ConfigNode(YAML::Load(text), std::make_shared<std::string>(name), "");
-    } catch (const YAML::ParserException& e) {
-        throw ConfigError(name + ":" + std::to_string(e.mark.line + 1) + ": YAML syntax error: " + e.msg);
+    } catch (const YAML::ParserException &e) {
+        throw ConfigError(name + ":" + std::to_string(e.mark.line + 1) +
+                          ": YAML syntax error: " + e.msg);
     }
 }
 
-void ConfigNode::fail(const std::string& message) const {
+void ConfigNode::fail(const std::string &message) const {
     std::ostringstream out;
     out << *file_ << ":" << line() << ": ";
-    if (!path_.empty()) out << "key '" << path_ << "': ";
+    if (!path_.empty())
+        out << "key '" << path_ << "': ";
     out << message;
     throw ConfigError(out.str());
 }
 
-bool ConfigNode::has(const std::string& key) const { return node_.IsMap() && node_[key]; }
+bool ConfigNode::has(const std::string &key) const {
+    return node_.IsMap() && node_[key];
+}
 
-ConfigNode ConfigNode::operator[](const std::string& key) const {
-    if (!node_.IsMap()) fail("expected a mapping with key '" + key + "'");
+ConfigNode ConfigNode::operator[](const std::string &key) const {
+    if (!node_.IsMap())
+        fail("expected a mapping with key '" + key + "'");
     used_->insert(key);
     const YAML::Node child = node_[key];
     const std::string child_path = path_.empty() ? key : path_ + "." + key;
     if (!child || child.IsNull()) {
         // A key with the same stem but another unit suffix is a wrong unit, not a missing key.
-        for (const auto& entry : node_) {
+        for (const auto &entry : node_) {
             const std::string other = entry.first.as<std::string>();
             if (other != key && stem(other) == stem(key)) {
                 std::ostringstream out;
@@ -69,15 +75,18 @@ ConfigNode ConfigNode::operator[](const std::string& key) const {
     return ConfigNode(child, file_, child_path);
 }
 
-std::optional<ConfigNode> ConfigNode::optional(const std::string& key) const {
-    if (!node_.IsMap()) fail("expected a mapping");
+std::optional<ConfigNode> ConfigNode::optional(const std::string &key) const {
+    if (!node_.IsMap())
+        fail("expected a mapping");
     used_->insert(key);
-    if (!node_[key] || node_[key].IsNull()) return std::nullopt;
+    if (!node_[key] || node_[key].IsNull())
+        return std::nullopt;
     return (*this)[key];
 }
 
 std::vector<ConfigNode> ConfigNode::items() const {
-    if (!node_.IsSequence()) fail("expected a list");
+    if (!node_.IsSequence())
+        fail("expected a list");
     std::vector<ConfigNode> out;
     for (std::size_t k = 0; k < node_.size(); ++k)
         out.push_back(ConfigNode(node_[k], file_, path_ + "[" + std::to_string(k) + "]"));
@@ -85,86 +94,100 @@ std::vector<ConfigNode> ConfigNode::items() const {
 }
 
 double ConfigNode::number() const {
-    if (!node_.IsScalar()) fail("expected a number");
+    if (!node_.IsScalar())
+        fail("expected a number");
     const std::string s = node_.Scalar();
     try {
         std::size_t used = 0;
         const double v = std::stod(s, &used);
-        if (used != s.size() || !std::isfinite(v)) throw std::invalid_argument(s);
+        if (used != s.size() || !std::isfinite(v))
+            throw std::invalid_argument(s);
         return v;
-    } catch (const std::exception&) {
+    } catch (const std::exception &) {
         fail("expected a number, got '" + s + "'");
     }
 }
 
 double ConfigNode::positive() const {
     const double v = number();
-    if (!(v > 0.0)) fail("must be > 0, got " + node_.Scalar());
+    if (!(v > 0.0))
+        fail("must be > 0, got " + node_.Scalar());
     return v;
 }
 
 long long ConfigNode::integer() const {
     const double v = number();
-    if (v != std::floor(v)) fail("expected a whole number, got " + node_.Scalar());
+    if (v != std::floor(v))
+        fail("expected a whole number, got " + node_.Scalar());
     return static_cast<long long>(v);
 }
 
 bool ConfigNode::boolean() const {
     const std::string s = text();
-    if (s == "true" || s == "yes" || s == "on") return true;
-    if (s == "false" || s == "no" || s == "off") return false;
+    if (s == "true" || s == "yes" || s == "on")
+        return true;
+    if (s == "false" || s == "no" || s == "off")
+        return false;
     fail("expected true or false, got '" + s + "'");
 }
 
 std::string ConfigNode::text() const {
-    if (!node_.IsScalar()) fail("expected a single value");
+    if (!node_.IsScalar())
+        fail("expected a single value");
     return node_.Scalar();
 }
 
-std::string ConfigNode::choice(const std::vector<std::string>& choices) const {
+std::string ConfigNode::choice(const std::vector<std::string> &choices) const {
     const std::string s = text();
-    for (const std::string& c : choices)
-        if (c == s) return s;
+    for (const std::string &c : choices)
+        if (c == s)
+            return s;
     std::string list;
-    for (const std::string& c : choices) list += (list.empty() ? "" : ", ") + c;
+    for (const std::string &c : choices)
+        list += (list.empty() ? "" : ", ") + c;
     fail("'" + s + "' is not one of: " + list);
 }
 
 Vec3 ConfigNode::vec3() const {
     const std::vector<double> v = numbers();
-    if (v.size() != 3) fail("expected a list of 3 numbers, got " + std::to_string(v.size()));
+    if (v.size() != 3)
+        fail("expected a list of 3 numbers, got " + std::to_string(v.size()));
     return Vec3(v[0], v[1], v[2]);
 }
 
 std::vector<double> ConfigNode::numbers() const {
     std::vector<double> out;
-    for (const ConfigNode& item : items()) out.push_back(item.number());
+    for (const ConfigNode &item : items())
+        out.push_back(item.number());
     return out;
 }
 
-double ConfigNode::number(const std::string& key, double fallback) const {
+double ConfigNode::number(const std::string &key, double fallback) const {
     const auto n = optional(key);
     return n ? n->number() : fallback;
 }
 
-std::string ConfigNode::text(const std::string& key, const std::string& fallback) const {
+std::string ConfigNode::text(const std::string &key, const std::string &fallback) const {
     const auto n = optional(key);
     return n ? n->text() : fallback;
 }
 
-bool ConfigNode::boolean(const std::string& key, bool fallback) const {
+bool ConfigNode::boolean(const std::string &key, bool fallback) const {
     const auto n = optional(key);
     return n ? n->boolean() : fallback;
 }
 
 void ConfigNode::finish() const {
-    if (!node_.IsMap()) return;
-    for (const auto& entry : node_) {
+    if (!node_.IsMap())
+        return;
+    for (const auto &entry : node_) {
         const std::string key = entry.first.as<std::string>();
-        if (used_->count(key)) continue;
+        if (used_->count(key))
+            continue;
         std::string hint;
-        for (const std::string& known : *used_)
-            if (stem(known) == stem(key)) hint = " (wrong unit? this key is '" + known + "')";
+        for (const std::string &known : *used_)
+            if (stem(known) == stem(key))
+                hint = " (wrong unit? this key is '" + known + "')";
         std::ostringstream out;
         out << *file_ << ":" << entry.first.Mark().line + 1 << ": unknown key '"
             << (path_.empty() ? key : path_ + "." + key) << "'" << hint;

@@ -7,14 +7,16 @@
 namespace grainlink::dem {
 
 namespace {
-[[noreturn]] void badParameter(const std::string& model, const std::string& parameter,
-                               double value, const std::string& rule) {
+[[noreturn]] void badParameter(const std::string &model, const std::string &parameter, double value,
+                               const std::string &rule) {
     std::ostringstream msg;
     msg << "contact model '" << model << "': parameter '" << parameter << "' = " << value
         << " is invalid (" << rule << ")";
     throw std::invalid_argument(msg.str());
 }
-double tanDeg(double degrees) { return std::tan(degrees * M_PI / 180.0); }
+double tanDeg(double degrees) {
+    return std::tan(degrees * M_PI / 180.0);
+}
 } // namespace
 
 void Material::validate() const {
@@ -60,7 +62,8 @@ void TangentialMindlin::validate() const {
 }
 
 void RollingEpsd::validate() const {
-    if (!(coefficient >= 0.0)) badParameter("rolling epsd", "coefficient", coefficient, "must be >= 0");
+    if (!(coefficient >= 0.0))
+        badParameter("rolling epsd", "coefficient", coefficient, "must be >= 0");
 }
 
 void CohesionLinear::validate() const {
@@ -69,7 +72,7 @@ void CohesionLinear::validate() const {
 }
 
 void ContactLaw::finalize() {
-    auto check = [](const auto& slot) { std::visit([](const auto& m) { m.validate(); }, slot); };
+    auto check = [](const auto &slot) { std::visit([](const auto &m) { m.validate(); }, slot); };
     check(normal);
     check(damping);
     check(tangential);
@@ -79,19 +82,20 @@ void ContactLaw::finalize() {
         badParameter("background damping", "background_damping_1_s", background_damping_1_s,
                      "must be >= 0");
     double beta = 0.0;
-    if (auto* restitution = std::get_if<DampingRestitution>(&damping)) {
+    if (auto *restitution = std::get_if<DampingRestitution>(&damping)) {
         restitution->derive();
         beta = restitution->beta;
     }
     // Cross-slot rule: Mindlin's tangential dashpot takes the normal restitution (LIGGGHTS).
-    if (auto* mindlin = std::get_if<TangentialMindlin>(&tangential)) mindlin->beta = beta;
+    if (auto *mindlin = std::get_if<TangentialMindlin>(&tangential))
+        mindlin->beta = beta;
 }
 
 std::string ContactLaw::describe() const {
     std::ostringstream out;
     out << "normal=hertz";
     std::visit(
-        [&](const auto& d) {
+        [&](const auto &d) {
             using D = std::decay_t<decltype(d)>;
             if constexpr (std::is_same_v<D, DampingViscous>)
                 out << " damping=viscous(k_n=" << d.coefficient_N_s_m << " N s/m)";
@@ -100,23 +104,26 @@ std::string ContactLaw::describe() const {
         },
         damping);
     std::visit(
-        [&](const auto& t) {
+        [&](const auto &t) {
             using T = std::decay_t<decltype(t)>;
             if constexpr (std::is_same_v<T, TangentialLinear>)
-                out << " tangential=linear(c_T=" << t.stiffness_N_m << " N/m, phi_h="
-                    << t.stick_angle_deg << " deg, phi_g=" << t.slip_angle_deg << " deg)";
+                out << " tangential=linear(c_T=" << t.stiffness_N_m
+                    << " N/m, phi_h=" << t.stick_angle_deg << " deg, phi_g=" << t.slip_angle_deg
+                    << " deg)";
             else
                 out << " tangential=mindlin(mu=" << t.friction_coefficient << ")";
         },
         tangential);
-    if (auto* r = std::get_if<RollingEpsd>(&rolling)) out << " rolling=epsd(mu_r=" << r->coefficient << ")";
-    if (auto* c = std::get_if<CohesionLinear>(&cohesion))
+    if (auto *r = std::get_if<RollingEpsd>(&rolling))
+        out << " rolling=epsd(mu_r=" << r->coefficient << ")";
+    if (auto *c = std::get_if<CohesionLinear>(&cohesion))
         out << " cohesion=linear(k_c=" << c->energy_density_J_m3 << " J/m^3)";
-    if (background_damping_1_s > 0.0) out << " background_damping=" << background_damping_1_s << " 1/s";
+    if (background_damping_1_s > 0.0)
+        out << " background_damping=" << background_damping_1_s << " 1/s";
     return out.str();
 }
 
-PairProperties pairProperties(const Material& a, const Material& b, const ContactLaw& law) {
+PairProperties pairProperties(const Material &a, const Material &b, const ContactLaw &law) {
     PairProperties p;
     const double ca = (1.0 - a.poisson_ratio * a.poisson_ratio) / a.youngs_modulus_Pa;
     const double cb = (1.0 - b.poisson_ratio * b.poisson_ratio) / b.youngs_modulus_Pa;
@@ -126,7 +133,7 @@ PairProperties pairProperties(const Material& a, const Material& b, const Contac
     p.effective_shear_modulus_Pa = 1.0 / (sa + sb);
     p.root_shear_ratio = std::sqrt(4.0 * p.effective_shear_modulus_Pa / p.effective_modulus_Pa);
     std::visit(
-        [&](const auto& t) {
+        [&](const auto &t) {
             using T = std::decay_t<decltype(t)>;
             if constexpr (std::is_same_v<T, TangentialLinear>) {
                 p.tan_stick = tanDeg(t.stick_angle_deg);
@@ -139,7 +146,7 @@ PairProperties pairProperties(const Material& a, const Material& b, const Contac
     return p;
 }
 
-PairProperties pairProperties(const Material& a, const Material& b, const ContactLaw& law,
+PairProperties pairProperties(const Material &a, const Material &b, const ContactLaw &law,
                               double wall_friction_coefficient) {
     if (!(wall_friction_coefficient >= 0.0))
         badParameter("wall", "friction_coefficient", wall_friction_coefficient, "must be >= 0");

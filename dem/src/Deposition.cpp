@@ -11,9 +11,12 @@ namespace grainlink::dem {
 
 double RadiusDistribution::largest() const {
     switch (kind) {
-    case Kind::Constant: return min_m;
-    case Kind::Uniform: return max_m;
-    case Kind::Discrete: return *std::max_element(radii_m.begin(), radii_m.end());
+    case Kind::Constant:
+        return min_m;
+    case Kind::Uniform:
+        return max_m;
+    case Kind::Discrete:
+        return *std::max_element(radii_m.begin(), radii_m.end());
     }
     return 0.0;
 }
@@ -25,7 +28,8 @@ void RadiusDistribution::validate() const {
         throw std::invalid_argument("radius: need 0 < min_m <= max_m");
     if (kind == Kind::Discrete) {
         if (radii_m.empty() || radii_m.size() != fractions.size())
-            throw std::invalid_argument("radius: radii_m and fractions must be non-empty and of equal length");
+            throw std::invalid_argument(
+                "radius: radii_m and fractions must be non-empty and of equal length");
         for (std::size_t k = 0; k < radii_m.size(); ++k)
             if (!(radii_m[k] > 0.0) || !(fractions[k] >= 0.0))
                 throw std::invalid_argument("radius: radii must be > 0 and fractions >= 0");
@@ -41,7 +45,9 @@ std::uint64_t Random::next() {
     return z ^ (z >> 31);
 }
 
-double Random::uniform() { return double(next() >> 11) * 0x1.0p-53; }
+double Random::uniform() {
+    return double(next() >> 11) * 0x1.0p-53;
+}
 
 std::string DepositionSpec::describe() const {
     std::ostringstream s;
@@ -59,16 +65,19 @@ std::string DepositionSpec::describe() const {
 
 namespace {
 
-double drawRadius(const RadiusDistribution& d, Random& random) {
+double drawRadius(const RadiusDistribution &d, Random &random) {
     switch (d.kind) {
-    case RadiusDistribution::Kind::Constant: return d.min_m;
-    case RadiusDistribution::Kind::Uniform: return random.uniform(d.min_m, d.max_m);
+    case RadiusDistribution::Kind::Constant:
+        return d.min_m;
+    case RadiusDistribution::Kind::Uniform:
+        return random.uniform(d.min_m, d.max_m);
     case RadiusDistribution::Kind::Discrete: {
         const double total = std::accumulate(d.fractions.begin(), d.fractions.end(), 0.0);
         double pick = random.uniform() * total;
         for (std::size_t k = 0; k < d.radii_m.size(); ++k) {
             pick -= d.fractions[k];
-            if (pick < 0.0) return d.radii_m[k];
+            if (pick < 0.0)
+                return d.radii_m[k];
         }
         return d.radii_m.back();
     }
@@ -80,36 +89,38 @@ double drawRadius(const RadiusDistribution& d, Random& random) {
 class PlacementGrid {
 public:
     explicit PlacementGrid(double cell) : cell_(cell) {}
-    void add(const Vec3& x, double r) {
+    void add(const Vec3 &x, double r) {
         spheres_.push_back({x, r});
         cells_[key(x)].push_back(int(spheres_.size() - 1));
     }
-    bool free(const Vec3& x, double r, double reach) const {
+    bool free(const Vec3 &x, double r, double reach) const {
         const Eigen::Vector3i c = coords(x);
         const int span = int(std::ceil(reach / cell_));
         for (int dz = -span; dz <= span; ++dz)
             for (int dy = -span; dy <= span; ++dy)
                 for (int dx = -span; dx <= span; ++dx) {
                     auto it = cells_.find(pack(c + Eigen::Vector3i(dx, dy, dz)));
-                    if (it == cells_.end()) continue;
+                    if (it == cells_.end())
+                        continue;
                     for (int k : it->second) {
                         const double d = spheres_[k].second + r;
-                        if ((spheres_[k].first - x).squaredNorm() < d * d) return false;
+                        if ((spheres_[k].first - x).squaredNorm() < d * d)
+                            return false;
                     }
                 }
         return true;
     }
 
 private:
-    Eigen::Vector3i coords(const Vec3& x) const {
+    Eigen::Vector3i coords(const Vec3 &x) const {
         return Eigen::Vector3i(int(std::floor(x.x() / cell_)), int(std::floor(x.y() / cell_)),
                                int(std::floor(x.z() / cell_)));
     }
-    static std::int64_t pack(const Eigen::Vector3i& c) {
+    static std::int64_t pack(const Eigen::Vector3i &c) {
         return (std::int64_t(c.x() & 0x1FFFFF) << 42) | (std::int64_t(c.y() & 0x1FFFFF) << 21) |
                std::int64_t(c.z() & 0x1FFFFF);
     }
-    std::int64_t key(const Vec3& x) const { return pack(coords(x)); }
+    std::int64_t key(const Vec3 &x) const { return pack(coords(x)); }
     double cell_;
     std::vector<std::pair<Vec3, double>> spheres_;
     std::unordered_map<std::int64_t, std::vector<int>> cells_;
@@ -117,20 +128,23 @@ private:
 
 } // namespace
 
-std::size_t insertRandom(DemSystem& system, const DepositionSpec& spec, Random& random,
-                         std::size_t count, const Vec3& lower_m, const Vec3& upper_m) {
+std::size_t insertRandom(DemSystem &system, const DepositionSpec &spec, Random &random,
+                         std::size_t count, const Vec3 &lower_m, const Vec3 &upper_m) {
     const double r_max = spec.radius.largest();
     PlacementGrid grid(2.0 * r_max);
-    ParticleStore& p = system.particles();
-    for (std::size_t i = 0; i < p.size(); ++i) grid.add(p.position[i], p.radius[i]);
+    ParticleStore &p = system.particles();
+    for (std::size_t i = 0; i < p.size(); ++i)
+        grid.add(p.position[i], p.radius[i]);
     const double density = system.materials().at(std::size_t(spec.material)).density_kg_m3;
     std::size_t placed = 0;
     const std::size_t max_attempts = 200 * count + 1000;
     for (std::size_t attempt = 0; attempt < max_attempts && placed < count; ++attempt) {
         const double r = drawRadius(spec.radius, random);
         Vec3 x;
-        for (int d = 0; d < 3; ++d) x[d] = random.uniform(lower_m[d] + r, upper_m[d] - r);
-        if (!grid.free(x, r, r + r_max)) continue;
+        for (int d = 0; d < 3; ++d)
+            x[d] = random.uniform(lower_m[d] + r, upper_m[d] - r);
+        if (!grid.free(x, r, r + r_max))
+            continue;
         ParticleSpec s;
         s.position_m = x;
         s.radius_m = r;
@@ -143,19 +157,22 @@ std::size_t insertRandom(DemSystem& system, const DepositionSpec& spec, Random& 
     return placed;
 }
 
-DepositionReport deposit(DemSystem& system, const DepositionSpec& spec,
-                         const std::function<void(const DepositionReport&)>& progress) {
+DepositionReport deposit(DemSystem &system, const DepositionSpec &spec,
+                         const std::function<void(const DepositionReport &)> &progress) {
     spec.radius.validate();
-    if (spec.count == 0) throw std::invalid_argument("deposition: count must be > 0");
+    if (spec.count == 0)
+        throw std::invalid_argument("deposition: count must be > 0");
     if ((spec.region_upper_m - spec.region_lower_m).minCoeff() <= 2.0 * spec.radius.largest())
         throw std::invalid_argument("deposition: region is thinner than a grain");
-    if (spec.layers < 1) throw std::invalid_argument("deposition: layers must be >= 1");
+    if (spec.layers < 1)
+        throw std::invalid_argument("deposition: layers must be >= 1");
     Random random(spec.seed);
     DepositionReport report;
     const double dt = system.settings().time_step_s;
     auto meanKinetic = [&] {
         const Energies e = system.energies();
-        return (e.translational_J + e.rotational_J) / double(std::max<std::size_t>(1, system.particles().size()));
+        return (e.translational_J + e.rotational_J) /
+               double(std::max<std::size_t>(1, system.particles().size()));
     };
     if (spec.method == DepositionSpec::Method::Random) {
         report.inserted = insertRandom(system, spec, random, spec.count, spec.region_lower_m,
@@ -165,15 +182,17 @@ DepositionReport deposit(DemSystem& system, const DepositionSpec& spec,
         const double height = spec.region_upper_m.z() - spec.region_lower_m.z();
         const double slab = std::max(height / spec.layers, 2.2 * spec.radius.largest());
         for (int layer = 0; layer < spec.layers; ++layer) {
-            const std::size_t want = spec.count * std::size_t(layer + 1) / std::size_t(spec.layers) -
-                                     report.inserted;
+            const std::size_t want =
+                spec.count * std::size_t(layer + 1) / std::size_t(spec.layers) - report.inserted;
             Vec3 lo = spec.region_lower_m;
             lo.z() = spec.region_upper_m.z() - slab;
             report.inserted += insertRandom(system, spec, random, want, lo, spec.region_upper_m);
             const auto steps = std::uint64_t(std::ceil(spec.layer_interval_s / dt));
-            for (std::uint64_t k = 0; k < steps; ++k) system.step();
+            for (std::uint64_t k = 0; k < steps; ++k)
+                system.step();
             report.settle_time_s += double(steps) * dt;
-            if (progress) progress(report);
+            if (progress)
+                progress(report);
         }
     }
     if (report.inserted < spec.count * 99 / 100) {
@@ -186,17 +205,20 @@ DepositionReport deposit(DemSystem& system, const DepositionSpec& spec,
     // Settle until the mean kinetic energy per particle falls below the threshold.
     const std::uint64_t check_every = std::max<std::uint64_t>(1, std::uint64_t(0.01 / dt));
     for (;;) {
-        for (std::uint64_t k = 0; k < check_every; ++k) system.step();
+        for (std::uint64_t k = 0; k < check_every; ++k)
+            system.step();
         report.settle_time_s += double(check_every) * dt;
         report.final_kinetic_energy_per_particle_J = meanKinetic();
         report.settled = report.final_kinetic_energy_per_particle_J < spec.settle_kinetic_energy_J;
-        if (progress) progress(report);
-        if (report.settled || report.settle_time_s >= spec.max_settle_time_s) break;
+        if (progress)
+            progress(report);
+        if (report.settled || report.settle_time_s >= spec.max_settle_time_s)
+            break;
     }
     return report;
 }
 
-std::string hashKey(const std::string& text) {
+std::string hashKey(const std::string &text) {
     std::uint64_t h = 1469598103934665603ull;
     for (unsigned char c : text) {
         h ^= c;

@@ -8,15 +8,16 @@
 namespace grainlink::dem {
 
 namespace {
-template <class T> void applyOrder(std::vector<T>& values, const std::vector<std::size_t>& order) {
+template <class T> void applyOrder(std::vector<T> &values, const std::vector<std::size_t> &order) {
     std::vector<T> sorted;
     sorted.reserve(values.size());
-    for (std::size_t k : order) sorted.push_back(values[k]);
+    for (std::size_t k : order)
+        sorted.push_back(values[k]);
     values.swap(sorted);
 }
 } // namespace
 
-ParticleId ParticleStore::add(const ParticleSpec& spec) {
+ParticleId ParticleStore::add(const ParticleSpec &spec) {
     if (!(spec.radius_m > 0.0) || !std::isfinite(spec.radius_m)) {
         std::ostringstream msg;
         msg << "particle radius must be positive and finite, got " << spec.radius_m << " m";
@@ -31,7 +32,8 @@ ParticleId ParticleStore::add(const ParticleSpec& spec) {
     const double r = spec.radius_m;
     const double m = 4.0 / 3.0 * M_PI * r * r * r * spec.density_kg_m3;
     Vec3 inertia_kg_m2 = spec.inertia_kg_m2;
-    if (inertia_kg_m2.isZero()) inertia_kg_m2.setConstant(0.4 * m * r * r); // solid sphere
+    if (inertia_kg_m2.isZero())
+        inertia_kg_m2.setConstant(0.4 * m * r * r); // solid sphere
     if ((inertia_kg_m2.array() <= 0.0).any())
         throw std::invalid_argument("particle moments of inertia must all be positive");
 
@@ -66,8 +68,9 @@ void ParticleStore::reserve(std::size_t n) {
     material.reserve(n);
 }
 
-void ParticleStore::permute(const std::vector<std::size_t>& order) {
-    if (order.size() != size()) throw std::logic_error("ParticleStore::permute: wrong order size");
+void ParticleStore::permute(const std::vector<std::size_t> &order) {
+    if (order.size() != size())
+        throw std::logic_error("ParticleStore::permute: wrong order size");
     applyOrder(id, order);
     applyOrder(position, order);
     applyOrder(velocity, order);

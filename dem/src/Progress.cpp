@@ -4,7 +4,7 @@
 
 namespace grainlink::dem {
 
-Progress::Progress(std::string label, double interval_s, std::FILE* stream)
+Progress::Progress(std::string label, double interval_s, std::FILE *stream)
     : label_(std::move(label)), interval_s_(interval_s), stream_(stream),
       start_(std::chrono::steady_clock::now()), last_(start_) {}
 
@@ -18,25 +18,30 @@ double Progress::rate(std::uint64_t particle_steps) const {
 }
 
 void Progress::update(double sim_time_s, double fraction, std::uint64_t particle_steps,
-                      const std::string& extra) {
+                      const std::string &extra) {
     const auto now = std::chrono::steady_clock::now();
-    if (std::chrono::duration<double>(now - last_).count() < interval_s_) return;
+    if (std::chrono::duration<double>(now - last_).count() < interval_s_)
+        return;
     last_ = now;
     const double wall = wallSeconds();
     const double eta = fraction > 1e-9 ? wall * (1.0 - fraction) / fraction : NAN;
-    std::fprintf(stream_, "[%s] t = %.4f s (%5.1f %%)  wall %s  ETA %s  %.2f M particle-steps/s%s%s\n",
+    std::fprintf(stream_,
+                 "[%s] t = %.4f s (%5.1f %%)  wall %s  ETA %s  %.2f M particle-steps/s%s%s\n",
                  label_.c_str(), sim_time_s, 100.0 * fraction, formatDuration(wall).c_str(),
-                 std::isfinite(eta) ? formatDuration(eta).c_str() : "?",
-                 rate(particle_steps) / 1e6, extra.empty() ? "" : "  ", extra.c_str());
+                 std::isfinite(eta) ? formatDuration(eta).c_str() : "?", rate(particle_steps) / 1e6,
+                 extra.empty() ? "" : "  ", extra.c_str());
     std::fflush(stream_);
 }
 
 std::string formatDuration(double seconds) {
     char out[32];
     const long s = long(std::lround(seconds));
-    if (s >= 3600) std::snprintf(out, sizeof out, "%ldh%02ldm", s / 3600, (s / 60) % 60);
-    else if (s >= 60) std::snprintf(out, sizeof out, "%ldm%02lds", s / 60, s % 60);
-    else std::snprintf(out, sizeof out, "%.1fs", seconds);
+    if (s >= 3600)
+        std::snprintf(out, sizeof out, "%ldh%02ldm", s / 3600, (s / 60) % 60);
+    else if (s >= 60)
+        std::snprintf(out, sizeof out, "%ldm%02lds", s / 60, s % 60);
+    else
+        std::snprintf(out, sizeof out, "%.1fs", seconds);
     return out;
 }
 

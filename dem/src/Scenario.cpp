@@ -4,13 +4,13 @@
 
 namespace grainlink::dem {
 
-RigidBodyState segmentedMotion(const RigidBodyState& start,
-                               const std::vector<MotionSegment>& motion, double t_s) {
+RigidBodyState segmentedMotion(const RigidBodyState &start,
+                               const std::vector<MotionSegment> &motion, double t_s) {
     RigidBodyState s = start;
     s.velocity_m_s.setZero();
     s.angular_velocity_rad_s.setZero();
     double remaining = std::max(t_s, 0.0);
-    for (const MotionSegment& seg : motion) {
+    for (const MotionSegment &seg : motion) {
         const double span = std::min(remaining, seg.duration_s);
         s.position_m += seg.velocity_m_s * span;
         s.orientation = rotationFromVector(seg.angular_velocity_rad_s * span) * s.orientation;
@@ -27,16 +27,20 @@ RigidBodyState segmentedMotion(const RigidBodyState& start,
 
 namespace {
 
-Vec3 gravityOf(const ConfigNode& node) {
-    if (node.isSequence()) return node.vec3();
+Vec3 gravityOf(const ConfigNode &node) {
+    if (node.isSequence())
+        return node.vec3();
     const std::string body = node.choice({"earth", "mars", "moon", "none"});
-    if (body == "earth") return Vec3(0, 0, -9.81);
-    if (body == "mars") return Vec3(0, 0, -3.71);
-    if (body == "moon") return Vec3(0, 0, -1.62);
+    if (body == "earth")
+        return Vec3(0, 0, -9.81);
+    if (body == "mars")
+        return Vec3(0, 0, -3.71);
+    if (body == "moon")
+        return Vec3(0, 0, -1.62);
     return Vec3::Zero();
 }
 
-Material parseMaterial(const ConfigNode& node) {
+Material parseMaterial(const ConfigNode &node) {
     Material m;
     m.name = node.text("name", "soil");
     m.youngs_modulus_Pa = node["youngs_modulus_Pa"].positive();
@@ -45,22 +49,22 @@ Material parseMaterial(const ConfigNode& node) {
     node.finish();
     try {
         m.validate();
-    } catch (const std::invalid_argument& e) {
+    } catch (const std::invalid_argument &e) {
         node.fail(e.what());
     }
     return m;
 }
 
 /// Runs a model's own parameter check and reports a failure at that model's key.
-template <class Model> void validateAt(const ConfigNode& node, const Model& model) {
+template <class Model> void validateAt(const ConfigNode &node, const Model &model) {
     try {
-        std::visit([](const auto& m) { m.validate(); }, model);
-    } catch (const std::invalid_argument& e) {
+        std::visit([](const auto &m) { m.validate(); }, model);
+    } catch (const std::invalid_argument &e) {
         node.fail(e.what());
     }
 }
 
-ContactLaw parseContact(const ConfigNode& node) {
+ContactLaw parseContact(const ConfigNode &node) {
     ContactLaw law;
     const ConfigNode damping = node["damping"];
     if (damping["model"].choice({"restitution", "viscous"}) == "restitution")
@@ -100,23 +104,25 @@ ContactLaw parseContact(const ConfigNode& node) {
     node.finish();
     try {
         law.finalize();
-    } catch (const std::invalid_argument& e) {
+    } catch (const std::invalid_argument &e) {
         node.fail(e.what());
     }
     return law;
 }
 
-void parseWall(const ConfigNode& node, const Material& material, std::vector<PlaneWall>& out) {
+void parseWall(const ConfigNode &node, const Material &material, std::vector<PlaneWall> &out) {
     const std::string name = node["name"].text();
     const std::string type = node["type"].choice({"plane", "box"});
     std::optional<double> friction;
-    if (const auto f = node.optional("friction_coefficient")) friction = f->number();
+    if (const auto f = node.optional("friction_coefficient"))
+        friction = f->number();
     if (type == "plane") {
         PlaneWall wall;
         wall.name = name;
         wall.point_m = node["point_m"].vec3();
         wall.normal = node["normal"].vec3();
-        if (wall.normal.norm() == 0.0) node["normal"].fail("normal must not be zero");
+        if (wall.normal.norm() == 0.0)
+            node["normal"].fail("normal must not be zero");
         wall.friction_coefficient = friction;
         wall.material = material;
         if (const auto track = node.optional("track")) {
@@ -131,11 +137,13 @@ void parseWall(const ConfigNode& node, const Material& material, std::vector<Pla
     } else {
         // Axis-aligned box: six inward-facing planes, the top one optional.
         const Vec3 lo = node["lower_m"].vec3(), hi = node["upper_m"].vec3();
-        if ((hi - lo).minCoeff() <= 0.0) node["upper_m"].fail("upper_m must exceed lower_m on every axis");
+        if ((hi - lo).minCoeff() <= 0.0)
+            node["upper_m"].fail("upper_m must exceed lower_m on every axis");
         const bool open_top = node.boolean("open_top", true);
-        const char* side[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
+        const char *side[6] = {"xmin", "xmax", "ymin", "ymax", "zmin", "zmax"};
         for (int k = 0; k < 6; ++k) {
-            if (k == 5 && open_top) continue;
+            if (k == 5 && open_top)
+                continue;
             const int axis = k / 2;
             PlaneWall wall;
             wall.name = name + "." + side[k];
@@ -150,7 +158,7 @@ void parseWall(const ConfigNode& node, const Material& material, std::vector<Pla
     node.finish();
 }
 
-RadiusDistribution parseRadius(const ConfigNode& node) {
+RadiusDistribution parseRadius(const ConfigNode &node) {
     RadiusDistribution d;
     const std::string kind = node["distribution"].choice({"constant", "uniform", "discrete"});
     if (kind == "constant") {
@@ -168,17 +176,18 @@ RadiusDistribution parseRadius(const ConfigNode& node) {
     node.finish();
     try {
         d.validate();
-    } catch (const std::invalid_argument& e) {
+    } catch (const std::invalid_argument &e) {
         node.fail(e.what());
     }
     return d;
 }
 
-DepositionSpec parseDeposition(const ConfigNode& node) {
+DepositionSpec parseDeposition(const ConfigNode &node) {
     DepositionSpec d;
     d.method = node.text("method", "random") == "rain" ? DepositionSpec::Method::Rain
                                                        : DepositionSpec::Method::Random;
-    if (const auto m = node.optional("method")) m->choice({"random", "rain"});
+    if (const auto m = node.optional("method"))
+        m->choice({"random", "rain"});
     const ConfigNode region = node["region"];
     d.region_lower_m = region["lower_m"].vec3();
     d.region_upper_m = region["upper_m"].vec3();
@@ -186,7 +195,8 @@ DepositionSpec parseDeposition(const ConfigNode& node) {
     if ((d.region_upper_m - d.region_lower_m).minCoeff() <= 0.0)
         region.fail("upper_m must exceed lower_m on every axis");
     d.count = std::size_t(node["count"].integer());
-    if (d.count == 0) node["count"].fail("must be > 0");
+    if (d.count == 0)
+        node["count"].fail("must be > 0");
     d.radius = parseRadius(node["radius"]);
     d.seed = std::uint64_t(node.number("seed", 1.0));
     d.layers = int(node.number("layers", 1.0));
@@ -197,7 +207,7 @@ DepositionSpec parseDeposition(const ConfigNode& node) {
     return d;
 }
 
-TriangleMesh parseMesh(const ConfigNode& node, const std::string& scenario_dir) {
+TriangleMesh parseMesh(const ConfigNode &node, const std::string &scenario_dir) {
     const std::string type = node["type"].choice({"cylinder", "stl"});
     TriangleMesh mesh;
     if (type == "cylinder") {
@@ -205,10 +215,11 @@ TriangleMesh parseMesh(const ConfigNode& node, const std::string& scenario_dir) 
                             int(node.number("segments", 72)));
     } else {
         std::string file = node["file"].text();
-        if (!file.empty() && file[0] != '/') file = scenario_dir + file;
+        if (!file.empty() && file[0] != '/')
+            file = scenario_dir + file;
         try {
             mesh = readStl(file);
-        } catch (const std::exception& e) {
+        } catch (const std::exception &e) {
             node["file"].fail(e.what());
         }
         mesh.transform(node.number("scale", 1.0), Vec3::Zero());
@@ -217,7 +228,7 @@ TriangleMesh parseMesh(const ConfigNode& node, const std::string& scenario_dir) 
     return mesh;
 }
 
-BodySpec parseBody(const ConfigNode& node, const std::string& scenario_dir) {
+BodySpec parseBody(const ConfigNode &node, const std::string &scenario_dir) {
     BodySpec b;
     b.name = node["name"].text();
     b.mesh = parseMesh(node["mesh"], scenario_dir);
@@ -228,14 +239,17 @@ BodySpec parseBody(const ConfigNode& node, const std::string& scenario_dir) {
                               Eigen::AngleAxisd(r.y(), Vec3::UnitY()) *
                               Eigen::AngleAxisd(r.x(), Vec3::UnitX());
     }
-    if (const auto c = node.optional("clearance_above_bed_m")) b.clearance_above_bed_m = c->number();
-    if (const auto f = node.optional("friction_coefficient")) b.friction_coefficient = f->number();
+    if (const auto c = node.optional("clearance_above_bed_m"))
+        b.clearance_above_bed_m = c->number();
+    if (const auto f = node.optional("friction_coefficient"))
+        b.friction_coefficient = f->number();
     b.record_triangle_loads = node.boolean("record_triangle_loads", false);
     if (const auto motion = node.optional("motion"))
-        for (const ConfigNode& seg : motion->items()) {
+        for (const ConfigNode &seg : motion->items()) {
             MotionSegment m;
             m.duration_s = seg["duration_s"].positive();
-            m.velocity_m_s = seg.optional("velocity_m_s") ? seg["velocity_m_s"].vec3() : Vec3::Zero();
+            m.velocity_m_s =
+                seg.optional("velocity_m_s") ? seg["velocity_m_s"].vec3() : Vec3::Zero();
             m.angular_velocity_rad_s = seg.optional("angular_velocity_rad_s")
                                            ? seg["angular_velocity_rad_s"].vec3()
                                            : Vec3::Zero();
@@ -248,13 +262,13 @@ BodySpec parseBody(const ConfigNode& node, const std::string& scenario_dir) {
 
 } // namespace
 
-DemScenario loadScenario(const std::string& path) {
+DemScenario loadScenario(const std::string &path) {
     DemScenario s = parseScenario(ConfigNode::loadFile(path));
     s.file = path;
     return s;
 }
 
-DemScenario parseScenario(const ConfigNode& root) {
+DemScenario parseScenario(const ConfigNode &root) {
     DemScenario s;
     s.name = root["name"].text();
     // Mesh files are found relative to the scenario file.
@@ -265,13 +279,17 @@ DemScenario parseScenario(const ConfigNode& root) {
     s.settings.integrator = sim.text("integrator", "velocity_verlet") == "newmark"
                                 ? Integrator::Newmark
                                 : Integrator::VelocityVerlet;
-    if (const auto i = sim.optional("integrator")) i->choice({"velocity_verlet", "newmark"});
+    if (const auto i = sim.optional("integrator"))
+        i->choice({"velocity_verlet", "newmark"});
     s.settings.newmark_beta = sim.number("newmark_beta", 0.25);
     s.settings.newmark_gamma = sim.number("newmark_gamma", 0.5);
-    if (const auto g = sim.optional("gravity")) s.settings.gravity_m_s2 = gravityOf(*g);
-    if (const auto g = sim.optional("gravity_m_s2")) s.settings.gravity_m_s2 = g->vec3();
+    if (const auto g = sim.optional("gravity"))
+        s.settings.gravity_m_s2 = gravityOf(*g);
+    if (const auto g = sim.optional("gravity_m_s2"))
+        s.settings.gravity_m_s2 = g->vec3();
     s.settings.threads = int(sim.number("threads", 1.0));
-    if (s.settings.threads < 1) sim["threads"].fail("must be >= 1");
+    if (s.settings.threads < 1)
+        sim["threads"].fail("must be >= 1");
     s.settings.skin_m = sim.number("skin_m", 0.0);
     s.settings.resort_every_builds = int(sim.number("resort_every_builds", 25.0));
     s.settings.max_overlap_ratio = sim.number("max_overlap_ratio", 0.4);
@@ -281,11 +299,13 @@ DemScenario parseScenario(const ConfigNode& root) {
     s.material = parseMaterial(root["material"]);
     s.law = parseContact(root["contact"]);
     if (const auto walls = root.optional("walls"))
-        for (const ConfigNode& w : walls->items()) parseWall(w, s.material, s.planes);
+        for (const ConfigNode &w : walls->items())
+            parseWall(w, s.material, s.planes);
     s.deposition = parseDeposition(root["deposition"]);
     s.packing_cache_directory = root.text("packing_cache_directory", ".cache/packings");
     if (const auto bodies = root.optional("bodies"))
-        for (const ConfigNode& b : bodies->items()) s.bodies.push_back(parseBody(b, dir));
+        for (const ConfigNode &b : bodies->items())
+            s.bodies.push_back(parseBody(b, dir));
     const ConfigNode run = root["run"];
     s.duration_s = run["duration_s"].positive();
     run.finish();
@@ -294,28 +314,30 @@ DemScenario parseScenario(const ConfigNode& root) {
         s.output.snapshot_interval_s = out->number("snapshot_interval_s", 0.0);
         s.output.checkpoint_interval_s = out->number("checkpoint_interval_s", 0.0);
         out->finish();
-        if (!(s.output.series_interval_s > 0.0)) (*out)["series_interval_s"].fail("must be > 0");
+        if (!(s.output.series_interval_s > 0.0))
+            (*out)["series_interval_s"].fail("must be > 0");
     }
     root.finish();
     return s;
 }
 
-std::unique_ptr<DemSystem> makeSystem(const DemScenario& s) {
+std::unique_ptr<DemSystem> makeSystem(const DemScenario &s) {
     auto system = std::make_unique<DemSystem>(s.law, std::vector<Material>{s.material}, s.settings);
-    for (const PlaneWall& w : s.planes) system->addPlane(w);
+    for (const PlaneWall &w : s.planes)
+        system->addPlane(w);
     return system;
 }
 
-std::string packingKey(const DemScenario& s) {
+std::string packingKey(const DemScenario &s) {
     std::ostringstream key;
     key.precision(17);
     key << "v1|" << s.law.describe() << "|E=" << s.material.youngs_modulus_Pa
         << " nu=" << s.material.poisson_ratio << " rho=" << s.material.density_kg_m3
         << "|dt=" << s.settings.time_step_s << " int=" << int(s.settings.integrator) << ','
         << s.settings.newmark_beta << ',' << s.settings.newmark_gamma
-        << " g=" << s.settings.gravity_m_s2.transpose() << " threads=" << s.settings.threads
-        << "|" << s.deposition.describe();
-    for (const PlaneWall& w : s.planes)
+        << " g=" << s.settings.gravity_m_s2.transpose() << " threads=" << s.settings.threads << "|"
+        << s.deposition.describe();
+    for (const PlaneWall &w : s.planes)
         key << "|wall " << w.name << ' ' << w.point_m.transpose() << ' ' << w.normal.transpose()
             << ' ' << w.friction_coefficient.value_or(-1.0);
     return hashKey(key.str());

@@ -18,21 +18,23 @@ namespace fs = std::filesystem;
 namespace {
 
 /// Height of the settled bed's surface: 98th percentile of grain tops (robust to stray grains).
-double bedSurface(const ParticleStore& p) {
-    if (p.empty()) return 0.0;
+double bedSurface(const ParticleStore &p) {
+    if (p.empty())
+        return 0.0;
     std::vector<double> tops(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i) tops[i] = p.position[i].z() + p.radius[i];
+    for (std::size_t i = 0; i < p.size(); ++i)
+        tops[i] = p.position[i].z() + p.radius[i];
     const std::size_t k = std::min(p.size() - 1, std::size_t(0.98 * double(p.size())));
     std::nth_element(tops.begin(), tops.begin() + std::ptrdiff_t(k), tops.end());
     return tops[k];
 }
 
-std::string seriesHeader(const DemSystem& sys) {
+std::string seriesHeader(const DemSystem &sys) {
     std::string h = "time_s,run_time_s,step,kinetic_J,rotational_J,gravitational_J,elastic_J,"
                     "contacts,wall_contacts,max_overlap_ratio";
     for (int b = 0; b < sys.bodyCount(); ++b) {
-        const std::string& n = sys.body(b).name();
-        for (const char* c : {"x_m", "y_m", "z_m", "vx_m_s", "vz_m_s", "wy_rad_s", "Fx_N", "Fy_N",
+        const std::string &n = sys.body(b).name();
+        for (const char *c : {"x_m", "y_m", "z_m", "vx_m_s", "vz_m_s", "wy_rad_s", "Fx_N", "Fy_N",
                               "Fz_N", "Tx_N_m", "Ty_N_m", "Tz_N_m"})
             h += "," + n + "_" + c;
     }
@@ -40,7 +42,7 @@ std::string seriesHeader(const DemSystem& sys) {
 }
 
 /// One row; body forces are averaged over the interval since the last row (impulse / time).
-std::string seriesRow(DemSystem& sys, double run_time_s) {
+std::string seriesRow(DemSystem &sys, double run_time_s) {
     sys.prepare(); // contacts are counted from the neighbour list
     const Energies e = sys.energies();
     std::ostringstream row;
@@ -49,8 +51,8 @@ std::string seriesRow(DemSystem& sys, double run_time_s) {
         << ',' << e.rotational_J << ',' << e.gravitational_J << ',' << e.elastic_J << ','
         << sys.contactCount() << ',' << sys.wallContactCount() << ',' << sys.maxOverlapRatio();
     for (int b = 0; b < sys.bodyCount(); ++b) {
-        MeshBody& body = sys.body(b);
-        const RigidBodyState& s = body.state();
+        MeshBody &body = sys.body(b);
+        const RigidBodyState &s = body.state();
         const double span = body.accumulated_time_s > 0.0 ? body.accumulated_time_s : 1.0;
         const Vec3 f = body.impulse_N_s / span, t = body.angular_impulse_N_m_s / span;
         row << ',' << s.position_m.x() << ',' << s.position_m.y() << ',' << s.position_m.z() << ','
@@ -63,9 +65,10 @@ std::string seriesRow(DemSystem& sys, double run_time_s) {
 }
 
 /// Keeps the header and the rows up to `last_step` (rows after a checkpoint are redone).
-void truncateSeries(const std::string& path, std::uint64_t last_step) {
+void truncateSeries(const std::string &path, std::uint64_t last_step) {
     std::ifstream in(path);
-    if (!in) return;
+    if (!in)
+        return;
     std::vector<std::string> keep;
     std::string line;
     while (std::getline(in, line)) {
@@ -78,14 +81,16 @@ void truncateSeries(const std::string& path, std::uint64_t last_step) {
         std::getline(fields, t, ',');
         std::getline(fields, rt, ',');
         std::getline(fields, step, ',');
-        if (!step.empty() && std::stoull(step) <= last_step) keep.push_back(line);
+        if (!step.empty() && std::stoull(step) <= last_step)
+            keep.push_back(line);
     }
     in.close();
     std::ofstream out(path, std::ios::trunc);
-    for (const std::string& l : keep) out << l << '\n';
+    for (const std::string &l : keep)
+        out << l << '\n';
 }
 
-void addBody(DemSystem& sys, const BodySpec& spec, const RigidBodyState& start,
+void addBody(DemSystem &sys, const BodySpec &spec, const RigidBodyState &start,
              double run_start_s) {
     MeshBody body(spec.name, spec.mesh, start);
     body.friction_coefficient = spec.friction_coefficient;
@@ -97,14 +102,14 @@ void addBody(DemSystem& sys, const BodySpec& spec, const RigidBodyState& start,
 }
 
 /// Start poses: a clearance above the bed puts the lowest mesh point that far above the surface.
-std::vector<RigidBodyState> startPoses(const DemSystem& sys, const DemScenario& scenario) {
+std::vector<RigidBodyState> startPoses(const DemSystem &sys, const DemScenario &scenario) {
     const double surface = bedSurface(sys.particles());
     std::vector<RigidBodyState> starts;
-    for (const BodySpec& spec : scenario.bodies) {
+    for (const BodySpec &spec : scenario.bodies) {
         RigidBodyState start = spec.start;
         if (spec.clearance_above_bed_m) {
             double lowest = 1e300;
-            for (const Vec3& v : spec.mesh.vertices_m)
+            for (const Vec3 &v : spec.mesh.vertices_m)
                 lowest = std::min(lowest, (start.orientation * v).z());
             start.position_m.z() = surface + *spec.clearance_above_bed_m - lowest;
         }
@@ -115,7 +120,7 @@ std::vector<RigidBodyState> startPoses(const DemSystem& sys, const DemScenario& 
 
 } // namespace
 
-RunSummary runScenario(const DemScenario& scenario, const RunOptions& options) {
+RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
     RunSummary summary;
     const fs::path out = options.output_directory;
     fs::create_directories(out);
@@ -156,15 +161,18 @@ RunSummary runScenario(const DemScenario& scenario, const RunOptions& options) {
                          cache.c_str(), sys->particles().size());
         } else {
             Progress progress("deposition", options.progress_interval_s);
-            const auto report = deposit(*sys, scenario.deposition, [&](const DepositionReport& r) {
-                progress.update(sys->time(),
-                                std::min(1.0, r.settle_time_s / scenario.deposition.max_settle_time_s),
-                                sys->stepCount() * sys->particles().size(),
-                                "KE/particle " + std::to_string(r.final_kinetic_energy_per_particle_J) + " J");
+            const auto report = deposit(*sys, scenario.deposition, [&](const DepositionReport &r) {
+                progress.update(
+                    sys->time(),
+                    std::min(1.0, r.settle_time_s / scenario.deposition.max_settle_time_s),
+                    sys->stepCount() * sys->particles().size(),
+                    "KE/particle " + std::to_string(r.final_kinetic_energy_per_particle_J) + " J");
             });
-            std::fprintf(stderr, "[deposition] %zu particles, settled %s after %.3f s (KE/particle %.3g J)\n",
-                         report.inserted, report.settled ? "" : "NOT (time limit)",
-                         report.settle_time_s, report.final_kinetic_energy_per_particle_J);
+            std::fprintf(
+                stderr,
+                "[deposition] %zu particles, settled %s after %.3f s (KE/particle %.3g J)\n",
+                report.inserted, report.settled ? "" : "NOT (time limit)", report.settle_time_s,
+                report.final_kinetic_energy_per_particle_J);
             if (!cache.empty()) {
                 fs::create_directories(cache.parent_path());
                 writeCheckpoint(*sys, cache.string());
@@ -174,11 +182,13 @@ RunSummary runScenario(const DemScenario& scenario, const RunOptions& options) {
         starts = startPoses(*sys, scenario);
         for (std::size_t b = 0; b < scenario.bodies.size(); ++b)
             addBody(*sys, scenario.bodies[b], starts[b], run_start_s);
-        if (fs::exists(series_path)) fs::remove(series_path);
+        if (fs::exists(series_path))
+            fs::remove(series_path);
     }
 
     // --- phase 2: the run -----------------------------------------------------------------
-    const auto steps_per_row = std::max<std::uint64_t>(1, std::llround(scenario.output.series_interval_s / dt));
+    const auto steps_per_row =
+        std::max<std::uint64_t>(1, std::llround(scenario.output.series_interval_s / dt));
     const auto rows_per_checkpoint =
         scenario.output.checkpoint_interval_s > 0.0
             ? std::max<std::uint64_t>(1, std::llround(scenario.output.checkpoint_interval_s /
@@ -201,9 +211,12 @@ RunSummary runScenario(const DemScenario& scenario, const RunOptions& options) {
         vtk.resumeAt(int(times.size()), times);
     }
     std::ofstream series(series_path, std::ios::app);
-    if (!series) throw std::runtime_error("cannot write '" + series_path + "'");
-    if (!options.resume) series << seriesHeader(*sys) << '\n' << seriesRow(*sys, 0.0) << '\n';
-    if (!options.resume && steps_per_snapshot) vtk.write(*sys, 0.0);
+    if (!series)
+        throw std::runtime_error("cannot write '" + series_path + "'");
+    if (!options.resume)
+        series << seriesHeader(*sys) << '\n' << seriesRow(*sys, 0.0) << '\n';
+    if (!options.resume && steps_per_snapshot)
+        vtk.write(*sys, 0.0);
 
     auto saveCheckpoint = [&] {
         CheckpointExtras e;
@@ -211,7 +224,8 @@ RunSummary runScenario(const DemScenario& scenario, const RunOptions& options) {
         for (std::size_t b = 0; b < starts.size(); ++b)
             e["body" + std::to_string(b) + "_start_z_m"] = starts[b].position_m.z();
         e["snapshots"] = vtk.count();
-        for (int k = 0; k < vtk.count(); ++k) e["snapshot" + std::to_string(k) + "_s"] = vtk.times()[std::size_t(k)];
+        for (int k = 0; k < vtk.count(); ++k)
+            e["snapshot" + std::to_string(k) + "_s"] = vtk.times()[std::size_t(k)];
         writeCheckpoint(*sys, checkpoint, e);
     };
 
@@ -225,13 +239,15 @@ RunSummary runScenario(const DemScenario& scenario, const RunOptions& options) {
                 series << seriesRow(*sys, double(done) * dt) << '\n';
                 series.flush();
                 ++rows;
-                if (rows_per_checkpoint && rows % rows_per_checkpoint == 0) saveCheckpoint();
+                if (rows_per_checkpoint && rows % rows_per_checkpoint == 0)
+                    saveCheckpoint();
             }
-            if (steps_per_snapshot && done % steps_per_snapshot == 0) vtk.write(*sys, double(done) * dt);
+            if (steps_per_snapshot && done % steps_per_snapshot == 0)
+                vtk.write(*sys, double(done) * dt);
             progress.update(double(done) * dt, double(done) / double(run_steps),
                             (sys->stepCount() - first_step) * sys->particles().size());
         }
-    } catch (const SimulationError& e) {
+    } catch (const SimulationError &e) {
         // Keep what is readable: the series so far, and the last finite particle state.
         series.flush();
         const std::string snapshot = (out / "failure_particles.vtu").string();
@@ -239,7 +255,8 @@ RunSummary runScenario(const DemScenario& scenario, const RunOptions& options) {
         std::ostringstream msg;
         msg << e.what() << "; series so far in " << series_path << ", state at failure in "
             << snapshot;
-        if (fs::exists(checkpoint)) msg << ", resume from " << checkpoint << " with --resume";
+        if (fs::exists(checkpoint))
+            msg << ", resume from " << checkpoint << " with --resume";
         throw std::runtime_error(msg.str());
     }
     saveCheckpoint();

@@ -12,30 +12,34 @@ namespace grainlink::dem {
 
 double TriangleMesh::boundingRadius() const {
     double r = 0.0;
-    for (const Vec3& v : vertices_m) r = std::max(r, v.norm());
+    for (const Vec3 &v : vertices_m)
+        r = std::max(r, v.norm());
     return r;
 }
 
-void TriangleMesh::transform(double scale, const Vec3& offset_m) {
-    for (Vec3& v : vertices_m) v = scale * v + offset_m;
+void TriangleMesh::transform(double scale, const Vec3 &offset_m) {
+    for (Vec3 &v : vertices_m)
+        v = scale * v + offset_m;
 }
 
-void TriangleMesh::validate(const std::string& what) const {
+void TriangleMesh::validate(const std::string &what) const {
     const int n = static_cast<int>(vertices_m.size());
-    for (const Vec3& v : vertices_m)
-        if (!v.allFinite()) throw std::runtime_error(what + ": non-finite vertex coordinate");
+    for (const Vec3 &v : vertices_m)
+        if (!v.allFinite())
+            throw std::runtime_error(what + ": non-finite vertex coordinate");
     for (std::size_t t = 0; t < triangles.size(); ++t) {
         for (int k : triangles[t])
             if (k < 0 || k >= n)
                 throw std::runtime_error(what + ": triangle " + std::to_string(t) +
                                          " refers to missing vertex " + std::to_string(k));
-        const auto& tri = triangles[t];
+        const auto &tri = triangles[t];
         const Vec3 area2 = (vertices_m[tri[1]] - vertices_m[tri[0]])
                                .cross(vertices_m[tri[2]] - vertices_m[tri[0]]);
         if (area2.norm() == 0.0)
             throw std::runtime_error(what + ": triangle " + std::to_string(t) + " is degenerate");
     }
-    if (triangles.empty()) throw std::runtime_error(what + ": mesh has no triangles");
+    if (triangles.empty())
+        throw std::runtime_error(what + ": mesh has no triangles");
 }
 
 namespace {
@@ -43,40 +47,42 @@ namespace {
 /// Shares identical vertices so the mesh is indexed rather than a triangle soup.
 class VertexWelder {
 public:
-    explicit VertexWelder(TriangleMesh& mesh) : mesh_(mesh) {}
-    int index(const Vec3& v) {
+    explicit VertexWelder(TriangleMesh &mesh) : mesh_(mesh) {}
+    int index(const Vec3 &v) {
         const auto key = std::make_tuple(v.x(), v.y(), v.z());
         auto [it, inserted] = lookup_.emplace(key, static_cast<int>(mesh_.vertices_m.size()));
-        if (inserted) mesh_.vertices_m.push_back(v);
+        if (inserted)
+            mesh_.vertices_m.push_back(v);
         return it->second;
     }
-    void addTriangle(const Vec3& a, const Vec3& b, const Vec3& c) {
+    void addTriangle(const Vec3 &a, const Vec3 &b, const Vec3 &c) {
         mesh_.triangles.push_back({index(a), index(b), index(c)});
     }
 
 private:
-    TriangleMesh& mesh_;
+    TriangleMesh &mesh_;
     std::map<std::tuple<double, double, double>, int> lookup_;
 };
 
-TriangleMesh readStlBinary(const std::string& path, const std::string& bytes) {
+TriangleMesh readStlBinary(const std::string &path, const std::string &bytes) {
     std::uint32_t count = 0;
     std::memcpy(&count, bytes.data() + 80, 4);
     TriangleMesh mesh;
     VertexWelder weld(mesh);
     for (std::uint32_t t = 0; t < count; ++t) {
-        const char* rec = bytes.data() + 84 + 50 * std::size_t(t);
+        const char *rec = bytes.data() + 84 + 50 * std::size_t(t);
         float f[12];
         std::memcpy(f, rec, sizeof f);
         Vec3 v[3];
-        for (int k = 0; k < 3; ++k) v[k] = Vec3(f[3 + 3 * k], f[4 + 3 * k], f[5 + 3 * k]);
+        for (int k = 0; k < 3; ++k)
+            v[k] = Vec3(f[3 + 3 * k], f[4 + 3 * k], f[5 + 3 * k]);
         weld.addTriangle(v[0], v[1], v[2]);
     }
     mesh.validate("STL file '" + path + "'");
     return mesh;
 }
 
-TriangleMesh readStlAscii(const std::string& path, const std::string& text) {
+TriangleMesh readStlAscii(const std::string &path, const std::string &text) {
     TriangleMesh mesh;
     VertexWelder weld(mesh);
     std::istringstream in(text);
@@ -87,7 +93,8 @@ TriangleMesh readStlAscii(const std::string& path, const std::string& text) {
         ++line_no;
         std::istringstream words(line);
         std::string word;
-        if (!(words >> word)) continue;
+        if (!(words >> word))
+            continue;
         if (word == "vertex") {
             Vec3 v;
             if (!(words >> v.x() >> v.y() >> v.z()))
@@ -109,15 +116,17 @@ TriangleMesh readStlAscii(const std::string& path, const std::string& text) {
 
 } // namespace
 
-TriangleMesh readStl(const std::string& path) {
+TriangleMesh readStl(const std::string &path) {
     std::ifstream file(path, std::ios::binary);
-    if (!file) throw std::runtime_error("cannot open STL file '" + path + "'");
+    if (!file)
+        throw std::runtime_error("cannot open STL file '" + path + "'");
     std::string bytes((std::istreambuf_iterator<char>(file)), std::istreambuf_iterator<char>());
     if (bytes.size() >= 84) {
         std::uint32_t count = 0;
         std::memcpy(&count, bytes.data() + 80, 4);
         // Binary STL has an exact size; ASCII files may also start with "solid", so test size.
-        if (bytes.size() == 84 + 50 * std::size_t(count)) return readStlBinary(path, bytes);
+        if (bytes.size() == 84 + 50 * std::size_t(count))
+            return readStlBinary(path, bytes);
     }
     if (bytes.compare(0, 5, "solid") != 0)
         throw std::runtime_error("STL file '" + path +
@@ -125,31 +134,33 @@ TriangleMesh readStl(const std::string& path) {
     return readStlAscii(path, bytes);
 }
 
-void writeStlAscii(const TriangleMesh& mesh, const std::string& path, const std::string& name) {
+void writeStlAscii(const TriangleMesh &mesh, const std::string &path, const std::string &name) {
     std::ofstream out(path);
-    if (!out) throw std::runtime_error("cannot write STL file '" + path + "'");
+    if (!out)
+        throw std::runtime_error("cannot write STL file '" + path + "'");
     out.precision(9);
     out << "solid " << name << "\n";
-    for (const auto& tri : mesh.triangles) {
+    for (const auto &tri : mesh.triangles) {
         const Vec3 &a = mesh.vertices_m[tri[0]], &b = mesh.vertices_m[tri[1]],
                    &c = mesh.vertices_m[tri[2]];
         const Vec3 n = (b - a).cross(c - a).normalized();
         out << " facet normal " << n.x() << ' ' << n.y() << ' ' << n.z() << "\n  outer loop\n";
-        for (const Vec3* v : {&a, &b, &c})
+        for (const Vec3 *v : {&a, &b, &c})
             out << "   vertex " << v->x() << ' ' << v->y() << ' ' << v->z() << "\n";
         out << "  endloop\n endfacet\n";
     }
     out << "endsolid " << name << "\n";
 }
 
-void writeStlBinary(const TriangleMesh& mesh, const std::string& path) {
+void writeStlBinary(const TriangleMesh &mesh, const std::string &path) {
     std::ofstream out(path, std::ios::binary);
-    if (!out) throw std::runtime_error("cannot write STL file '" + path + "'");
+    if (!out)
+        throw std::runtime_error("cannot write STL file '" + path + "'");
     char header[80] = "grainlink binary STL";
     out.write(header, 80);
     const std::uint32_t count = static_cast<std::uint32_t>(mesh.triangles.size());
-    out.write(reinterpret_cast<const char*>(&count), 4);
-    for (const auto& tri : mesh.triangles) {
+    out.write(reinterpret_cast<const char *>(&count), 4);
+    for (const auto &tri : mesh.triangles) {
         const Vec3 &a = mesh.vertices_m[tri[0]], &b = mesh.vertices_m[tri[1]],
                    &c = mesh.vertices_m[tri[2]];
         const Vec3 n = (b - a).cross(c - a).normalized();
@@ -160,26 +171,31 @@ void writeStlBinary(const TriangleMesh& mesh, const std::string& path) {
             f[6 + k] = float(b[k]);
             f[9 + k] = float(c[k]);
         }
-        out.write(reinterpret_cast<const char*>(f), sizeof f);
+        out.write(reinterpret_cast<const char *>(f), sizeof f);
         const std::uint16_t attribute = 0;
-        out.write(reinterpret_cast<const char*>(&attribute), 2);
+        out.write(reinterpret_cast<const char *>(&attribute), 2);
     }
 }
 
-Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c) {
+Vec3 closestPointOnTriangle(const Vec3 &p, const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     const Vec3 ab = b - a, ac = c - a, ap = p - a;
     const double d1 = ab.dot(ap), d2 = ac.dot(ap);
-    if (d1 <= 0.0 && d2 <= 0.0) return a;
+    if (d1 <= 0.0 && d2 <= 0.0)
+        return a;
     const Vec3 bp = p - b;
     const double d3 = ab.dot(bp), d4 = ac.dot(bp);
-    if (d3 >= 0.0 && d4 <= d3) return b;
+    if (d3 >= 0.0 && d4 <= d3)
+        return b;
     const double vc = d1 * d4 - d3 * d2;
-    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0) return a + (d1 / (d1 - d3)) * ab;
+    if (vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0)
+        return a + (d1 / (d1 - d3)) * ab;
     const Vec3 cp = p - c;
     const double d5 = ab.dot(cp), d6 = ac.dot(cp);
-    if (d6 >= 0.0 && d5 <= d6) return c;
+    if (d6 >= 0.0 && d5 <= d6)
+        return c;
     const double vb = d5 * d2 - d1 * d6;
-    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0) return a + (d2 / (d2 - d6)) * ac;
+    if (vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0)
+        return a + (d2 / (d2 - d6)) * ac;
     const double va = d3 * d6 - d5 * d4;
     if (va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0)
         return b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (c - b);
@@ -188,7 +204,8 @@ Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 }
 
 TriangleMesh makeCylinder(double radius_m, double width_m, int segments) {
-    if (segments < 3) throw std::invalid_argument("makeCylinder: need at least 3 segments");
+    if (segments < 3)
+        throw std::invalid_argument("makeCylinder: need at least 3 segments");
     TriangleMesh mesh;
     const double half = 0.5 * width_m;
     // Ring vertices on both faces, then the two cap centres.

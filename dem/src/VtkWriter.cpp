@@ -8,20 +8,21 @@ namespace grainlink::dem {
 
 namespace {
 
-std::string numbered(const std::string& prefix, int index) {
+std::string numbered(const std::string &prefix, int index) {
     char name[64];
     std::snprintf(name, sizeof name, "%s_%06d.vtu", prefix.c_str(), index);
     return name;
 }
 
-void openOrThrow(std::ofstream& out, const std::string& path) {
+void openOrThrow(std::ofstream &out, const std::string &path) {
     out.open(path);
-    if (!out) throw std::runtime_error("cannot write snapshot '" + path + "'");
+    if (!out)
+        throw std::runtime_error("cannot write snapshot '" + path + "'");
     out.precision(9);
 }
 
 template <class Get>
-void vectorArray(std::ofstream& out, const char* name, std::size_t n, Get get) {
+void vectorArray(std::ofstream &out, const char *name, std::size_t n, Get get) {
     out << "<DataArray type=\"Float64\" Name=\"" << name
         << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
     for (std::size_t i = 0; i < n; ++i) {
@@ -31,25 +32,30 @@ void vectorArray(std::ofstream& out, const char* name, std::size_t n, Get get) {
     out << "</DataArray>\n";
 }
 
-void writeMesh(const MeshBody& body, const std::string& path) {
+void writeMesh(const MeshBody &body, const std::string &path) {
     std::ofstream out;
     openOrThrow(out, path);
-    const auto& v = body.worldVertices();
-    const auto& t = body.mesh().triangles;
+    const auto &v = body.worldVertices();
+    const auto &t = body.mesh().triangles;
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
         << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << v.size() << "\" NumberOfCells=\""
         << t.size() << "\">\n<Points>\n";
     vectorArray(out, "position_m", v.size(), [&](std::size_t i) { return v[i]; });
-    out << "</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-    for (const auto& tri : t) out << tri[0] << ' ' << tri[1] << ' ' << tri[2] << '\n';
+    out << "</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" "
+           "format=\"ascii\">\n";
+    for (const auto &tri : t)
+        out << tri[0] << ' ' << tri[1] << ' ' << tri[2] << '\n';
     out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t k = 0; k < t.size(); ++k) out << 3 * (k + 1) << '\n';
+    for (std::size_t k = 0; k < t.size(); ++k)
+        out << 3 * (k + 1) << '\n';
     out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-    for (std::size_t k = 0; k < t.size(); ++k) out << "5\n"; // VTK_TRIANGLE
+    for (std::size_t k = 0; k < t.size(); ++k)
+        out << "5\n"; // VTK_TRIANGLE
     out << "</DataArray>\n</Cells>\n";
     if (body.record_triangle_loads) {
         out << "<CellData>\n";
-        vectorArray(out, "force_N", t.size(), [&](std::size_t k) { return body.triangle_force_N[k]; });
+        vectorArray(out, "force_N", t.size(),
+                    [&](std::size_t k) { return body.triangle_force_N[k]; });
         out << "</CellData>\n";
     }
     out << "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
@@ -59,7 +65,7 @@ void writeMesh(const MeshBody& body, const std::string& path) {
 
 VtkWriter::VtkWriter(std::string directory) : directory_(std::move(directory)) {}
 
-void VtkWriter::writeParticles(const ParticleStore& p, const std::string& path) {
+void VtkWriter::writeParticles(const ParticleStore &p, const std::string &path) {
     std::ofstream out;
     openOrThrow(out, path);
     const std::size_t n = p.size();
@@ -69,22 +75,26 @@ void VtkWriter::writeParticles(const ParticleStore& p, const std::string& path) 
     vectorArray(out, "position_m", n, [&](std::size_t i) { return p.position[i]; });
     out << "</Points>\n<PointData Scalars=\"radius_m\" Vectors=\"velocity_m_s\">\n"
         << "<DataArray type=\"Int64\" Name=\"id\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i) out << p.id[i] << '\n';
+    for (std::size_t i = 0; i < n; ++i)
+        out << p.id[i] << '\n';
     out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"radius_m\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i) out << p.radius[i] << '\n';
+    for (std::size_t i = 0; i < n; ++i)
+        out << p.radius[i] << '\n';
     out << "</DataArray>\n";
     vectorArray(out, "velocity_m_s", n, [&](std::size_t i) { return p.velocity[i]; });
-    vectorArray(out, "angular_velocity_rad_s", n, [&](std::size_t i) { return p.angular_velocity[i]; });
+    vectorArray(out, "angular_velocity_rad_s", n,
+                [&](std::size_t i) { return p.angular_velocity[i]; });
     vectorArray(out, "force_N", n, [&](std::size_t i) { return p.force[i]; });
     out << "</PointData>\n<Cells>\n"
         << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\"></DataArray>\n"
         << "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\"></DataArray>\n"
         << "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\"></DataArray>\n"
         << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-    if (!out) throw std::runtime_error("failed writing snapshot '" + path + "'");
+    if (!out)
+        throw std::runtime_error("failed writing snapshot '" + path + "'");
 }
 
-void VtkWriter::write(const DemSystem& system, double time_s) {
+void VtkWriter::write(const DemSystem &system, double time_s) {
     const int index = int(times_.size());
     writeParticles(system.particles(), directory_ + "/" + numbered("particles", index));
     body_names_.clear();
@@ -95,17 +105,20 @@ void VtkWriter::write(const DemSystem& system, double time_s) {
     }
     times_.push_back(time_s);
     writeCollection("particles.pvd", "particles");
-    for (const std::string& name : body_names_) writeCollection("body_" + name + ".pvd", "body_" + name);
+    for (const std::string &name : body_names_)
+        writeCollection("body_" + name + ".pvd", "body_" + name);
 }
 
-void VtkWriter::resumeAt(int index, const std::vector<double>& times_s) {
-    times_.assign(times_s.begin(), times_s.begin() + std::min<std::size_t>(std::size_t(index), times_s.size()));
+void VtkWriter::resumeAt(int index, const std::vector<double> &times_s) {
+    times_.assign(times_s.begin(),
+                  times_s.begin() + std::min<std::size_t>(std::size_t(index), times_s.size()));
 }
 
-void VtkWriter::writeCollection(const std::string& name, const std::string& prefix) const {
+void VtkWriter::writeCollection(const std::string &name, const std::string &prefix) const {
     const std::string path = directory_ + "/" + name;
     std::ofstream out(path + ".partial");
-    if (!out) throw std::runtime_error("cannot write '" + path + "'");
+    if (!out)
+        throw std::runtime_error("cannot write '" + path + "'");
     out.precision(12);
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
     for (std::size_t k = 0; k < times_.size(); ++k)

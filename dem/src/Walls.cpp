@@ -10,7 +10,7 @@ MeshBody::MeshBody(std::string name, TriangleMesh mesh_body_frame, RigidBodyStat
     setState(initial);
 }
 
-void MeshBody::setState(const RigidBodyState& state) {
+void MeshBody::setState(const RigidBodyState &state) {
     state_ = state;
     state_.orientation.normalize();
     const Mat3 rotation = state_.orientation.toRotationMatrix();
@@ -25,7 +25,7 @@ void MeshBody::resetAccumulatedImpulse() {
     accumulated_time_s = 0.0;
 }
 
-RigidBodyState constantVelocityMotion(const RigidBodyState& initial, double t_s) {
+RigidBodyState constantVelocityMotion(const RigidBodyState &initial, double t_s) {
     RigidBodyState s = initial;
     s.position_m = initial.position_m + initial.velocity_m_s * t_s;
     s.orientation = rotationFromVector(initial.angular_velocity_rad_s * t_s) * initial.orientation;

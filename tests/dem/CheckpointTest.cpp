@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratch(const std::string& name) {
+fs::path scratch(const std::string &name) {
     const fs::path dir = fs::temp_directory_path() / ("grainlink-test-" + name);
     fs::remove_all(dir);
     fs::create_directories(dir);
@@ -33,10 +33,13 @@ std::unique_ptr<DemSystem> busySystem(int threads) {
     settings.resort_every_builds = 3; // re-sorts happen between checkpoint and end
     ContactLaw law = hertzViscous(0.02, 400.0, 32.0, 28.0);
     law.rolling = RollingEpsd{0.2};
-    auto sys = std::make_unique<DemSystem>(law, std::vector<Material>{soil(3e6, 0.2, 2400)}, settings);
-    const char* names[5] = {"floor", "x0", "x1", "y0", "y1"};
-    const Vec3 normals[5] = {Vec3::UnitZ(), Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(), -Vec3::UnitY()};
-    const Vec3 points[5] = {Vec3::Zero(), Vec3::Zero(), Vec3(0.1, 0, 0), Vec3::Zero(), Vec3(0, 0.06, 0)};
+    auto sys =
+        std::make_unique<DemSystem>(law, std::vector<Material>{soil(3e6, 0.2, 2400)}, settings);
+    const char *names[5] = {"floor", "x0", "x1", "y0", "y1"};
+    const Vec3 normals[5] = {Vec3::UnitZ(), Vec3::UnitX(), -Vec3::UnitX(), Vec3::UnitY(),
+                             -Vec3::UnitY()};
+    const Vec3 points[5] = {Vec3::Zero(), Vec3::Zero(), Vec3(0.1, 0, 0), Vec3::Zero(),
+                            Vec3(0, 0.06, 0)};
     for (int k = 0; k < 5; ++k) {
         PlaneWall w;
         w.name = names[k];
@@ -64,11 +67,12 @@ std::unique_ptr<DemSystem> busySystem(int threads) {
     return sys;
 }
 
-bool sameState(const ParticleStore& a, const ParticleStore& b) {
-    if (a.size() != b.size()) return false;
+bool sameState(const ParticleStore &a, const ParticleStore &b) {
+    if (a.size() != b.size())
+        return false;
     for (std::size_t i = 0; i < a.size(); ++i)
-        if (a.id[i] != b.id[i] || a.position[i] != b.position[i] || a.velocity[i] != b.velocity[i] ||
-            a.angular_velocity[i] != b.angular_velocity[i])
+        if (a.id[i] != b.id[i] || a.position[i] != b.position[i] ||
+            a.velocity[i] != b.velocity[i] || a.angular_velocity[i] != b.angular_velocity[i])
             return false;
     return true;
 }
@@ -108,14 +112,16 @@ TEST_CASE("damaged checkpoints are refused with the file named", "[dem][checkpoi
     const auto size = fs::file_size(file);
     fs::resize_file(file, size - 20);
     auto target = busySystem(1);
-    CHECK_THROWS_WITH(readCheckpoint(*target, file), Catch::Contains(file) && Catch::Contains("truncated"));
+    CHECK_THROWS_WITH(readCheckpoint(*target, file),
+                      Catch::Contains(file) && Catch::Contains("truncated"));
     std::ofstream(file) << "not a checkpoint";
-    CHECK_THROWS_WITH(readCheckpoint(*target, file), Catch::Contains("is not a grainlink DEM checkpoint"));
+    CHECK_THROWS_WITH(readCheckpoint(*target, file),
+                      Catch::Contains("is not a grainlink DEM checkpoint"));
 }
 
 namespace {
 
-DemScenario smallScenario(const fs::path& dir, double duration_s) {
+DemScenario smallScenario(const fs::path &dir, double duration_s) {
     std::ostringstream text;
     text << R"(name: small
 simulation: {time_step_s: 1.0e-4, threads: 1}
@@ -140,15 +146,17 @@ bodies:
       - {duration_s: 0.1, velocity_m_s: [0, 0, -0.05]}
       - {duration_s: 1.0, velocity_m_s: [0.1, 0, 0], angular_velocity_rad_s: [0, 2.5, 0]}
 output: {series_interval_s: 0.01, checkpoint_interval_s: 0.05, snapshot_interval_s: 0.1}
-)" << "packing_cache_directory: " << (dir / "cache").string() << "\n"
+)"
+         << "packing_cache_directory: " << (dir / "cache").string() << "\n"
          << "run: {duration_s: " << duration_s << "}\n";
     return parseScenario(ConfigNode::loadString(text.str(), "small.yaml"));
 }
 
-std::vector<std::string> lines(const fs::path& file) {
+std::vector<std::string> lines(const fs::path &file) {
     std::ifstream in(file);
     std::vector<std::string> out;
-    for (std::string line; std::getline(in, line);) out.push_back(line);
+    for (std::string line; std::getline(in, line);)
+        out.push_back(line);
     return out;
 }
 
@@ -187,7 +195,7 @@ TEST_CASE("a failing run reports step, particle and quantity and keeps its resul
     try {
         runScenario(s, options);
         FAIL("expected the run to stop");
-    } catch (const std::runtime_error& e) {
+    } catch (const std::runtime_error &e) {
         const std::string msg = e.what();
         CHECK(msg.find("step ") == 0);
         CHECK(msg.find("particle ") != std::string::npos);
@@ -196,6 +204,7 @@ TEST_CASE("a failing run reports step, particle and quantity and keeps its resul
     }
     const auto rows = lines(dir / "run" / "series.csv");
     CHECK(rows.size() > 2);
-    for (const std::string& row : rows) CHECK(row.find("nan") == std::string::npos);
+    for (const std::string &row : rows)
+        CHECK(row.find("nan") == std::string::npos);
     CHECK(fs::exists(dir / "run" / "failure_particles.vtu"));
 }

@@ -15,7 +15,8 @@ struct ImpactResult {
 };
 
 /// Runs a head-on collision of two equal spheres approaching at `speed` and times the contact.
-ImpactResult collide(const ContactLaw& law, const Material& mat, double r, double speed, double dt) {
+ImpactResult collide(const ContactLaw &law, const Material &mat, double r, double speed,
+                     double dt) {
     DemSystem sys(law, {mat}, quietSettings(dt));
     const double gap = 0.1 * r;
     sys.particles().add(sphere({-r - gap, 0, 0}, r, mat.density_kg_m3, {0.5 * speed, 0, 0}));
@@ -24,7 +25,7 @@ ImpactResult collide(const ContactLaw& law, const Material& mat, double r, doubl
     double start = 0.0, end = 0.0, max_overlap = 0.0;
     for (int k = 0; k < 10000000; ++k) {
         sys.step();
-        const auto& x = sys.particles().position;
+        const auto &x = sys.particles().position;
         const double overlap = 2.0 * r - (x[1] - x[0]).norm();
         max_overlap = std::max(max_overlap, overlap);
         if (!touching && overlap > 0.0) {
@@ -35,7 +36,7 @@ ImpactResult collide(const ContactLaw& law, const Material& mat, double r, doubl
             break;
         }
     }
-    const auto& v = sys.particles().velocity;
+    const auto &v = sys.particles().velocity;
     return {end - start, (v[1] - v[0]).x(), max_overlap};
 }
 

@@ -27,16 +27,16 @@ run: {duration_s: 0.1}
 )";
 
 /// The message of the ConfigError that parsing `text` throws.
-std::string errorOf(const std::string& text) {
+std::string errorOf(const std::string &text) {
     try {
         parseScenario(ConfigNode::loadString(text, "bad.yaml"));
-    } catch (const ConfigError& e) {
+    } catch (const ConfigError &e) {
         return e.what();
     }
     return "no error";
 }
 
-std::string replaced(std::string text, const std::string& from, const std::string& to) {
+std::string replaced(std::string text, const std::string &from, const std::string &to) {
     const auto at = text.find(from);
     REQUIRE(at != std::string::npos);
     return text.replace(at, from.size(), to);
@@ -57,7 +57,8 @@ TEST_CASE("a valid scenario parses into the documented settings", "[dem][scenari
 
 TEST_CASE("scenario errors name the file, the key and the line", "[dem][scenario]") {
     SECTION("unknown key") {
-        const std::string msg = errorOf(replaced(kValid, "gravity: mars", "gravity: mars\n  gravty: 3"));
+        const std::string msg =
+            errorOf(replaced(kValid, "gravity: mars", "gravity: mars\n  gravty: 3"));
         CHECK(msg == "bad.yaml:5: unknown key 'simulation.gravty'");
     }
     SECTION("wrong unit is recognised as such") {
@@ -76,16 +77,19 @@ TEST_CASE("scenario errors name the file, the key and the line", "[dem][scenario
     }
     SECTION("unknown model") {
         const std::string msg = errorOf(replaced(kValid, "model: restitution", "model: hooke"));
-        CHECK(msg.find("key 'contact.damping.model': 'hooke' is not one of: restitution, viscous") !=
-              std::string::npos);
+        CHECK(
+            msg.find("key 'contact.damping.model': 'hooke' is not one of: restitution, viscous") !=
+            std::string::npos);
     }
     SECTION("non-physical parameter") {
-        const std::string msg = errorOf(replaced(kValid, "slip_angle_deg: 30", "slip_angle_deg: 40"));
+        const std::string msg =
+            errorOf(replaced(kValid, "slip_angle_deg: 30", "slip_angle_deg: 40"));
         CHECK(msg.find("bad.yaml:8:") == 0);
         CHECK(msg.find("slip_angle_deg") != std::string::npos);
     }
     SECTION("YAML syntax error") {
-        const std::string msg = errorOf(replaced(kValid, "run: {duration_s: 0.1}", "run: {duration_s: 0.1"));
+        const std::string msg =
+            errorOf(replaced(kValid, "run: {duration_s: 0.1}", "run: {duration_s: 0.1"));
         CHECK(msg.find("bad.yaml:") == 0);
         CHECK(msg.find("YAML syntax error") != std::string::npos);
     }
@@ -104,7 +108,7 @@ TEST_CASE("a time step above the stability estimate is refused with both numbers
     try {
         system->step();
         FAIL("expected an error");
-    } catch (const std::invalid_argument& e) {
+    } catch (const std::invalid_argument &e) {
         const std::string msg = e.what();
         CHECK(msg.find("time_step_s = 0.01 s is above the stability estimate") == 0);
     }

@@ -13,12 +13,12 @@ namespace grainlink::dem {
 using CheckpointExtras = std::map<std::string, double>;
 
 /// Writes atomically (temporary file, then rename): a crash never leaves a half-written file.
-void writeCheckpoint(const DemSystem& system, const std::string& path,
-                     const CheckpointExtras& extras = {});
+void writeCheckpoint(const DemSystem &system, const std::string &path,
+                     const CheckpointExtras &extras = {});
 /// Restores into a system built from the same scenario (same materials, planes and bodies).
 /// Throws naming the file when it is missing, truncated or from another format version.
-CheckpointExtras readCheckpoint(DemSystem& system, const std::string& path);
+CheckpointExtras readCheckpoint(DemSystem &system, const std::string &path);
 /// Only the driver's extras of a checkpoint (to rebuild the bodies before restoring).
-CheckpointExtras readCheckpointExtras(const std::string& path);
+CheckpointExtras readCheckpointExtras(const std::string &path);
 
 } // namespace grainlink::dem

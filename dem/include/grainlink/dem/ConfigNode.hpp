@@ -22,20 +22,20 @@ public:
 class ConfigNode {
 public:
     /// Loads a file; a YAML syntax error is reported with its line.
-    static ConfigNode loadFile(const std::string& path);
-    static ConfigNode loadString(const std::string& text, const std::string& name);
+    static ConfigNode loadFile(const std::string &path);
+    static ConfigNode loadString(const std::string &text, const std::string &name);
 
-    const std::string& path() const { return path_; }
-    const std::string& file() const { return *file_; }
+    const std::string &path() const { return path_; }
+    const std::string &file() const { return *file_; }
     int line() const { return node_.Mark().line + 1; }
     bool isMap() const { return node_.IsMap(); }
     bool isSequence() const { return node_.IsSequence(); }
     bool isScalar() const { return node_.IsScalar(); }
 
-    bool has(const std::string& key) const;
-    ConfigNode operator[](const std::string& key) const;               ///< required
-    std::optional<ConfigNode> optional(const std::string& key) const;  ///< may be absent
-    std::vector<ConfigNode> items() const;                             ///< a sequence
+    bool has(const std::string &key) const;
+    ConfigNode operator[](const std::string &key) const;              ///< required
+    std::optional<ConfigNode> optional(const std::string &key) const; ///< may be absent
+    std::vector<ConfigNode> items() const;                            ///< a sequence
 
     double number() const;
     double positive() const;
@@ -43,17 +43,17 @@ public:
     bool boolean() const;
     std::string text() const;
     /// One of `choices`; otherwise an error listing them.
-    std::string choice(const std::vector<std::string>& choices) const;
+    std::string choice(const std::vector<std::string> &choices) const;
     Vec3 vec3() const;
     std::vector<double> numbers() const;
 
-    double number(const std::string& key, double fallback) const;
-    std::string text(const std::string& key, const std::string& fallback) const;
-    bool boolean(const std::string& key, bool fallback) const;
+    double number(const std::string &key, double fallback) const;
+    std::string text(const std::string &key, const std::string &fallback) const;
+    bool boolean(const std::string &key, bool fallback) const;
 
     /// Throws on the first key of this mapping that was never read, suggesting a near match.
     void finish() const;
-    [[noreturn]] void fail(const std::string& message) const;
+    [[noreturn]] void fail(const std::string &message) const;
 
 private:
     ConfigNode(YAML::Node node, std::shared_ptr<const std::string> file, std::string path);

@@ -21,10 +21,10 @@ struct Material {
 
 /// Quantities of one material pair, computed once at setup.
 struct PairProperties {
-    double effective_modulus_Pa = 0.0; ///< E* : 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2
+    double effective_modulus_Pa = 0.0;       ///< E* : 1/E* = (1-nu1^2)/E1 + (1-nu2^2)/E2
     double effective_shear_modulus_Pa = 0.0; ///< G* : 1/G* = 2(2-nu1)(1+nu1)/E1 + ...
-    double tan_stick = 0.0; ///< tan(phi_h), Coulomb limit while sticking
-    double tan_slip = 0.0;  ///< tan(phi_g), friction while sliding
+    double tan_stick = 0.0;                  ///< tan(phi_h), Coulomb limit while sticking
+    double tan_slip = 0.0;                   ///< tan(phi_g), friction while sliding
     double root_shear_ratio = 0.0; ///< sqrt(4 G*/E*): Mindlin's k_t over Hertz's S_n, rooted
 };
 
@@ -54,10 +54,10 @@ using DampingModel = std::variant<DampingViscous, DampingRestitution>;
 /// Seed eq. 5: linear spring c_T on the accumulated tangential displacement with dashpot k_T;
 /// sticks while |F_T| <= F_N tan(phi_h), slides at F_N tan(phi_g) once exceeded. §2.4.
 struct TangentialLinear {
-    double stiffness_N_m = 0.0;     ///< c_T [N/m]
-    double damping_N_s_m = 0.0;     ///< k_T [N s/m]
-    double stick_angle_deg = 30.0;  ///< phi_h
-    double slip_angle_deg = 30.0;   ///< phi_g
+    double stiffness_N_m = 0.0;    ///< c_T [N/m]
+    double damping_N_s_m = 0.0;    ///< k_T [N s/m]
+    double stick_angle_deg = 30.0; ///< phi_h
+    double slip_angle_deg = 30.0;  ///< phi_g
     void validate() const;
 };
 /// Mindlin no-slip tangential spring k_t = 8 G* sqrt(R* delta) with restitution damping and a
@@ -108,16 +108,16 @@ struct ContactLaw {
 };
 
 /// Pair quantities of two materials with Coulomb angles from the tangential slot.
-PairProperties pairProperties(const Material& a, const Material& b, const ContactLaw& law);
+PairProperties pairProperties(const Material &a, const Material &b, const ContactLaw &law);
 /// Same, with a wall's own friction coefficient replacing both Coulomb angles.
-PairProperties pairProperties(const Material& a, const Material& b, const ContactLaw& law,
+PairProperties pairProperties(const Material &a, const Material &b, const ContactLaw &law,
                               double wall_friction_coefficient);
 
 /// Per-contact memory that survives neighbour-list rebuilds and re-sorts.
 struct ContactHistory {
-    Vec3 tangential_m = Vec3::Zero();  ///< accumulated tangential displacement of i rel. to j
-    Vec3 rolling_N_m = Vec3::Zero();   ///< elastic rolling moment on i
-    bool sliding = false;              ///< two-angle Coulomb state (seed eq. 5)
+    Vec3 tangential_m = Vec3::Zero(); ///< accumulated tangential displacement of i rel. to j
+    Vec3 rolling_N_m = Vec3::Zero();  ///< elastic rolling moment on i
+    bool sliding = false;             ///< two-angle Coulomb state (seed eq. 5)
     bool active() const { return sliding || !tangential_m.isZero() || !rolling_N_m.isZero(); }
     /// The same contact seen from the other particle.
     ContactHistory reversed() const { return {-tangential_m, -rolling_N_m, sliding}; }

@@ -12,9 +12,9 @@ namespace grainlink::dem {
 /// Grain radius distribution.
 struct RadiusDistribution {
     enum class Kind { Constant, Uniform, Discrete } kind = Kind::Constant;
-    double min_m = 0.0, max_m = 0.0;  ///< Constant uses min_m; Uniform draws in [min, max]
-    std::vector<double> radii_m;      ///< Discrete: radii ...
-    std::vector<double> fractions;    ///< ... and their number fractions (normalised)
+    double min_m = 0.0, max_m = 0.0; ///< Constant uses min_m; Uniform draws in [min, max]
+    std::vector<double> radii_m;     ///< Discrete: radii ...
+    std::vector<double> fractions;   ///< ... and their number fractions (normalised)
     double largest() const;
     void validate() const;
 };
@@ -57,14 +57,14 @@ struct DepositionReport {
 
 /// Inserts up to `count` non-overlapping spheres in the region (also avoiding existing
 /// particles); returns how many fitted. Throws if fewer than 99 % fit (region too small).
-std::size_t insertRandom(DemSystem& system, const DepositionSpec& spec, Random& random,
-                         std::size_t count, const Vec3& lower_m, const Vec3& upper_m);
+std::size_t insertRandom(DemSystem &system, const DepositionSpec &spec, Random &random,
+                         std::size_t count, const Vec3 &lower_m, const Vec3 &upper_m);
 
 /// Inserts and settles; `progress` is called every few hundred steps with the report so far.
-DepositionReport deposit(DemSystem& system, const DepositionSpec& spec,
-                         const std::function<void(const DepositionReport&)>& progress = {});
+DepositionReport deposit(DemSystem &system, const DepositionSpec &spec,
+                         const std::function<void(const DepositionReport &)> &progress = {});
 
 /// 64-bit FNV-1a of a text, as 16 hex digits (keys of the packing cache).
-std::string hashKey(const std::string& text);
+std::string hashKey(const std::string &text);
 
 } // namespace grainlink::dem

@@ -26,11 +26,11 @@ public:
     bool empty() const { return id.empty(); }
 
     /// Appends a particle; returns its stable id. Throws on non-physical radius or density.
-    ParticleId add(const ParticleSpec& spec);
+    ParticleId add(const ParticleSpec &spec);
     void reserve(std::size_t n);
 
     /// Reorders every array so that new index k holds old index `order[k]`.
-    void permute(const std::vector<std::size_t>& order);
+    void permute(const std::vector<std::size_t> &order);
 
     /// True when all three principal moments of particle i are equal (no frame transforms needed).
     bool isotropic(std::size_t i) const {

@@ -9,7 +9,7 @@ namespace grainlink::dem {
 class PhaseTimer {
 public:
     /// Index of a phase, created on first use; phases keep their first-use order.
-    int phase(const std::string& name);
+    int phase(const std::string &name);
     void add(int phase, double seconds) { seconds_[phase] += seconds; }
     double total() const;
     std::string table() const;
@@ -18,17 +18,18 @@ public:
     /// Adds the lifetime of this object to one phase.
     class Scope {
     public:
-        Scope(PhaseTimer& timer, int phase)
+        Scope(PhaseTimer &timer, int phase)
             : timer_(timer), phase_(phase), start_(std::chrono::steady_clock::now()) {}
         ~Scope() {
-            timer_.add(phase_, std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                                             start_).count());
+            timer_.add(
+                phase_,
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count());
         }
-        Scope(const Scope&) = delete;
-        Scope& operator=(const Scope&) = delete;
+        Scope(const Scope &) = delete;
+        Scope &operator=(const Scope &) = delete;
 
     private:
-        PhaseTimer& timer_;
+        PhaseTimer &timer_;
         int phase_;
         std::chrono::steady_clock::time_point start_;
     };

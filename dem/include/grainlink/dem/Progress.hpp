@@ -10,17 +10,17 @@ namespace grainlink::dem {
 class Progress {
 public:
     /// `label` prefixes each line; lines go to `stream` at most every `interval_s` of wall time.
-    explicit Progress(std::string label, double interval_s = 5.0, std::FILE* stream = stderr);
+    explicit Progress(std::string label, double interval_s = 5.0, std::FILE *stream = stderr);
     /// Reports if due. `fraction` of the phase done, `particle_steps` since construction.
     void update(double sim_time_s, double fraction, std::uint64_t particle_steps,
-                const std::string& extra = "");
+                const std::string &extra = "");
     double wallSeconds() const;
     double rate(std::uint64_t particle_steps) const; ///< particle-steps per wall second
 
 private:
     std::string label_;
     double interval_s_;
-    std::FILE* stream_;
+    std::FILE *stream_;
     std::chrono::steady_clock::time_point start_, last_;
 };
 

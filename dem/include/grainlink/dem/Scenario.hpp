@@ -1,8 +1,8 @@
 #pragma once
 // A DEM-only run described by one YAML file (every key in docs/scenario.md).
 #include "grainlink/dem/ConfigNode.hpp"
-#include "grainlink/dem/Deposition.hpp"
 #include "grainlink/dem/DemSystem.hpp"
+#include "grainlink/dem/Deposition.hpp"
 
 #include <memory>
 #include <optional>
@@ -20,8 +20,8 @@ struct MotionSegment {
 
 /// Pose at time t (from the start of the run phase) of piecewise-constant velocity motion;
 /// the body rests after the last segment.
-RigidBodyState segmentedMotion(const RigidBodyState& start, const std::vector<MotionSegment>& motion,
-                               double t_s);
+RigidBodyState segmentedMotion(const RigidBodyState &start,
+                               const std::vector<MotionSegment> &motion, double t_s);
 
 struct BodySpec {
     std::string name;
@@ -55,12 +55,12 @@ struct DemScenario {
 };
 
 /// Reads and validates a scenario; errors name the file, key and line.
-DemScenario loadScenario(const std::string& path);
-DemScenario parseScenario(const ConfigNode& root);
+DemScenario loadScenario(const std::string &path);
+DemScenario parseScenario(const ConfigNode &root);
 
 /// The system without mesh bodies (deposition runs without them).
-std::unique_ptr<DemSystem> makeSystem(const DemScenario& scenario);
+std::unique_ptr<DemSystem> makeSystem(const DemScenario &scenario);
 /// Key of the settled packing: everything that shapes it, nothing that does not.
-std::string packingKey(const DemScenario& scenario);
+std::string packingKey(const DemScenario &scenario);
 
 } // namespace grainlink::dem

@@ -9,7 +9,7 @@ namespace grainlink::dem {
 
 struct RunOptions {
     std::string output_directory;
-    bool resume = false;          ///< continue from output_directory/checkpoint.bin
+    bool resume = false; ///< continue from output_directory/checkpoint.bin
     double progress_interval_s = 5.0;
 };
 
@@ -23,6 +23,6 @@ struct RunSummary {
 };
 
 /// Runs to the end; throws (after saving what is readable) on bad input or a failed step.
-RunSummary runScenario(const DemScenario& scenario, const RunOptions& options);
+RunSummary runScenario(const DemScenario &scenario, const RunOptions &options);
 
 } // namespace grainlink::dem

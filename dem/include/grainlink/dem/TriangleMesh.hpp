@@ -9,25 +9,25 @@
 namespace grainlink::dem {
 
 struct TriangleMesh {
-    std::vector<Vec3> vertices_m;                 ///< body frame [m]
-    std::vector<std::array<int, 3>> triangles;    ///< counter-clockwise seen from outside
+    std::vector<Vec3> vertices_m;              ///< body frame [m]
+    std::vector<std::array<int, 3>> triangles; ///< counter-clockwise seen from outside
 
     std::size_t triangleCount() const { return triangles.size(); }
     /// Largest distance of any vertex from the body-frame origin [m].
     double boundingRadius() const;
     /// Applies a uniform scale and then a translation to every vertex.
-    void transform(double scale, const Vec3& offset_m);
+    void transform(double scale, const Vec3 &offset_m);
     /// Throws if an index is out of range, a triangle is degenerate or a vertex is non-finite.
-    void validate(const std::string& what) const;
+    void validate(const std::string &what) const;
 };
 
 /// Reads ASCII or binary STL (detected from the file); vertices are shared where identical.
-TriangleMesh readStl(const std::string& path);
-void writeStlAscii(const TriangleMesh& mesh, const std::string& path, const std::string& name);
-void writeStlBinary(const TriangleMesh& mesh, const std::string& path);
+TriangleMesh readStl(const std::string &path);
+void writeStlAscii(const TriangleMesh &mesh, const std::string &path, const std::string &name);
+void writeStlBinary(const TriangleMesh &mesh, const std::string &path);
 
 /// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5).
-Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+Vec3 closestPointOnTriangle(const Vec3 &p, const Vec3 &a, const Vec3 &b, const Vec3 &c);
 
 /// Closed cylinder about the body y axis (a wheel without grousers): `segments` facets around.
 TriangleMesh makeCylinder(double radius_m, double width_m, int segments);

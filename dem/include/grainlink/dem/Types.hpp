@@ -15,9 +15,10 @@ using Mat3 = Eigen::Matrix3d;
 using ParticleId = std::uint64_t;
 
 /// Rotation by the rotation vector `rotation_rad` (axis times angle), exact for any angle.
-inline Quat rotationFromVector(const Vec3& rotation_rad) {
+inline Quat rotationFromVector(const Vec3 &rotation_rad) {
     const double angle = rotation_rad.norm();
-    if (angle < 1e-300) return Quat::Identity();
+    if (angle < 1e-300)
+        return Quat::Identity();
     return Quat(Eigen::AngleAxisd(angle, rotation_rad / angle));
 }
 

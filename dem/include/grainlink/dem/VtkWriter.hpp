@@ -12,16 +12,16 @@ public:
     /// Snapshots go to `directory`/particles_NNNNNN.vtu (and body_<name>_NNNNNN.vtu).
     explicit VtkWriter(std::string directory);
     /// Writes one snapshot; the .pvd collections are rewritten so they are valid after each call.
-    void write(const DemSystem& system, double time_s);
+    void write(const DemSystem &system, double time_s);
     /// Writes particles only, to an explicit path (failure snapshots).
-    static void writeParticles(const ParticleStore& particles, const std::string& path);
+    static void writeParticles(const ParticleStore &particles, const std::string &path);
     /// Restarts numbering after a resume so earlier snapshots stay in the collection.
-    void resumeAt(int index, const std::vector<double>& times_s);
+    void resumeAt(int index, const std::vector<double> &times_s);
     int count() const { return int(times_.size()); }
-    const std::vector<double>& times() const { return times_; }
+    const std::vector<double> &times() const { return times_; }
 
 private:
-    void writeCollection(const std::string& name, const std::string& prefix) const;
+    void writeCollection(const std::string &name, const std::string &prefix) const;
     std::string directory_;
     std::vector<double> times_;
     std::vector<std::string> body_names_;

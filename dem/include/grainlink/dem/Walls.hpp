@@ -12,10 +12,10 @@ namespace grainlink::dem {
 
 /// Rectangle on a plane where another friction applies (the seed's friction track in its bin).
 struct FrictionTrack {
-    Vec3 lower_m;  ///< axis-aligned box containing the track's contact points
+    Vec3 lower_m; ///< axis-aligned box containing the track's contact points
     Vec3 upper_m;
     double friction_coefficient = 0.0;
-    bool contains(const Vec3& p) const {
+    bool contains(const Vec3 &p) const {
         return (p.array() >= lower_m.array()).all() && (p.array() <= upper_m.array()).all();
     }
 };
@@ -38,7 +38,7 @@ struct RigidBodyState {
     Vec3 velocity_m_s = Vec3::Zero();
     Vec3 angular_velocity_rad_s = Vec3::Zero();
     /// Velocity of the body-fixed point now at world position p.
-    Vec3 pointVelocity(const Vec3& p) const {
+    Vec3 pointVelocity(const Vec3 &p) const {
         return velocity_m_s + angular_velocity_rad_s.cross(p - position_m);
     }
 };
@@ -49,11 +49,11 @@ class MeshBody {
 public:
     MeshBody(std::string name, TriangleMesh mesh_body_frame, RigidBodyState initial);
 
-    const std::string& name() const { return name_; }
-    const TriangleMesh& mesh() const { return mesh_; }
-    const RigidBodyState& state() const { return state_; }
+    const std::string &name() const { return name_; }
+    const TriangleMesh &mesh() const { return mesh_; }
+    const RigidBodyState &state() const { return state_; }
     /// Imposes pose and velocity (prescribed motion now, the coupling later).
-    void setState(const RigidBodyState& state);
+    void setState(const RigidBodyState &state);
 
     std::optional<double> friction_coefficient; ///< unset: particle law's Coulomb angles
     Material material;                          ///< defaults to the particles' material
@@ -61,8 +61,8 @@ public:
 
     // Filled by the DEM step: reaction of the particles on the body during the last step.
     Vec3 force_N = Vec3::Zero();
-    Vec3 torque_N_m = Vec3::Zero();          ///< about the body origin
-    std::vector<Vec3> triangle_force_N;      ///< per triangle, when recorded
+    Vec3 torque_N_m = Vec3::Zero();     ///< about the body origin
+    std::vector<Vec3> triangle_force_N; ///< per triangle, when recorded
     // Impulse summed since the last resetAccumulatedImpulse() (window averages for coupling).
     Vec3 impulse_N_s = Vec3::Zero();
     Vec3 angular_impulse_N_m_s = Vec3::Zero();
@@ -70,7 +70,7 @@ public:
     void resetAccumulatedImpulse();
 
     /// World-frame vertices at the current pose.
-    const std::vector<Vec3>& worldVertices() const { return world_vertices_; }
+    const std::vector<Vec3> &worldVertices() const { return world_vertices_; }
     double boundingRadius() const { return bounding_radius_; }
 
 private:
@@ -82,6 +82,6 @@ private:
 };
 
 /// Body state at time t for constant linear and angular velocity from an initial pose.
-RigidBodyState constantVelocityMotion(const RigidBodyState& initial, double t_s);
+RigidBodyState constantVelocityMotion(const RigidBodyState &initial, double t_s);
 
 } // namespace grainlink::dem
