@@ -137,22 +137,27 @@ std::size_t insertRandom(DemSystem &system, const DepositionSpec &spec, Random &
         grid.add(p.position[i], p.radius[i]);
     const double density = system.materials().at(std::size_t(spec.material)).density_kg_m3;
     std::size_t placed = 0;
-    const std::size_t max_attempts = 200 * count + 1000;
-    for (std::size_t attempt = 0; attempt < max_attempts && placed < count; ++attempt) {
+    // Each grain keeps its drawn radius until it finds room: redrawing after a rejection would
+    // favour small grains and distort the size distribution in a crowded region.
+    constexpr int kTriesPerGrain = 200;
+    for (std::size_t k = 0; k < count; ++k) {
         const double r = drawRadius(spec.radius, random);
-        Vec3 x;
-        for (int d = 0; d < 3; ++d)
-            x[d] = random.uniform(lower_m[d] + r, upper_m[d] - r);
-        if (!grid.free(x, r, r + r_max))
-            continue;
-        ParticleSpec s;
-        s.position_m = x;
-        s.radius_m = r;
-        s.density_kg_m3 = density;
-        s.material = spec.material;
-        system.particles().add(s);
-        grid.add(x, r);
-        ++placed;
+        for (int attempt = 0; attempt < kTriesPerGrain; ++attempt) {
+            Vec3 x;
+            for (int d = 0; d < 3; ++d)
+                x[d] = random.uniform(lower_m[d] + r, upper_m[d] - r);
+            if (!grid.free(x, r, r + r_max))
+                continue;
+            ParticleSpec s;
+            s.position_m = x;
+            s.radius_m = r;
+            s.density_kg_m3 = density;
+            s.material = spec.material;
+            system.particles().add(s);
+            grid.add(x, r);
+            ++placed;
+            break;
+        }
     }
     return placed;
 }

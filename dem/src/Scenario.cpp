@@ -331,7 +331,7 @@ std::unique_ptr<DemSystem> makeSystem(const DemScenario &s) {
 std::string packingKey(const DemScenario &s) {
     std::ostringstream key;
     key.precision(17);
-    key << "v1|" << s.law.describe() << "|E=" << s.material.youngs_modulus_Pa
+    key << "v2|" << s.law.describe() << "|E=" << s.material.youngs_modulus_Pa
         << " nu=" << s.material.poisson_ratio << " rho=" << s.material.density_kg_m3
         << "|dt=" << s.settings.time_step_s << " int=" << int(s.settings.integrator) << ','
         << s.settings.newmark_beta << ',' << s.settings.newmark_gamma

@@ -87,8 +87,8 @@ public:
     /// Changes the time step between steps (the clock stays exact in steps of the old size).
     void setTimeStep(double dt_s);
 
-    /// Largest stable step estimate: Rayleigh time of the smallest grain, and the viscous
-    /// dashpot limit 2 m*/k_n where one is set (docs/physics.md §3.3).
+    /// Largest safe step estimate: half the Rayleigh time of the smallest grain, the viscous
+    /// dashpot limit m_min/k_n where one is set, 2/k_h (docs/physics.md §3.3).
     double stableTimeStepEstimate() const;
     Energies energies() const;
     std::size_t contactCount() const;      ///< particle-particle contacts
@@ -163,6 +163,8 @@ private:
     std::vector<ContactHistory> plane_history_;  ///< [particle * planes + plane]
     std::vector<MeshContactSlot> mesh_slots_;     ///< [particle * kMeshSlots + slot]
     bool candidates_stale_ = true;
+    std::size_t prepared_particles_ = 0; ///< particle count the lists were built for
+    std::size_t history_planes_ = 0;     ///< plane count plane_history_ is laid out for
 
     /// Reaction on a particle owned by a later thread, added after the pair loop.
     struct SideContribution {

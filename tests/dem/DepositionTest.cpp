@@ -1,0 +1,115 @@
+// Particle generation and settling (docs/physics.md §6).
+#include "Fixtures.hpp"
+
+#include "grainlink/dem/Deposition.hpp"
+
+#include <catch2/catch.hpp>
+
+using namespace grainlink::dem;
+using namespace grainlink::dem::testing;
+
+namespace {
+
+std::unique_ptr<DemSystem> boxSystem(const Vec3 &upper) {
+    DemSettings settings;
+    settings.time_step_s = 1e-4;
+    auto sys = std::make_unique<DemSystem>(hertzRestitution(0.3, 0.5),
+                                           std::vector<Material>{soil(3e6, 0.2, 2400)}, settings);
+    for (int k = 0; k < 5; ++k) { // open-top box
+        PlaneWall w;
+        w.name = "wall" + std::to_string(k);
+        w.normal = Vec3::Zero();
+        w.normal[k / 2] = (k % 2 == 0) ? 1.0 : -1.0;
+        w.point_m = (k % 2 == 0) ? Vec3::Zero() : upper;
+        sys->addPlane(w);
+    }
+    return sys;
+}
+
+double largestOverlap(const ParticleStore &p) {
+    double worst = 0.0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+        for (std::size_t j = i + 1; j < p.size(); ++j)
+            worst =
+                std::max(worst, p.radius[i] + p.radius[j] - (p.position[i] - p.position[j]).norm());
+    return worst;
+}
+
+} // namespace
+
+TEST_CASE("random insertion places non-overlapping grains of the requested sizes inside the "
+          "region, the same for the same seed",
+          "[dem][deposition]") {
+    DepositionSpec spec;
+    spec.region_lower_m = Vec3(0.01, 0.0, 0.02);
+    spec.region_upper_m = Vec3(0.06, 0.05, 0.07);
+    spec.count = 400;
+    spec.radius.kind = RadiusDistribution::Kind::Discrete;
+    spec.radius.radii_m = {0.002, 0.003};
+    spec.radius.fractions = {3.0, 1.0};
+    spec.seed = 11;
+    auto a = boxSystem(Vec3(0.07, 0.05, 0.2));
+    Random random(spec.seed);
+    REQUIRE(insertRandom(*a, spec, random, spec.count, spec.region_lower_m, spec.region_upper_m) ==
+            400);
+    const ParticleStore &p = a->particles();
+    std::size_t small = 0;
+    for (std::size_t i = 0; i < p.size(); ++i) {
+        const double r = p.radius[i];
+        CHECK((r == 0.002 || r == 0.003));
+        small += r == 0.002 ? 1 : 0;
+        CHECK((p.position[i].array() - r >= spec.region_lower_m.array()).all());
+        CHECK((p.position[i].array() + r <= spec.region_upper_m.array()).all());
+    }
+    // Number fraction 3:1 -> 300 small expected; binomial sd ~ 8.7, so +-4 sd.
+    CHECK(small == Approx(300).margin(35));
+    CHECK(largestOverlap(p) <= 0.0);
+
+    auto b = boxSystem(Vec3(0.07, 0.05, 0.2));
+    Random again(spec.seed);
+    insertRandom(*b, spec, again, spec.count, spec.region_lower_m, spec.region_upper_m);
+    CHECK(b->particles().position == p.position);
+}
+
+TEST_CASE("deposition by rain fills layer by layer and settles below the energy threshold",
+          "[dem][deposition]") {
+    DepositionSpec spec;
+    spec.method = DepositionSpec::Method::Rain;
+    spec.region_lower_m = Vec3(0.0, 0.0, 0.0);
+    spec.region_upper_m = Vec3(0.05, 0.05, 0.12);
+    spec.count = 300;
+    spec.radius.kind = RadiusDistribution::Kind::Uniform;
+    spec.radius.min_m = 0.0025;
+    spec.radius.max_m = 0.0035;
+    spec.layers = 3;
+    spec.layer_interval_s = 0.08;
+    spec.settle_kinetic_energy_J = 1e-8;
+    spec.max_settle_time_s = 2.0;
+    auto sys = boxSystem(Vec3(0.05, 0.05, 0.3));
+    std::vector<std::size_t> counts;
+    const DepositionReport report = deposit(*sys, spec, [&](const DepositionReport &r) {
+        if (counts.empty() || counts.back() != r.inserted)
+            counts.push_back(r.inserted);
+    });
+    CHECK(report.inserted == 300);
+    CHECK(counts == std::vector<std::size_t>{100, 200, 300});
+    CHECK(report.settled);
+    const Energies e = sys->energies();
+    CHECK((e.translational_J + e.rotational_J) / 300.0 < 1e-8);
+    // Settled means resting on the floor: every grain is below the slab it was rained from.
+    for (const Vec3 &x : sys->particles().position)
+        CHECK(x.z() < 0.08);
+}
+
+TEST_CASE("a region too small for the grains is an error that says what to change",
+          "[dem][deposition]") {
+    DepositionSpec spec;
+    spec.region_lower_m = Vec3::Zero();
+    spec.region_upper_m = Vec3(0.02, 0.02, 0.02);
+    spec.count = 500;
+    spec.radius.kind = RadiusDistribution::Kind::Constant;
+    spec.radius.min_m = spec.radius.max_m = 0.003;
+    auto sys = boxSystem(Vec3(0.02, 0.02, 0.2));
+    CHECK_THROWS_WITH(deposit(*sys, spec),
+                      Catch::Contains("particles fit into the insertion region"));
+}
