@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -166,6 +167,16 @@ int run(const fs::path& dir, const std::string& which, int threads, std::uint64_
                  double(sys->neighbourPairs()) / double(sys->particles().size()),
                  double(sys->contactCount()) / double(sys->particles().size()),
                  static_cast<unsigned long long>(sys->neighbourBuilds()));
+    // Digest of the final state: variants of the code that must not change the results are
+    // compared by it (FNV-1a over the bytes of positions, velocities and spins).
+    std::uint64_t digest = 1469598103934665603ull;
+    for (const auto* array : {&sys->particles().position, &sys->particles().velocity,
+                              &sys->particles().angular_velocity}) {
+        const auto* bytes = reinterpret_cast<const unsigned char*>(array->data());
+        for (std::size_t k = 0; k < array->size() * sizeof(Vec3); ++k)
+            digest = (digest ^ bytes[k]) * 1099511628211ull;
+    }
+    std::fprintf(stderr, "state digest %016llx\n", static_cast<unsigned long long>(digest));
     std::printf("GRAINLINK case=%s threads=%d particles=%zu steps=%llu seconds=%.4f "
                 "particle_steps_per_s=%.0f\n",
                 which.c_str(), threads, sys->particles().size(),
