@@ -7,6 +7,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -17,12 +19,20 @@ namespace fs = std::filesystem;
 
 namespace {
 
-fs::path scratch(const std::string &name) {
-    const fs::path dir = fs::temp_directory_path() / ("grainlink-test-" + name);
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir;
-}
+/// A fresh folder for one test, removed afterwards. Per process: two test runs at once (two
+/// build trees) must not share files.
+struct Scratch {
+    explicit Scratch(const std::string &name)
+        : dir(fs::temp_directory_path() /
+              ("grainlink-test-" + name + "-" + std::to_string(::getpid()))) {
+        fs::remove_all(dir);
+        fs::create_directories(dir);
+    }
+    ~Scratch() { fs::remove_all(dir); }
+    Scratch(const Scratch &) = delete;
+    Scratch &operator=(const Scratch &) = delete;
+    fs::path dir;
+};
 
 /// A falling, colliding bed in a box with a cylinder ploughing through it: every kind of
 /// history (pairs, planes, mesh) is active when the checkpoint is taken.
@@ -81,7 +91,8 @@ bool sameState(const ParticleStore &a, const ParticleStore &b) {
 
 TEST_CASE("a run restarted from a checkpoint continues bit-identically", "[dem][checkpoint]") {
     const int threads = GENERATE(1, 2);
-    const fs::path dir = scratch("checkpoint-" + std::to_string(threads));
+    const Scratch scratch("checkpoint-" + std::to_string(threads));
+    const fs::path &dir = scratch.dir;
     const std::string file = (dir / "state.bin").string();
 
     auto straight = busySystem(threads);
@@ -104,7 +115,8 @@ TEST_CASE("a run restarted from a checkpoint continues bit-identically", "[dem][
 }
 
 TEST_CASE("damaged checkpoints are refused with the file named", "[dem][checkpoint]") {
-    const fs::path dir = scratch("checkpoint-damaged");
+    const Scratch scratch("checkpoint-damaged");
+    const fs::path &dir = scratch.dir;
     const std::string file = (dir / "state.bin").string();
     auto sys = busySystem(1);
     sys->run(10);
@@ -164,7 +176,8 @@ std::vector<std::string> lines(const fs::path &file) {
 
 TEST_CASE("an interrupted scenario run resumes to the same series as an uninterrupted one",
           "[dem][checkpoint][scenario]") {
-    const fs::path dir = scratch("resume");
+    const Scratch scratch("resume");
+    const fs::path &dir = scratch.dir;
     RunOptions straight{(dir / "straight").string(), false, 1e9};
     const RunSummary first = runScenario(smallScenario(dir, 0.3), straight);
     CHECK_FALSE(first.packing_from_cache);
@@ -187,7 +200,8 @@ TEST_CASE("an interrupted scenario run resumes to the same series as an uninterr
 
 TEST_CASE("a failing run reports step, particle and quantity and keeps its results",
           "[dem][checkpoint][scenario]") {
-    const fs::path dir = scratch("failure");
+    const Scratch scratch("failure");
+    const fs::path &dir = scratch.dir;
     DemScenario s = smallScenario(dir, 0.3);
     // Drive the wheel straight down into the floor: overlaps run away.
     s.bodies[0].motion = {{1.0, Vec3(0, 0, -1.0), Vec3::Zero()}};
