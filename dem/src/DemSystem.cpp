@@ -214,17 +214,11 @@ void DemSystem::step() {
         forces_valid_ = true;
     }
     const double t_next = time() + settings_.time_step_s;
-    if (settings_.integrator == Integrator::VelocityVerlet) {
-        kickDriftClear();
-        moveBodies(t_next);
-        computeForces();
-        finishForces(0.5);
-    } else {
-        newmarkPredictClear();
-        moveBodies(t_next);
-        computeForces();
-        newmarkCorrect();
-    }
+    advanceAndClear();
+    moveBodies(t_next);
+    computeForces();
+    if (settings_.integrator == Integrator::VelocityVerlet) finishForces(0.5);
+    else newmarkCorrect();
     ++step_;
 }
 
@@ -232,19 +226,20 @@ void DemSystem::run(std::uint64_t steps) {
     for (std::uint64_t k = 0; k < steps; ++k) step();
 }
 
-void DemSystem::angularAcceleration(std::size_t i, Vec3& alpha) const {
+inline void DemSystem::angularAcceleration(std::size_t i, Vec3& alpha) const {
     const Vec3& inertia = particles_.inertia[i];
-    const Vec3& tau = particles_.torque[i];
-    if (particles_.isotropic(i)) {
-        alpha = tau / inertia.x();
-        return;
-    }
+    if (particles_.isotropic(i)) alpha = particles_.torque[i] / inertia.x();
+    else alpha = anisotropicAngularAcceleration(i);
+}
+
+Vec3 DemSystem::anisotropicAngularAcceleration(std::size_t i) const {
     // Euler's equations in the particle frame (per-axis inertia, seed eq. 2).
+    const Vec3& inertia = particles_.inertia[i];
     const Mat3 rot = particles_.orientation[i].toRotationMatrix();
     const Vec3 w = rot.transpose() * particles_.angular_velocity[i];
-    const Vec3 t = rot.transpose() * tau;
+    const Vec3 t = rot.transpose() * particles_.torque[i];
     const Vec3 body_alpha = (t - w.cross(inertia.cwiseProduct(w))).cwiseQuotient(inertia);
-    alpha = rot * body_alpha;
+    return rot * body_alpha;
 }
 
 namespace {
@@ -265,9 +260,14 @@ inline void rotate(Quat& q, const Vec3& turn) {
 }
 } // namespace
 
-void DemSystem::kickDriftClear() {
+void DemSystem::advanceAndClear() {
+    // Velocity Verlet: half kick, drift. Newmark: predictor. Both then clear the forces and
+    // measure the displacement that decides the next neighbour-list rebuild.
     PhaseTimer::Scope scope(timer_, phase_.kick_drift);
+    const bool newmark = settings_.integrator == Integrator::Newmark;
     const double dt = settings_.time_step_s, h = 0.5 * dt;
+    const double drift_a = dt * dt * (0.5 - settings_.newmark_beta);
+    const double kick_a = dt * (1.0 - settings_.newmark_gamma);
     auto& p = particles_;
     const std::size_t n = p.size();
     const bool track_mesh = !bodies_.empty() && !candidates_stale_;
@@ -275,42 +275,20 @@ void DemSystem::kickDriftClear() {
 #pragma omp parallel for schedule(static) num_threads(settings_.threads) \
     reduction(max : max_sq, max_mesh_sq)
     for (std::size_t i = 0; i < n; ++i) {
-        p.velocity[i] += (h * p.inv_mass[i]) * p.force[i];
         Vec3 alpha;
         angularAcceleration(i, alpha);
-        p.angular_velocity[i] += h * alpha;
-        p.position[i] += dt * p.velocity[i];
-        rotate(p.orientation[i], dt * p.angular_velocity[i]);
-        p.force[i].setZero();
-        p.torque[i].setZero();
-        max_sq = std::max(max_sq, (p.position[i] - reference_position_[i]).squaredNorm());
-        if (track_mesh)
-            max_mesh_sq =
-                std::max(max_mesh_sq, (p.position[i] - mesh_reference_position_[i]).squaredNorm());
-    }
-    max_displacement_sq_ = max_sq;
-    max_mesh_displacement_sq_ = max_mesh_sq;
-    displacement_known_ = true;
-}
-
-void DemSystem::newmarkPredictClear() {
-    PhaseTimer::Scope scope(timer_, phase_.kick_drift);
-    const double dt = settings_.time_step_s, beta = settings_.newmark_beta,
-                 gamma = settings_.newmark_gamma;
-    auto& p = particles_;
-    const std::size_t n = p.size();
-    const bool track_mesh = !bodies_.empty() && !candidates_stale_;
-    double max_sq = 0.0, max_mesh_sq = 0.0;
-#pragma omp parallel for schedule(static) num_threads(settings_.threads) \
-    reduction(max : max_sq, max_mesh_sq)
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec3 a = p.inv_mass[i] * p.force[i];
-        p.position[i] += dt * p.velocity[i] + (dt * dt * (0.5 - beta)) * a;
-        p.velocity[i] += (dt * (1.0 - gamma)) * a;
-        Vec3 alpha;
-        angularAcceleration(i, alpha);
-        rotate(p.orientation[i], dt * p.angular_velocity[i] + (dt * dt * (0.5 - beta)) * alpha);
-        p.angular_velocity[i] += (dt * (1.0 - gamma)) * alpha;
+        if (newmark) {
+            const Vec3 a = p.inv_mass[i] * p.force[i];
+            p.position[i] += dt * p.velocity[i] + drift_a * a;
+            p.velocity[i] += kick_a * a;
+            rotate(p.orientation[i], dt * p.angular_velocity[i] + drift_a * alpha);
+            p.angular_velocity[i] += kick_a * alpha;
+        } else {
+            p.velocity[i] += (h * p.inv_mass[i]) * p.force[i];
+            p.angular_velocity[i] += h * alpha;
+            p.position[i] += dt * p.velocity[i];
+            rotate(p.orientation[i], dt * p.angular_velocity[i]);
+        }
         p.force[i].setZero();
         p.torque[i].setZero();
         max_sq = std::max(max_sq, (p.position[i] - reference_position_[i]).squaredNorm());

@@ -116,8 +116,7 @@ private:
     void initialise();
     void prepareWalls();
     void validateTimeStep() const;
-    void kickDriftClear();
-    void newmarkPredictClear();
+    void advanceAndClear();
     void newmarkCorrect();
     void finishForces(double kick_fraction);
     void addBodyForces(std::size_t i);
@@ -134,6 +133,7 @@ private:
     void meshContacts();
     void checkOverlaps();
     void angularAcceleration(std::size_t i, Vec3& alpha) const;
+    Vec3 anisotropicAngularAcceleration(std::size_t i) const;
     void resizeWallHistories();
     void permuteWallHistories(const std::vector<std::size_t>& order);
 
