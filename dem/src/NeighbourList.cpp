@@ -8,12 +8,12 @@
 
 namespace grainlink::dem {
 
-void CellGrid::bin(const std::vector<Vec3>& positions, double min_cell_size_m) {
+void CellGrid::bin(const std::vector<Vec3> &positions, double min_cell_size_m) {
     const std::size_t n = positions.size();
     Vec3 lo = Vec3::Constant(0.0), hi = Vec3::Constant(0.0);
     if (n > 0) {
         lo = hi = positions[0];
-        for (const Vec3& p : positions) {
+        for (const Vec3 &p : positions) {
             lo = lo.cwiseMin(p);
             hi = hi.cwiseMax(p);
         }
@@ -24,7 +24,8 @@ void CellGrid::bin(const std::vector<Vec3>& positions, double min_cell_size_m) {
     for (;;) {
         const Vec3 extent = (hi - lo) / cell_size_;
         dims_ = Eigen::Vector3i(int(extent.x()) + 1, int(extent.y()) + 1, int(extent.z()) + 1);
-        if (double(dims_.x()) * dims_.y() * dims_.z() <= max_cells) break;
+        if (double(dims_.x()) * dims_.y() * dims_.z() <= max_cells)
+            break;
         cell_size_ *= 1.25;
     }
     origin_ = lo;
@@ -35,13 +36,15 @@ void CellGrid::bin(const std::vector<Vec3>& positions, double min_cell_size_m) {
         particle_cell_[i] = cellIndex(cellCoords(positions[i]));
         ++cell_start_[particle_cell_[i] + 1];
     }
-    for (int c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
+    for (int c = 0; c < cells; ++c)
+        cell_start_[c + 1] += cell_start_[c];
     cell_particles_.resize(n);
     std::vector<int> fill(cell_start_.begin(), cell_start_.end() - 1);
-    for (std::size_t i = 0; i < n; ++i) cell_particles_[fill[particle_cell_[i]]++] = int(i);
+    for (std::size_t i = 0; i < n; ++i)
+        cell_particles_[fill[particle_cell_[i]]++] = int(i);
 }
 
-Eigen::Vector3i CellGrid::cellCoords(const Vec3& p) const {
+Eigen::Vector3i CellGrid::cellCoords(const Vec3 &p) const {
     Eigen::Vector3i c;
     for (int d = 0; d < 3; ++d)
         c[d] = std::clamp(int(std::floor((p[d] - origin_[d]) / cell_size_)), 0, dims_[d] - 1);
@@ -52,69 +55,94 @@ std::vector<NeighbourList::StoredContact> NeighbourList::activeContacts() const 
     std::vector<StoredContact> out;
     for (std::size_t i = 0; i + 1 < first.size(); ++i)
         for (std::size_t k = first[i]; k < first[i + 1]; ++k)
-            if (touching[k]) out.push_back({i, std::size_t(neighbour[k]), history[k]});
+            if (touching[k])
+                out.push_back({i, std::size_t(neighbour[k]), history[k]});
     return out;
 }
 
-void NeighbourList::build(const std::vector<Vec3>& positions, const std::vector<double>& radii,
-                          double skin_m, const std::vector<std::size_t>& old_to_new, int threads) {
+void NeighbourList::build(const std::vector<Vec3> &positions, const std::vector<double> &radii,
+                          double skin_m, const std::vector<std::size_t> &old_to_new, int threads) {
     const std::size_t n = positions.size();
-    // 1. Collect surviving histories, re-indexed and oriented so that i < j.
-    std::vector<StoredContact> carried = activeContacts();
-    carried.insert(carried.end(), pending_.begin(), pending_.end());
-    pending_.clear();
-    for (StoredContact& c : carried) {
-        if (!old_to_new.empty()) {
-            c.i = old_to_new[c.i];
-            c.j = old_to_new[c.j];
-        }
-        if (c.i > c.j) {
-            std::swap(c.i, c.j);
-            c.history = c.history.reversed();
-        }
-    }
-    std::sort(carried.begin(), carried.end(), [](const StoredContact& a, const StoredContact& b) {
-        return a.i != b.i ? a.i < b.i : a.j < b.j;
-    });
+    // 1. Surviving histories. Without a re-sort the old list is still indexed like the new one
+    //    and sorted per particle, so it is merged entry by entry (step 3); otherwise the active
+    //    contacts are re-indexed, oriented so that i < j, and sorted.
+    const bool same_indexing = old_to_new.empty() && pending_.empty() && first.size() == n + 1;
+    std::vector<std::size_t> old_first;
+    std::vector<int> old_neighbour;
+    std::vector<ContactHistory> old_history;
+    std::vector<std::uint8_t> old_touching;
+    std::vector<StoredContact> carried;
     std::vector<std::size_t> carried_first(n + 1, 0);
-    for (const StoredContact& c : carried) ++carried_first[c.i + 1];
-    for (std::size_t i = 0; i < n; ++i) carried_first[i + 1] += carried_first[i];
+    if (same_indexing) {
+        old_first.swap(first);
+        old_neighbour.swap(neighbour);
+        old_history.swap(history);
+        old_touching.swap(touching);
+    } else {
+        carried = activeContacts();
+        carried.insert(carried.end(), pending_.begin(), pending_.end());
+        pending_.clear();
+        for (StoredContact &c : carried) {
+            if (!old_to_new.empty()) {
+                c.i = old_to_new[c.i];
+                c.j = old_to_new[c.j];
+            }
+            if (c.i > c.j) {
+                std::swap(c.i, c.j);
+                c.history = c.history.reversed();
+            }
+        }
+        std::sort(carried.begin(), carried.end(),
+                  [](const StoredContact &a, const StoredContact &b) {
+                      return a.i != b.i ? a.i < b.i : a.j < b.j;
+                  });
+        for (const StoredContact &c : carried)
+            ++carried_first[c.i + 1];
+        for (std::size_t i = 0; i < n; ++i)
+            carried_first[i + 1] += carried_first[i];
+    }
 
     // 2. Bin and search the 27 surrounding cells; each thread fills a contiguous range of i.
     double max_radius = 0.0;
-    for (double r : radii) max_radius = std::max(max_radius, r);
+    for (double r : radii)
+        max_radius = std::max(max_radius, r);
     grid_.bin(positions, 2.0 * max_radius + skin_m);
-    const auto& start = grid_.cellStart();
-    const auto& members = grid_.cellParticles();
-    const auto& dims = grid_.dims();
+    const auto &start = grid_.cellStart();
+    const auto &members = grid_.cellParticles();
+    const auto &dims = grid_.dims();
 
     threads = std::max(1, threads);
     std::vector<std::vector<int>> chunk_neighbours(threads);
     std::vector<std::vector<std::size_t>> chunk_counts(threads);
     std::vector<std::size_t> chunk_begin(threads + 1);
-    for (int t = 0; t <= threads; ++t) chunk_begin[t] = n * std::size_t(t) / std::size_t(threads);
+    for (int t = 0; t <= threads; ++t)
+        chunk_begin[t] = n * std::size_t(t) / std::size_t(threads);
 
 #pragma omp parallel num_threads(threads)
     {
         const int t = omp_get_thread_num();
-        auto& out = chunk_neighbours[t];
-        auto& counts = chunk_counts[t];
+        auto &out = chunk_neighbours[t];
+        auto &counts = chunk_counts[t];
         for (std::size_t i = chunk_begin[t]; i < chunk_begin[t + 1]; ++i) {
             const std::size_t before = out.size();
             const Eigen::Vector3i c = grid_.cellCoords(positions[i]);
             for (int dz = -1; dz <= 1; ++dz) {
                 const int z = c.z() + dz;
-                if (z < 0 || z >= dims.z()) continue;
+                if (z < 0 || z >= dims.z())
+                    continue;
                 for (int dy = -1; dy <= 1; ++dy) {
                     const int y = c.y() + dy;
-                    if (y < 0 || y >= dims.y()) continue;
+                    if (y < 0 || y >= dims.y())
+                        continue;
                     for (int dx = -1; dx <= 1; ++dx) {
                         const int x = c.x() + dx;
-                        if (x < 0 || x >= dims.x()) continue;
+                        if (x < 0 || x >= dims.x())
+                            continue;
                         const int cell = grid_.cellIndex({x, y, z});
                         for (int k = start[cell]; k < start[cell + 1]; ++k) {
                             const int j = members[k];
-                            if (std::size_t(j) <= i) continue;
+                            if (std::size_t(j) <= i)
+                                continue;
                             const double reach = radii[i] + radii[j] + skin_m;
                             if ((positions[i] - positions[j]).squaredNorm() < reach * reach)
                                 out.push_back(j);
@@ -133,23 +161,42 @@ void NeighbourList::build(const std::vector<Vec3>& positions, const std::vector<
     for (int t = 0; t < threads; ++t)
         for (std::size_t k = 0; k < chunk_counts[t].size(); ++k)
             first[chunk_begin[t] + k + 1] = chunk_counts[t][k];
-    for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
+    for (std::size_t i = 0; i < n; ++i)
+        first[i + 1] += first[i];
     neighbour.clear();
     neighbour.reserve(first[n]);
     for (int t = 0; t < threads; ++t)
         neighbour.insert(neighbour.end(), chunk_neighbours[t].begin(), chunk_neighbours[t].end());
     history.assign(neighbour.size(), ContactHistory{});
     touching.assign(neighbour.size(), 0);
-    for (std::size_t i = 0; i < n; ++i)
-        for (std::size_t c = carried_first[i]; c < carried_first[i + 1]; ++c) {
-            const auto begin = neighbour.begin() + first[i], end = neighbour.begin() + first[i + 1];
-            const auto it = std::lower_bound(begin, end, int(carried[c].j));
-            // A pair beyond the search radius cannot be in contact: its history lapses.
-            if (it != end && *it == int(carried[c].j)) {
-                history[std::size_t(it - neighbour.begin())] = carried[c].history;
-                touching[std::size_t(it - neighbour.begin())] = 1;
+    // A pair beyond the search radius cannot be in contact: its history lapses.
+    if (same_indexing) {
+#pragma omp parallel for schedule(static) num_threads(threads)
+        for (std::size_t i = 0; i < n; ++i) {
+            std::size_t k = first[i];
+            for (std::size_t o = old_first[i]; o < old_first[i + 1]; ++o) {
+                if (!old_touching[o])
+                    continue;
+                while (k < first[i + 1] && neighbour[k] < old_neighbour[o])
+                    ++k;
+                if (k < first[i + 1] && neighbour[k] == old_neighbour[o]) {
+                    history[k] = old_history[o];
+                    touching[k] = 1;
+                }
             }
         }
+    } else {
+        for (std::size_t i = 0; i < n; ++i)
+            for (std::size_t c = carried_first[i]; c < carried_first[i + 1]; ++c) {
+                const auto begin = neighbour.begin() + std::ptrdiff_t(first[i]);
+                const auto end = neighbour.begin() + std::ptrdiff_t(first[i + 1]);
+                const auto it = std::lower_bound(begin, end, int(carried[c].j));
+                if (it != end && *it == int(carried[c].j)) {
+                    history[std::size_t(it - neighbour.begin())] = carried[c].history;
+                    touching[std::size_t(it - neighbour.begin())] = 1;
+                }
+            }
+    }
     ++builds_;
 }
 
