@@ -12,20 +12,23 @@
 namespace grainlink::dem {
 
 SimulationError::SimulationError(std::uint64_t step_, ParticleId particle_,
-                                 const std::string& quantity_, const std::string& detail)
+                                 const std::string &quantity_, const std::string &detail)
     : std::runtime_error("step " + std::to_string(step_) + ", particle " +
                          std::to_string(particle_) + ": " + quantity_ + " " + detail),
       step(step_), particle(particle_), quantity(quantity_) {}
 
 DemSystem::DemSystem(ContactLaw law, std::vector<Material> materials, DemSettings settings)
     : settings_(settings), law_(std::move(law)), materials_(std::move(materials)) {
-    if (materials_.empty()) throw std::invalid_argument("DemSystem needs at least one material");
-    for (const Material& m : materials_) m.validate();
+    if (materials_.empty())
+        throw std::invalid_argument("DemSystem needs at least one material");
+    for (const Material &m : materials_)
+        m.validate();
     law_.finalize();
     if (!(settings_.time_step_s > 0.0))
         throw std::invalid_argument("time_step_s must be > 0, got " +
                                     std::to_string(settings_.time_step_s));
-    if (settings_.threads < 1) throw std::invalid_argument("threads must be >= 1");
+    if (settings_.threads < 1)
+        throw std::invalid_argument("threads must be >= 1");
     if (settings_.integrator == Integrator::Newmark &&
         !(settings_.newmark_beta >= 0.0 && settings_.newmark_gamma >= 0.5))
         throw std::invalid_argument("Newmark needs beta >= 0 and gamma >= 0.5");
@@ -35,24 +38,25 @@ DemSystem::DemSystem(ContactLaw law, std::vector<Material> materials, DemSetting
         for (std::size_t b = 0; b < nm; ++b)
             pair_props_[a * nm + b] = pairProperties(materials_[a], materials_[b], law_);
     // Phases in step order; the two passes over all particles fuse the cheap per-particle work.
-    phase_.kick_drift = timer_.phase(settings_.integrator == Integrator::Newmark
-                                         ? "predict+clearForces"
-                                         : "halfKick+drift+clearForces");
+    phase_.kick_drift =
+        timer_.phase(settings_.integrator == Integrator::Newmark ? "predict+clearForces"
+                                                                 : "halfKick+drift+clearForces");
     phase_.bodies = timer_.phase("moveBodies");
     phase_.neighbours = timer_.phase("updateNeighbours");
     phase_.contacts = timer_.phase("pairContacts");
     phase_.walls = timer_.phase("planeContacts");
     phase_.meshes = timer_.phase("meshContacts");
     phase_.check = timer_.phase("checkOverlaps");
-    phase_.finish = timer_.phase(settings_.integrator == Integrator::Newmark
-                                     ? "bodyForces+correct"
-                                     : "bodyForces+halfKick");
+    phase_.finish = timer_.phase(
+        settings_.integrator == Integrator::Newmark ? "bodyForces+correct" : "bodyForces+halfKick");
 }
 
 int DemSystem::addPlane(PlaneWall wall) {
-    if (!(wall.normal.norm() > 0.0)) throw std::invalid_argument("plane '" + wall.name + "' has a zero normal");
+    if (!(wall.normal.norm() > 0.0))
+        throw std::invalid_argument("plane '" + wall.name + "' has a zero normal");
     wall.normal.normalize();
-    if (wall.material.youngs_modulus_Pa == 0.0) wall.material = materials_[0];
+    if (wall.material.youngs_modulus_Pa == 0.0)
+        wall.material = materials_[0];
     wall.material.validate();
     planes_.push_back(std::move(wall));
     initialised_ = false;
@@ -60,7 +64,8 @@ int DemSystem::addPlane(PlaneWall wall) {
 }
 
 int DemSystem::addBody(MeshBody body, std::function<RigidBodyState(double)> motion) {
-    if (body.material.youngs_modulus_Pa == 0.0) body.material = materials_[0];
+    if (body.material.youngs_modulus_Pa == 0.0)
+        body.material = materials_[0];
     body.material.validate();
     bodies_.push_back(std::move(body));
     body_motion_.push_back(std::move(motion));
@@ -73,7 +78,7 @@ void DemSystem::prepareWalls() {
     const std::size_t nm = materials_.size();
     plane_props_.assign(planes_.size(), {});
     for (std::size_t w = 0; w < planes_.size(); ++w) {
-        const PlaneWall& p = planes_[w];
+        const PlaneWall &p = planes_[w];
         for (std::size_t m = 0; m < nm; ++m)
             plane_props_[w].push_back(
                 p.friction_coefficient
@@ -98,7 +103,8 @@ void DemSystem::resizeWallHistories() {
     // New particles are appended, so per-particle blocks keep their place; a changed plane
     // count changes the layout, and those histories start afresh.
     const std::size_t n = particles_.size();
-    if (history_planes_ != planes_.size()) plane_history_.clear();
+    if (history_planes_ != planes_.size())
+        plane_history_.clear();
     history_planes_ = planes_.size();
     plane_history_.resize(n * planes_.size());
     mesh_slots_.resize(n * kMeshSlots);
@@ -111,8 +117,10 @@ void DemSystem::initialise() {
                                         ", but only " + std::to_string(materials_.size()) +
                                         " are defined");
     prepareWalls();
-    if (settings_.skin_m <= 0.0) settings_.skin_m = 0.4 * particles_.minRadius();
-    if (settings_.check_time_step) validateTimeStep();
+    if (settings_.skin_m <= 0.0)
+        settings_.skin_m = 0.4 * particles_.minRadius();
+    if (settings_.check_time_step)
+        validateTimeStep();
     const int threads = settings_.threads;
     const std::size_t n = particles_.size();
     side_.assign(std::size_t(threads), {});
@@ -122,8 +130,8 @@ void DemSystem::initialise() {
     thread_body_torque_.assign(threads, std::vector<Vec3>(bodies_.size()));
     thread_plane_force_.assign(threads, std::vector<Vec3>(planes_.size()));
     thread_triangle_force_.assign(threads, {});
-    for (auto& per_thread : thread_triangle_force_)
-        for (const MeshBody& b : bodies_)
+    for (auto &per_thread : thread_triangle_force_)
+        for (const MeshBody &b : bodies_)
             per_thread.emplace_back(b.record_triangle_loads ? b.mesh().triangleCount() : 0,
                                     Vec3::Zero());
     thread_max_overlap_.assign(threads, 0.0);
@@ -135,7 +143,8 @@ void DemSystem::initialise() {
     body_reference_.resize(bodies_.size());
     initialised_ = true;
     prepared_particles_ = n;
-    if (reference_position_.size() != n) rebuildNeighbours();
+    if (reference_position_.size() != n)
+        rebuildNeighbours();
     else {
         // Restored: rebuild the pair list at the saved reference so the rebuild schedule and
         // the storage order continue exactly as in the run that wrote the checkpoint.
@@ -152,16 +161,16 @@ void DemSystem::validateTimeStep() const {
     const double estimate = stableTimeStepEstimate();
     if (settings_.time_step_s > estimate) {
         std::ostringstream msg;
-        msg << "time_step_s = " << settings_.time_step_s
-            << " s is above the stability estimate " << estimate
-            << " s (docs/physics.md §3.3); reduce it or set check_time_step: false";
+        msg << "time_step_s = " << settings_.time_step_s << " s is above the stability estimate "
+            << estimate << " s (docs/physics.md §3.3); reduce it or set check_time_step: false";
         throw std::invalid_argument(msg.str());
     }
 }
 
 double DemSystem::stableTimeStepEstimate() const {
     double estimate = std::numeric_limits<double>::infinity();
-    if (particles_.empty()) return estimate;
+    if (particles_.empty())
+        return estimate;
     // Rayleigh time step of the smallest grain of each material.
     for (std::size_t m = 0; m < materials_.size(); ++m) {
         double r_min = std::numeric_limits<double>::infinity(), rho = 0.0;
@@ -170,17 +179,18 @@ double DemSystem::stableTimeStepEstimate() const {
                 r_min = particles_.radius[i];
                 rho = particles_.mass[i] / (4.0 / 3.0 * M_PI * std::pow(r_min, 3));
             }
-        if (!std::isfinite(r_min)) continue;
-        const Material& mat = materials_[m];
+        if (!std::isfinite(r_min))
+            continue;
+        const Material &mat = materials_[m];
         const double shear = mat.youngs_modulus_Pa / (2.0 * (1.0 + mat.poisson_ratio));
-        const double rayleigh = M_PI * r_min * std::sqrt(rho / shear) /
-                                (0.1631 * mat.poisson_ratio + 0.8766);
+        const double rayleigh =
+            M_PI * r_min * std::sqrt(rho / shear) / (0.1631 * mat.poisson_ratio + 0.8766);
         // Half the Rayleigh time: a settled bed of Table 1 soil starts to rattle at 0.41 T_R
         // and blows up at 0.71 T_R (IntegratorStabilityTest), so T_R itself is not safe.
         estimate = std::min(estimate, 0.5 * rayleigh);
     }
     // An explicit dashpot c is stable only for dt < 2 m*/c (lightest pair, m* = m/2).
-    if (const auto* viscous = std::get_if<DampingViscous>(&law_.damping)) {
+    if (const auto *viscous = std::get_if<DampingViscous>(&law_.damping)) {
         const double m_min = *std::min_element(particles_.mass.begin(), particles_.mass.end());
         if (viscous->coefficient_N_s_m > 0.0)
             estimate = std::min(estimate, m_min / viscous->coefficient_N_s_m);
@@ -191,11 +201,13 @@ double DemSystem::stableTimeStepEstimate() const {
 }
 
 void DemSystem::setTimeStep(double dt_s) {
-    if (!(dt_s > 0.0)) throw std::invalid_argument("time step must be > 0");
+    if (!(dt_s > 0.0))
+        throw std::invalid_argument("time step must be > 0");
     time_offset_s_ = time();
     step_offset_ = step_;
     settings_.time_step_s = dt_s;
-    if (initialised_ && settings_.check_time_step) validateTimeStep();
+    if (initialised_ && settings_.check_time_step)
+        validateTimeStep();
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -203,7 +215,8 @@ void DemSystem::setTimeStep(double dt_s) {
 
 void DemSystem::step() {
     // Particles added since the last step (rain deposition) need lists and wall data.
-    if (!initialised_ || particles_.size() != prepared_particles_) initialise();
+    if (!initialised_ || particles_.size() != prepared_particles_)
+        initialise();
     if (!forces_valid_) {
         // Forces at the initial state, needed by the first half kick / predictor.
         moveBodies(time());
@@ -217,24 +230,29 @@ void DemSystem::step() {
     advanceAndClear();
     moveBodies(t_next);
     computeForces();
-    if (settings_.integrator == Integrator::VelocityVerlet) finishForces(0.5);
-    else newmarkCorrect();
+    if (settings_.integrator == Integrator::VelocityVerlet)
+        finishForces(0.5);
+    else
+        newmarkCorrect();
     ++step_;
 }
 
 void DemSystem::run(std::uint64_t steps) {
-    for (std::uint64_t k = 0; k < steps; ++k) step();
+    for (std::uint64_t k = 0; k < steps; ++k)
+        step();
 }
 
-inline void DemSystem::angularAcceleration(std::size_t i, Vec3& alpha) const {
-    const Vec3& inertia = particles_.inertia[i];
-    if (particles_.isotropic(i)) alpha = particles_.torque[i] / inertia.x();
-    else alpha = anisotropicAngularAcceleration(i);
+inline void DemSystem::angularAcceleration(std::size_t i, Vec3 &alpha) const {
+    const Vec3 &inertia = particles_.inertia[i];
+    if (particles_.isotropic(i))
+        alpha = particles_.torque[i] / inertia.x();
+    else
+        alpha = anisotropicAngularAcceleration(i);
 }
 
 Vec3 DemSystem::anisotropicAngularAcceleration(std::size_t i) const {
     // Euler's equations in the particle frame (per-axis inertia, seed eq. 2).
-    const Vec3& inertia = particles_.inertia[i];
+    const Vec3 &inertia = particles_.inertia[i];
     const Mat3 rot = particles_.orientation[i].toRotationMatrix();
     const Vec3 w = rot.transpose() * particles_.angular_velocity[i];
     const Vec3 t = rot.transpose() * particles_.torque[i];
@@ -245,7 +263,7 @@ Vec3 DemSystem::anisotropicAngularAcceleration(std::size_t i) const {
 namespace {
 /// Turns q by the rotation vector `turn` (world frame). Small turns, the rule in a DEM step,
 /// use the exact series of the exponential map and so need no trigonometric functions.
-inline void rotate(Quat& q, const Vec3& turn) {
+inline void rotate(Quat &q, const Vec3 &turn) {
     const Vec3 half = 0.5 * turn;
     const double s2 = half.squaredNorm();
     Quat dq;
@@ -256,7 +274,8 @@ inline void rotate(Quat& q, const Vec3& turn) {
         dq = rotationFromVector(turn);
     }
     q = dq * q;
-    if (s2 >= 1e-6) q.normalize(); // the series keeps |dq| = 1 to round-off
+    if (s2 >= 1e-6)
+        q.normalize(); // the series keeps |dq| = 1 to round-off
 }
 } // namespace
 
@@ -268,12 +287,13 @@ void DemSystem::advanceAndClear() {
     const double dt = settings_.time_step_s, h = 0.5 * dt;
     const double drift_a = dt * dt * (0.5 - settings_.newmark_beta);
     const double kick_a = dt * (1.0 - settings_.newmark_gamma);
-    auto& p = particles_;
+    auto &p = particles_;
     const std::size_t n = p.size();
     const bool track_mesh = !bodies_.empty() && !candidates_stale_;
     double max_sq = 0.0, max_mesh_sq = 0.0;
-#pragma omp parallel for schedule(static) num_threads(settings_.threads) \
-    reduction(max : max_sq, max_mesh_sq)
+#pragma omp parallel for schedule(static) num_threads(settings_.threads)                           \
+    reduction(max                                                                                  \
+              : max_sq, max_mesh_sq)
     for (std::size_t i = 0; i < n; ++i) {
         Vec3 alpha;
         angularAcceleration(i, alpha);
@@ -305,7 +325,7 @@ void DemSystem::newmarkCorrect() {
     PhaseTimer::Scope scope(timer_, phase_.finish);
     const double dt = settings_.time_step_s, beta = settings_.newmark_beta,
                  gamma = settings_.newmark_gamma;
-    auto& p = particles_;
+    auto &p = particles_;
     const std::size_t n = p.size();
     std::size_t bad = n;
 #pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : bad)
@@ -321,13 +341,14 @@ void DemSystem::newmarkCorrect() {
         rotate(p.orientation[i], (beta * dt * dt) * alpha);
         p.angular_velocity[i] += (gamma * dt) * alpha;
     }
-    if (bad < n) reportNonFinite(bad);
+    if (bad < n)
+        reportNonFinite(bad);
 }
 
 void DemSystem::finishForces(double kick_fraction) {
     PhaseTimer::Scope scope(timer_, phase_.finish);
     const double h = kick_fraction * settings_.time_step_s;
-    auto& p = particles_;
+    auto &p = particles_;
     const std::size_t n = p.size();
     std::size_t bad = n;
 #pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : bad)
@@ -338,17 +359,19 @@ void DemSystem::finishForces(double kick_fraction) {
             bad = std::min(bad, i);
             continue;
         }
-        if (h == 0.0) continue;
+        if (h == 0.0)
+            continue;
         p.velocity[i] += (h * p.inv_mass[i]) * p.force[i];
         Vec3 alpha;
         angularAcceleration(i, alpha);
         p.angular_velocity[i] += h * alpha;
     }
-    if (bad < n) reportNonFinite(bad);
+    if (bad < n)
+        reportNonFinite(bad);
 }
 
 inline void DemSystem::addBodyForces(std::size_t i) {
-    auto& p = particles_;
+    auto &p = particles_;
     p.force[i] += p.mass[i] * settings_.gravity_m_s2;
     const double k_h = law_.background_damping_1_s;
     if (k_h > 0.0) {
@@ -359,7 +382,7 @@ inline void DemSystem::addBodyForces(std::size_t i) {
 }
 
 void DemSystem::reportNonFinite(std::size_t i) const {
-    const auto& p = particles_;
+    const auto &p = particles_;
     const std::string what = !p.position[i].allFinite() ? "position"
                              : !p.force[i].allFinite()  ? "force"
                                                         : "torque";
@@ -374,7 +397,8 @@ void DemSystem::clearForces() {
 void DemSystem::moveBodies(double t_s) {
     PhaseTimer::Scope scope(timer_, phase_.bodies);
     for (std::size_t b = 0; b < bodies_.size(); ++b)
-        if (body_motion_[b]) bodies_[b].setState(body_motion_[b](t_s));
+        if (body_motion_[b])
+            bodies_[b].setState(body_motion_[b](t_s));
 }
 
 void DemSystem::computeForces() {
@@ -391,7 +415,7 @@ void DemSystem::computeForces() {
 void DemSystem::updateNeighbours() {
     PhaseTimer::Scope scope(timer_, phase_.neighbours);
     const std::size_t n = particles_.size();
-    const auto& x = particles_.position;
+    const auto &x = particles_.position;
     const bool have_bodies = !bodies_.empty();
     if (!displacement_known_) {
         // Only at the first force evaluation; later the kick-drift pass measures this.
@@ -407,14 +431,17 @@ void DemSystem::updateNeighbours() {
     }
     displacement_known_ = false;
     const double skin = settings_.skin_m;
-    if (2.0 * std::sqrt(max_displacement_sq_) > skin) rebuildNeighbours();
-    if (!have_bodies) return;
+    if (2.0 * std::sqrt(max_displacement_sq_) > skin)
+        rebuildNeighbours();
+    if (!have_bodies)
+        return;
     // A particle-triangle pair may approach by the particle's and the mesh's displacement.
     double body_move = 0.0;
     for (std::size_t b = 0; b < bodies_.size() && !candidates_stale_; ++b) {
         const RigidBodyState &now = bodies_[b].state(), &ref = body_reference_[b];
-        const double angle = 2.0 * std::acos(std::min(
-                                       1.0, std::abs((now.orientation * ref.orientation.conjugate()).w())));
+        const double angle =
+            2.0 *
+            std::acos(std::min(1.0, std::abs((now.orientation * ref.orientation.conjugate()).w())));
         body_move = std::max(body_move, (now.position_m - ref.position_m).norm() +
                                             angle * bodies_[b].boundingRadius());
     }
@@ -425,19 +452,21 @@ void DemSystem::updateNeighbours() {
 void DemSystem::rebuildNeighbours() {
     const std::size_t n = particles_.size();
     std::vector<std::size_t> old_to_new;
-    const bool resort = settings_.resort_every_builds > 0 &&
-                        neighbours_.buildCount() % std::uint64_t(settings_.resort_every_builds) == 0;
+    const bool resort =
+        settings_.resort_every_builds > 0 &&
+        neighbours_.buildCount() % std::uint64_t(settings_.resort_every_builds) == 0;
     if (resort && n > 0) {
         // Spatial re-sort by cell for memory locality; histories follow by index map.
         CellGrid grid;
         grid.bin(particles_.position, 2.0 * particles_.maxRadius() + settings_.skin_m);
         std::vector<std::size_t> order(n);
         std::iota(order.begin(), order.end(), 0);
-        const auto& cell = grid.particleCell();
+        const auto &cell = grid.particleCell();
         std::stable_sort(order.begin(), order.end(),
                          [&](std::size_t a, std::size_t b) { return cell[a] < cell[b]; });
         old_to_new.resize(n);
-        for (std::size_t k = 0; k < n; ++k) old_to_new[order[k]] = k;
+        for (std::size_t k = 0; k < n; ++k)
+            old_to_new[order[k]] = k;
         particles_.permute(order);
         permuteWallHistories(order);
         candidates_stale_ = true;
@@ -458,20 +487,24 @@ void DemSystem::updatePlaneMasks() {
     for (std::size_t i = 0; i < n; ++i) {
         std::uint64_t mask = 0;
         for (std::size_t w = 0; w < np; ++w) {
-            const double dist = (particles_.position[i] - planes_[w].point_m).dot(planes_[w].normal);
-            if (dist < particles_.radius[i] + skin) mask |= std::uint64_t(1) << w;
-            else if (plane_history_[i * np + w].active()) plane_history_[i * np + w] = ContactHistory{};
+            const double dist =
+                (particles_.position[i] - planes_[w].point_m).dot(planes_[w].normal);
+            if (dist < particles_.radius[i] + skin)
+                mask |= std::uint64_t(1) << w;
+            else if (plane_history_[i * np + w].active())
+                plane_history_[i * np + w] = ContactHistory{};
         }
         plane_mask_[i] = mask;
     }
 }
 
-void DemSystem::permuteWallHistories(const std::vector<std::size_t>& order) {
+void DemSystem::permuteWallHistories(const std::vector<std::size_t> &order) {
     const std::size_t np = planes_.size();
     std::vector<ContactHistory> planes(plane_history_.size());
     std::vector<MeshContactSlot> slots(mesh_slots_.size());
     for (std::size_t k = 0; k < order.size(); ++k) {
-        for (std::size_t w = 0; w < np; ++w) planes[k * np + w] = plane_history_[order[k] * np + w];
+        for (std::size_t w = 0; w < np; ++w)
+            planes[k * np + w] = plane_history_[order[k] * np + w];
         for (int s = 0; s < kMeshSlots; ++s)
             slots[k * kMeshSlots + s] = mesh_slots_[order[k] * kMeshSlots + s];
     }
@@ -483,13 +516,13 @@ void DemSystem::rebuildMeshCandidates() {
     const std::size_t n = particles_.size();
     const double skin = settings_.skin_m, r_max = particles_.maxRadius();
     mesh_grid_.bin(particles_.position, 2.0 * r_max + skin);
-    const auto& start = mesh_grid_.cellStart();
-    const auto& members = mesh_grid_.cellParticles();
+    const auto &start = mesh_grid_.cellStart();
+    const auto &members = mesh_grid_.cellParticles();
     std::vector<std::pair<std::size_t, std::pair<int, int>>> found;
     for (std::size_t b = 0; b < bodies_.size(); ++b) {
-        const MeshBody& body = bodies_[b];
-        const auto& v = body.worldVertices();
-        const auto& tris = body.mesh().triangles;
+        const MeshBody &body = bodies_[b];
+        const auto &v = body.worldVertices();
+        const auto &tris = body.mesh().triangles;
         for (std::size_t t = 0; t < tris.size(); ++t) {
             const Vec3 &a = v[tris[t][0]], &bb = v[tris[t][1]], &c = v[tris[t][2]];
             const Vec3 pad = Vec3::Constant(r_max + skin);
@@ -502,11 +535,13 @@ void DemSystem::rebuildMeshCandidates() {
                         const int cell = mesh_grid_.cellIndex({x, y, z});
                         for (int k = start[cell]; k < start[cell + 1]; ++k) {
                             const std::size_t i = std::size_t(members[k]);
-                            const Vec3& p = particles_.position[i];
+                            const Vec3 &p = particles_.position[i];
                             const double reach = particles_.radius[i] + skin;
                             // Cheap plane test first: most cell members are far off the plane.
-                            if (std::abs((p - a).dot(normal)) >= reach) continue;
-                            if ((closestPointOnTriangle(p, a, bb, c) - p).squaredNorm() < reach * reach)
+                            if (std::abs((p - a).dot(normal)) >= reach)
+                                continue;
+                            if ((closestPointOnTriangle(p, a, bb, c) - p).squaredNorm() <
+                                reach * reach)
                                 found.push_back({i, {int(b), int(t)}});
                         }
                     }
@@ -515,15 +550,17 @@ void DemSystem::rebuildMeshCandidates() {
     std::sort(found.begin(), found.end());
     std::vector<std::size_t> first(n + 1, 0);
     mesh_candidates_.clear();
-    for (const auto& f : found) {
+    for (const auto &f : found) {
         ++first[f.first + 1];
         mesh_candidates_.push_back(f.second);
     }
-    for (std::size_t i = 0; i < n; ++i) first[i + 1] += first[i];
+    for (std::size_t i = 0; i < n; ++i)
+        first[i + 1] += first[i];
     // Particles out of every mesh's reach drop their mesh histories (they cannot touch).
     for (std::size_t i = 0; i < n; ++i)
         if (first[i] == first[i + 1] && mesh_slots_[i * kMeshSlots].body >= 0)
-            for (int s = 0; s < kMeshSlots; ++s) mesh_slots_[i * kMeshSlots + s] = MeshContactSlot{};
+            for (int s = 0; s < kMeshSlots; ++s)
+                mesh_slots_[i * kMeshSlots + s] = MeshContactSlot{};
     mesh_particles_.clear();
     mesh_candidate_first_.clear();
     for (std::size_t i = 0; i < n; ++i)
@@ -533,7 +570,8 @@ void DemSystem::rebuildMeshCandidates() {
         }
     mesh_candidate_first_.push_back(first[n]);
     mesh_reference_position_ = particles_.position;
-    for (std::size_t b = 0; b < bodies_.size(); ++b) body_reference_[b] = bodies_[b].state();
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+        body_reference_[b] = bodies_[b].state();
     candidates_stale_ = false;
 }
 
@@ -546,9 +584,9 @@ void DemSystem::pairContacts() {
     const std::size_t n = particles_.size();
     const std::size_t nm = materials_.size();
     const double dt = settings_.time_step_s;
-    auto& p = particles_;
-    withConcreteLaw(law_, [&](const auto& normal, const auto& damping, const auto& tangential,
-                              const auto& rolling, const auto& cohesion) {
+    auto &p = particles_;
+    withConcreteLaw(law_, [&](const auto &normal, const auto &damping, const auto &tangential,
+                              const auto &rolling, const auto &cohesion) {
         using Normal = std::decay_t<decltype(normal)>;
 #pragma omp parallel num_threads(threads)
         {
@@ -558,24 +596,24 @@ void DemSystem::pairContacts() {
             const int t = omp_get_thread_num();
             const std::size_t begin = n * std::size_t(t) / std::size_t(threads);
             const std::size_t end = n * std::size_t(t + 1) / std::size_t(threads);
-            auto& side = side_[std::size_t(t)];
+            auto &side = side_[std::size_t(t)];
             side.clear();
             // Raw, non-aliasing pointers: the stores to forces then cannot force reloads of
             // the arrays' addresses from the store object inside the loop.
-            Vec3* __restrict force = p.force.data();
-            Vec3* __restrict torque = p.torque.data();
-            const Vec3* __restrict position = p.position.data();
-            const Vec3* __restrict velocity = p.velocity.data();
-            const Vec3* __restrict spin = p.angular_velocity.data();
-            const double* __restrict radius = p.radius.data();
-            const double* __restrict inv_mass = p.inv_mass.data();
-            const int* __restrict material = p.material.data();
+            Vec3 *__restrict force = p.force.data();
+            Vec3 *__restrict torque = p.torque.data();
+            const Vec3 *__restrict position = p.position.data();
+            const Vec3 *__restrict velocity = p.velocity.data();
+            const Vec3 *__restrict spin = p.angular_velocity.data();
+            const double *__restrict radius = p.radius.data();
+            const double *__restrict inv_mass = p.inv_mass.data();
+            const int *__restrict material = p.material.data();
             double max_ratio = 0.0;
             std::pair<ParticleId, ParticleId> max_pair{0, 0};
-            const std::size_t* __restrict first = neighbours_.first.data();
-            const int* __restrict neighbour = neighbours_.neighbour.data();
-            std::uint8_t* __restrict touching = neighbours_.touching.data();
-            ContactHistory* __restrict history = neighbours_.history.data();
+            const std::size_t *__restrict first = neighbours_.first.data();
+            const int *__restrict neighbour = neighbours_.neighbour.data();
+            std::uint8_t *__restrict touching = neighbours_.touching.data();
+            ContactHistory *__restrict history = neighbours_.history.data();
             ContactGeometry g;
             ContactResult r;
             for (std::size_t i = begin; i < end; ++i) {
@@ -607,7 +645,7 @@ void DemSystem::pairContacts() {
                         velocity[i] - velocity[j] -
                         (g.arm_i_m * spin[i] + g.arm_j_m * spin[j]).cross(g.normal);
                     g.relative_spin_rad_s = spin[i] - spin[j];
-                    const PairProperties& props =
+                    const PairProperties &props =
                         pair_props_[std::size_t(material[i]) * nm + std::size_t(material[j])];
                     evaluateContact<Normal>(damping, tangential, rolling, cohesion, props, g, dt,
                                             history[k], r);
@@ -633,7 +671,7 @@ void DemSystem::pairContacts() {
             if (threads > 1) {
 #pragma omp barrier
                 for (int s = 0; s < t; ++s)
-                    for (const SideContribution& c : side_[std::size_t(s)])
+                    for (const SideContribution &c : side_[std::size_t(s)])
                         if (c.particle >= begin && c.particle < end) {
                             force[c.particle] += c.force_N;
                             torque[c.particle] += c.torque_N_m;
@@ -644,19 +682,20 @@ void DemSystem::pairContacts() {
 }
 
 void DemSystem::planeContacts() {
-    if (planes_.empty()) return;
+    if (planes_.empty())
+        return;
     PhaseTimer::Scope scope(timer_, phase_.walls);
     const int threads = settings_.threads;
     const std::size_t n = particles_.size(), np = planes_.size(), nm = materials_.size();
     const double dt = settings_.time_step_s;
-    auto& p = particles_;
-    withConcreteLaw(law_, [&](const auto& normal, const auto& damping, const auto& tangential,
-                              const auto& rolling, const auto& cohesion) {
+    auto &p = particles_;
+    withConcreteLaw(law_, [&](const auto &normal, const auto &damping, const auto &tangential,
+                              const auto &rolling, const auto &cohesion) {
         using Normal = std::decay_t<decltype(normal)>;
 #pragma omp parallel num_threads(threads)
         {
             const int t = omp_get_thread_num();
-            auto& plane_force = thread_plane_force_[t];
+            auto &plane_force = thread_plane_force_[t];
             std::fill(plane_force.begin(), plane_force.end(), Vec3::Zero());
             ContactGeometry g;
             ContactResult r;
@@ -664,11 +703,12 @@ void DemSystem::planeContacts() {
             for (std::size_t i = 0; i < n; ++i) {
                 for (std::uint64_t mask = plane_mask_[i]; mask != 0; mask &= mask - 1) {
                     const std::size_t w = std::size_t(__builtin_ctzll(mask));
-                    const PlaneWall& wall = planes_[w];
-                    ContactHistory& h = plane_history_[i * np + w];
+                    const PlaneWall &wall = planes_[w];
+                    ContactHistory &h = plane_history_[i * np + w];
                     const double dist = (p.position[i] - wall.point_m).dot(wall.normal);
                     if (dist >= p.radius[i]) {
-                        if (h.active()) h = ContactHistory{};
+                        if (h.active())
+                            h = ContactHistory{};
                         continue;
                     }
                     g.normal = wall.normal;
@@ -682,7 +722,8 @@ void DemSystem::planeContacts() {
                     g.relative_spin_rad_s = p.angular_velocity[i];
                     const Vec3 contact_point = p.position[i] - dist * wall.normal;
                     std::size_t slot = std::size_t(p.material[i]);
-                    if (wall.track && wall.track->contains(contact_point)) slot += nm;
+                    if (wall.track && wall.track->contains(contact_point))
+                        slot += nm;
                     evaluateContact<Normal>(damping, tangential, rolling, cohesion,
                                             plane_props_[w][slot], g, dt, h, r);
                     p.force[i] += r.force_on_i_N;
@@ -699,29 +740,32 @@ void DemSystem::planeContacts() {
     });
     for (std::size_t w = 0; w < np; ++w) {
         plane_force_[w].setZero();
-        for (int t = 0; t < threads; ++t) plane_force_[w] += thread_plane_force_[t][w];
+        for (int t = 0; t < threads; ++t)
+            plane_force_[w] += thread_plane_force_[t][w];
     }
 }
 
 void DemSystem::meshContacts() {
-    if (bodies_.empty()) return;
+    if (bodies_.empty())
+        return;
     PhaseTimer::Scope scope(timer_, phase_.meshes);
     const int threads = settings_.threads;
     const std::size_t nb = bodies_.size();
     const double dt = settings_.time_step_s;
-    auto& p = particles_;
-    withConcreteLaw(law_, [&](const auto& normal, const auto& damping, const auto& tangential,
-                              const auto& rolling, const auto& cohesion) {
+    auto &p = particles_;
+    withConcreteLaw(law_, [&](const auto &normal, const auto &damping, const auto &tangential,
+                              const auto &rolling, const auto &cohesion) {
         using Normal = std::decay_t<decltype(normal)>;
 #pragma omp parallel num_threads(threads)
         {
             const int t = omp_get_thread_num();
-            auto& body_force = thread_body_force_[t];
-            auto& body_torque = thread_body_torque_[t];
-            auto& triangle_force = thread_triangle_force_[t];
+            auto &body_force = thread_body_force_[t];
+            auto &body_torque = thread_body_torque_[t];
+            auto &triangle_force = thread_triangle_force_[t];
             std::fill(body_force.begin(), body_force.end(), Vec3::Zero());
             std::fill(body_torque.begin(), body_torque.end(), Vec3::Zero());
-            for (auto& loads : triangle_force) std::fill(loads.begin(), loads.end(), Vec3::Zero());
+            for (auto &loads : triangle_force)
+                std::fill(loads.begin(), loads.end(), Vec3::Zero());
             struct Touch {
                 int body, triangle;
                 Vec3 point;
@@ -736,7 +780,7 @@ void DemSystem::meshContacts() {
 #pragma omp for schedule(static)
             for (std::size_t c_index = 0; c_index < candidates; ++c_index) {
                 const std::size_t i = mesh_particles_[c_index];
-                MeshContactSlot* slots = &mesh_slots_[i * kMeshSlots];
+                MeshContactSlot *slots = &mesh_slots_[i * kMeshSlots];
                 const std::size_t c0 = mesh_candidate_first_[c_index];
                 const std::size_t c1 = mesh_candidate_first_[c_index + 1];
                 const Vec3 xi = p.position[i];
@@ -744,11 +788,12 @@ void DemSystem::meshContacts() {
                 int count = 0;
                 for (std::size_t c = c0; c < c1; ++c) {
                     const auto [b, tri] = mesh_candidates_[c];
-                    const auto& v = bodies_[std::size_t(b)].worldVertices();
-                    const auto& ids = bodies_[std::size_t(b)].mesh().triangles[std::size_t(tri)];
+                    const auto &v = bodies_[std::size_t(b)].worldVertices();
+                    const auto &ids = bodies_[std::size_t(b)].mesh().triangles[std::size_t(tri)];
                     const Vec3 q = closestPointOnTriangle(xi, v[ids[0]], v[ids[1]], v[ids[2]]);
                     const double dist_sq = (xi - q).squaredNorm();
-                    if (dist_sq >= ri * ri || count == kMaxTouches) continue;
+                    if (dist_sq >= ri * ri || count == kMaxTouches)
+                        continue;
                     touches[count++] = {b, tri, q, std::sqrt(dist_sq)};
                 }
                 // Nearest first. A touch whose point lies in (or behind) the tangent plane of a
@@ -756,27 +801,28 @@ void DemSystem::meshContacts() {
                 // neighbouring triangle's edge or vertex (a point shared by two triangles is the
                 // extreme case): counting it would add a second, tilted force wherever a sphere
                 // overlaps a flat mesh near an edge. Concave corners keep both faces.
-                std::sort(touches, touches + count, [](const Touch& a, const Touch& b) {
-                    return a.dist != b.dist ? a.dist < b.dist
-                                            : (a.body != b.body ? a.body < b.body
-                                                                : a.triangle < b.triangle);
+                std::sort(touches, touches + count, [](const Touch &a, const Touch &b) {
+                    return a.dist != b.dist
+                               ? a.dist < b.dist
+                               : (a.body != b.body ? a.body < b.body : a.triangle < b.triangle);
                 });
                 int used = 0, accepted_count = 0;
                 int accepted[kMaxTouches];
                 Vec3 accepted_normal[kMaxTouches];
                 for (int k = 0; k < count; ++k) {
-                    const Touch& touch = touches[k];
+                    const Touch &touch = touches[k];
                     bool duplicate = false;
                     for (int m = 0; m < accepted_count && !duplicate; ++m) {
-                        const Touch& nearer = touches[accepted[m]];
-                        duplicate = nearer.body == touch.body &&
-                                    (touch.point - nearer.point).dot(accepted_normal[m]) <=
-                                        1e-9 * ri;
+                        const Touch &nearer = touches[accepted[m]];
+                        duplicate =
+                            nearer.body == touch.body &&
+                            (touch.point - nearer.point).dot(accepted_normal[m]) <= 1e-9 * ri;
                     }
-                    if (duplicate) continue;
+                    if (duplicate)
+                        continue;
                     // Same triangle, or a neighbour of it with the same normal, keeps history.
-                    const Vec3 n_c = touch.dist > 0.0 ? Vec3((xi - touch.point) / touch.dist)
-                                                      : Vec3::UnitZ();
+                    const Vec3 n_c =
+                        touch.dist > 0.0 ? Vec3((xi - touch.point) / touch.dist) : Vec3::UnitZ();
                     accepted[accepted_count] = k;
                     accepted_normal[accepted_count++] = n_c;
                     ContactHistory h;
@@ -791,43 +837,46 @@ void DemSystem::meshContacts() {
                         h = slots[best].history;
                         slots[best].body = -1; // consumed
                     }
-                    const MeshBody& body = bodies_[std::size_t(touch.body)];
+                    const MeshBody &body = bodies_[std::size_t(touch.body)];
                     g.normal = n_c;
                     g.overlap_m = ri - touch.dist;
                     g.radius_eff_m = ri;
                     g.mass_eff_kg = p.mass[i];
                     g.arm_i_m = touch.dist;
                     g.arm_j_m = 0.0;
-                    g.contact_velocity_m_s =
-                        p.velocity[i] - touch.dist * p.angular_velocity[i].cross(n_c) -
-                        body.state().pointVelocity(touch.point);
+                    g.contact_velocity_m_s = p.velocity[i] -
+                                             touch.dist * p.angular_velocity[i].cross(n_c) -
+                                             body.state().pointVelocity(touch.point);
                     g.relative_spin_rad_s =
                         p.angular_velocity[i] - body.state().angular_velocity_rad_s;
-                    const auto& props =
+                    const auto &props =
                         body_props_[std::size_t(touch.body)][std::size_t(p.material[i])];
-                    evaluateContact<Normal>(damping, tangential, rolling, cohesion, props, g, dt,
-                                            h, r);
+                    evaluateContact<Normal>(damping, tangential, rolling, cohesion, props, g, dt, h,
+                                            r);
                     p.force[i] += r.force_on_i_N;
                     p.torque[i] += r.torque_on_i_N_m;
                     body_force[std::size_t(touch.body)] -= r.force_on_i_N;
                     body_torque[std::size_t(touch.body)] +=
                         (touch.point - body.state().position_m).cross(-r.force_on_i_N) +
                         r.torque_on_j_N_m;
-                    auto& loads = triangle_force[std::size_t(touch.body)];
-                    if (!loads.empty()) loads[std::size_t(touch.triangle)] -= r.force_on_i_N;
+                    auto &loads = triangle_force[std::size_t(touch.body)];
+                    if (!loads.empty())
+                        loads[std::size_t(touch.triangle)] -= r.force_on_i_N;
                     const double ratio = g.overlap_m / ri;
                     if (ratio > thread_max_overlap_[t]) {
                         thread_max_overlap_[t] = ratio;
                         thread_max_overlap_pair_[t] = {p.id[i], p.id[i]};
                     }
-                    if (used < kMeshSlots) next[used++] = {touch.body, touch.triangle, n_c, h};
+                    if (used < kMeshSlots)
+                        next[used++] = {touch.body, touch.triangle, n_c, h};
                 }
-                for (int s = 0; s < kMeshSlots; ++s) slots[s] = s < used ? next[s] : MeshContactSlot{};
+                for (int s = 0; s < kMeshSlots; ++s)
+                    slots[s] = s < used ? next[s] : MeshContactSlot{};
             }
         }
     });
     for (std::size_t b = 0; b < nb; ++b) {
-        MeshBody& body = bodies_[b];
+        MeshBody &body = bodies_[b];
         body.force_N.setZero();
         body.torque_N_m.setZero();
         for (int t = 0; t < threads; ++t) {
@@ -855,7 +904,8 @@ void DemSystem::checkOverlaps() {
             max_overlap_ratio_ = thread_max_overlap_[t];
             worst = thread_max_overlap_pair_[t];
         }
-    for (double& v : thread_max_overlap_) v = 0.0;
+    for (double &v : thread_max_overlap_)
+        v = 0.0;
     if (max_overlap_ratio_ > settings_.max_overlap_ratio) {
         std::ostringstream msg;
         msg << "= " << max_overlap_ratio_ << " of the radius"
@@ -872,26 +922,29 @@ void DemSystem::checkOverlaps() {
 
 std::size_t DemSystem::contactCount() const {
     std::size_t count = 0;
-    const auto& p = particles_;
+    const auto &p = particles_;
     for (std::size_t i = 0; i + 1 < neighbours_.first.size(); ++i)
         for (std::size_t k = neighbours_.first[i]; k < neighbours_.first[i + 1]; ++k) {
             const std::size_t j = std::size_t(neighbours_.neighbour[k]);
             const double r = p.radius[i] + p.radius[j];
-            if ((p.position[i] - p.position[j]).squaredNorm() < r * r) ++count;
+            if ((p.position[i] - p.position[j]).squaredNorm() < r * r)
+                ++count;
         }
     return count;
 }
 
 std::size_t DemSystem::wallContactCount() const {
     std::size_t count = 0;
-    for (const ContactHistory& h : plane_history_) count += h.active() ? 1 : 0;
-    for (const MeshContactSlot& s : mesh_slots_) count += s.body >= 0 ? 1 : 0;
+    for (const ContactHistory &h : plane_history_)
+        count += h.active() ? 1 : 0;
+    for (const MeshContactSlot &s : mesh_slots_)
+        count += s.body >= 0 ? 1 : 0;
     return count;
 }
 
 Energies DemSystem::energies() const {
     Energies e;
-    const auto& p = particles_;
+    const auto &p = particles_;
     for (std::size_t i = 0; i < p.size(); ++i) {
         e.translational_J += 0.5 * p.mass[i] * p.velocity[i].squaredNorm();
         const Mat3 rot = p.orientation[i].toRotationMatrix();
@@ -901,14 +954,16 @@ Energies DemSystem::energies() const {
     }
     // Stored elastic energy: Hertz 8/15 E* sqrt(R*) delta^(5/2) plus 1/2 k_t |delta_t|^2.
     const std::size_t nm = materials_.size();
-    auto tangential_energy = [&](const PairProperties& props, double r_eff, double overlap,
-                                 const ContactHistory& h) {
+    auto tangential_energy = [&](const PairProperties &props, double r_eff, double overlap,
+                                 const ContactHistory &h) {
         double k_t = 0.0;
-        if (const auto* lin = std::get_if<TangentialLinear>(&law_.tangential)) k_t = lin->stiffness_N_m;
-        else k_t = 8.0 * props.effective_shear_modulus_Pa * std::sqrt(r_eff * overlap);
+        if (const auto *lin = std::get_if<TangentialLinear>(&law_.tangential))
+            k_t = lin->stiffness_N_m;
+        else
+            k_t = 8.0 * props.effective_shear_modulus_Pa * std::sqrt(r_eff * overlap);
         return 0.5 * k_t * h.tangential_m.squaredNorm();
     };
-    auto hertz_energy = [](const PairProperties& props, double r_eff, double overlap) {
+    auto hertz_energy = [](const PairProperties &props, double r_eff, double overlap) {
         return 8.0 / 15.0 * props.effective_modulus_Pa * std::sqrt(r_eff) * std::pow(overlap, 2.5);
     };
     for (std::size_t i = 0; i + 1 < neighbours_.first.size(); ++i)
@@ -916,8 +971,9 @@ Energies DemSystem::energies() const {
             const std::size_t j = std::size_t(neighbours_.neighbour[k]);
             const double r_sum = p.radius[i] + p.radius[j];
             const double overlap = r_sum - (p.position[i] - p.position[j]).norm();
-            if (overlap <= 0.0) continue;
-            const PairProperties& props =
+            if (overlap <= 0.0)
+                continue;
+            const PairProperties &props =
                 pair_props_[std::size_t(p.material[i]) * nm + std::size_t(p.material[j])];
             const double r_eff = p.radius[i] * p.radius[j] / r_sum;
             e.elastic_J += hertz_energy(props, r_eff, overlap) +
@@ -927,8 +983,9 @@ Energies DemSystem::energies() const {
         for (std::size_t w = 0; w < planes_.size(); ++w) {
             const double overlap =
                 p.radius[i] - (p.position[i] - planes_[w].point_m).dot(planes_[w].normal);
-            if (overlap <= 0.0) continue;
-            const PairProperties& props = plane_props_[w][std::size_t(p.material[i])];
+            if (overlap <= 0.0)
+                continue;
+            const PairProperties &props = plane_props_[w][std::size_t(p.material[i])];
             e.elastic_J += hertz_energy(props, p.radius[i], overlap) +
                            tangential_energy(props, p.radius[i], overlap,
                                              plane_history_[i * planes_.size() + w]);
@@ -944,7 +1001,8 @@ DemSystem::Internals DemSystem::saveInternals() const {
     s.mesh_slots = mesh_slots_;
     s.reference_position = reference_position_;
     s.mesh_reference_position = mesh_reference_position_;
-    for (const MeshBody& b : bodies_) s.body_states.push_back(b.state());
+    for (const MeshBody &b : bodies_)
+        s.body_states.push_back(b.state());
     s.body_reference = body_reference_;
     s.neighbour_builds = neighbours_.buildCount();
     s.forces_valid = forces_valid_;
@@ -954,7 +1012,7 @@ DemSystem::Internals DemSystem::saveInternals() const {
     return s;
 }
 
-void DemSystem::restoreInternals(const Internals& s) {
+void DemSystem::restoreInternals(const Internals &s) {
     if (s.body_states.size() != bodies_.size())
         throw std::runtime_error("checkpoint has " + std::to_string(s.body_states.size()) +
                                  " mesh bodies, the scenario defines " +
@@ -971,7 +1029,8 @@ void DemSystem::restoreInternals(const Internals& s) {
     mesh_slots_ = s.mesh_slots;
     reference_position_ = s.reference_position;
     mesh_reference_position_ = s.mesh_reference_position;
-    for (std::size_t b = 0; b < bodies_.size(); ++b) bodies_[b].setState(s.body_states[b]);
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+        bodies_[b].setState(s.body_states[b]);
     body_reference_ = s.body_reference;
     neighbours_ = NeighbourList{};
     neighbours_.setPendingContacts(s.contacts);

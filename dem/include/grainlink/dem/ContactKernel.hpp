@@ -13,12 +13,12 @@ namespace grainlink::dem {
 struct ContactGeometry {
     Vec3 normal;
     double overlap_m;
-    double radius_eff_m;          ///< R* = r_i r_j / (r_i + r_j); r_i for walls
-    double mass_eff_kg;           ///< m* = m_i m_j / (m_i + m_j); m_i for walls
-    double arm_i_m;               ///< centre of i to contact point
-    double arm_j_m;               ///< centre of j to contact point (0 for walls)
-    Vec3 contact_velocity_m_s;    ///< velocity of i relative to j at the contact point
-    Vec3 relative_spin_rad_s;     ///< omega_i - omega_j
+    double radius_eff_m;       ///< R* = r_i r_j / (r_i + r_j); r_i for walls
+    double mass_eff_kg;        ///< m* = m_i m_j / (m_i + m_j); m_i for walls
+    double arm_i_m;            ///< centre of i to contact point
+    double arm_j_m;            ///< centre of j to contact point (0 for walls)
+    Vec3 contact_velocity_m_s; ///< velocity of i relative to j at the contact point
+    Vec3 relative_spin_rad_s;  ///< omega_i - omega_j
 };
 
 struct ContactResult {
@@ -32,9 +32,10 @@ namespace detail {
 constexpr double kSqrtFiveSixths = 0.91287092917527685576;
 
 /// Turns a history vector into the current tangent plane, keeping its length (§2.4).
-inline void rotateIntoPlane(Vec3& history, const Vec3& normal) {
+inline void rotateIntoPlane(Vec3 &history, const Vec3 &normal) {
     const double length_sq = history.squaredNorm();
-    if (length_sq == 0.0) return;
+    if (length_sq == 0.0)
+        return;
     const double along = history.dot(normal);
     history -= along * normal;
     // Rescale by 1/sqrt(1 - x), x = along^2 / length^2. Within one step the plane turns by a
@@ -49,12 +50,12 @@ inline void rotateIntoPlane(Vec3& history, const Vec3& normal) {
 } // namespace detail
 
 template <class Normal, class Damping, class Tangential, class Rolling, class Cohesion>
-inline void evaluateContact(const Damping& damping, const Tangential& tangential,
-                            const Rolling& rolling, const Cohesion& cohesion,
-                            const PairProperties& pair, const ContactGeometry& g, double dt_s,
-                            ContactHistory& history, ContactResult& out) {
+inline void evaluateContact(const Damping &damping, const Tangential &tangential,
+                            const Rolling &rolling, const Cohesion &cohesion,
+                            const PairProperties &pair, const ContactGeometry &g, double dt_s,
+                            ContactHistory &history, ContactResult &out) {
     static_assert(std::is_same_v<Normal, NormalHertz>, "only Hertz normal contact exists");
-    const Vec3& n = g.normal;
+    const Vec3 &n = g.normal;
     const double sqrt_r_delta = std::sqrt(g.radius_eff_m * g.overlap_m);
     // Hertz: S_n = dF/d(delta) = 2 E* sqrt(R* delta); F = 2/3 S_n delta (seed eq. 3).
     const double normal_stiffness = 2.0 * pair.effective_modulus_Pa * sqrt_r_delta;
@@ -64,7 +65,8 @@ inline void evaluateContact(const Damping& damping, const Tangential& tangential
     // sqrt(S_n m*) serves the restitution dashpot and, scaled, Mindlin's tangential one.
     constexpr bool kNeedsRoot = std::is_same_v<Damping, DampingRestitution> ||
                                 std::is_same_v<Tangential, TangentialMindlin>;
-    const double root_stiffness_mass = kNeedsRoot ? std::sqrt(normal_stiffness * g.mass_eff_kg) : 0.0;
+    const double root_stiffness_mass =
+        kNeedsRoot ? std::sqrt(normal_stiffness * g.mass_eff_kg) : 0.0;
     double damping_coefficient;
     if constexpr (std::is_same_v<Damping, DampingViscous>) {
         damping_coefficient = damping.coefficient_N_s_m; // seed eq. 4
@@ -139,11 +141,11 @@ inline void evaluateContact(const Damping& damping, const Tangential& tangential
 }
 
 /// Calls `body` with the concrete slot types of `law` (one std::visit per batch of contacts).
-template <class Body> inline void withConcreteLaw(const ContactLaw& law, Body&& body) {
-    std::visit(
-        [&](const auto& normal, const auto& damping, const auto& tangential, const auto& rolling,
-            const auto& cohesion) { body(normal, damping, tangential, rolling, cohesion); },
-        law.normal, law.damping, law.tangential, law.rolling, law.cohesion);
+template <class Body> inline void withConcreteLaw(const ContactLaw &law, Body &&body) {
+    std::visit([&](const auto &normal, const auto &damping, const auto &tangential,
+                   const auto &rolling,
+                   const auto &cohesion) { body(normal, damping, tangential, rolling, cohesion); },
+               law.normal, law.damping, law.tangential, law.rolling, law.cohesion);
 }
 
 } // namespace grainlink::dem

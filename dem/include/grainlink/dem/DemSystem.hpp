@@ -23,7 +23,7 @@ enum class Integrator {
 struct DemSettings {
     double time_step_s = 5e-5;
     Integrator integrator = Integrator::VelocityVerlet;
-    double newmark_beta = 0.25;  ///< beta = 0, gamma = 1/2 is velocity Verlet
+    double newmark_beta = 0.25; ///< beta = 0, gamma = 1/2 is velocity Verlet
     double newmark_gamma = 0.5;
     Vec3 gravity_m_s2 = Vec3(0.0, 0.0, -9.81);
     double skin_m = 0.0;          ///< neighbour skin; 0 picks 0.4 * smallest radius
@@ -36,8 +36,8 @@ struct DemSettings {
 /// A run stopped by a non-physical state; says where and what.
 class SimulationError : public std::runtime_error {
 public:
-    SimulationError(std::uint64_t step, ParticleId particle, const std::string& quantity,
-                    const std::string& detail);
+    SimulationError(std::uint64_t step, ParticleId particle, const std::string &quantity,
+                    const std::string &detail);
     std::uint64_t step;
     ParticleId particle;
     std::string quantity;
@@ -55,26 +55,27 @@ class DemSystem {
 public:
     DemSystem(ContactLaw law, std::vector<Material> materials, DemSettings settings);
 
-    ParticleStore& particles() { return particles_; }
-    const ParticleStore& particles() const { return particles_; }
-    const ContactLaw& law() const { return law_; }
-    const DemSettings& settings() const { return settings_; }
-    const std::vector<Material>& materials() const { return materials_; }
+    ParticleStore &particles() { return particles_; }
+    const ParticleStore &particles() const { return particles_; }
+    const ContactLaw &law() const { return law_; }
+    const DemSettings &settings() const { return settings_; }
+    const std::vector<Material> &materials() const { return materials_; }
 
     int addPlane(PlaneWall wall);
     /// Adds a mesh body; `motion`, if given, imposes its state at each step's end time.
     int addBody(MeshBody body, std::function<RigidBodyState(double)> motion = {});
-    std::vector<PlaneWall>& planes() { return planes_; }
-    const std::vector<PlaneWall>& planes() const { return planes_; }
-    MeshBody& body(int k) { return bodies_[std::size_t(k)]; }
-    const MeshBody& body(int k) const { return bodies_[std::size_t(k)]; }
+    std::vector<PlaneWall> &planes() { return planes_; }
+    const std::vector<PlaneWall> &planes() const { return planes_; }
+    MeshBody &body(int k) { return bodies_[std::size_t(k)]; }
+    const MeshBody &body(int k) const { return bodies_[std::size_t(k)]; }
     int bodyCount() const { return int(bodies_.size()); }
     /// Reaction force of the particles on plane k during the last step [N].
-    const Vec3& planeForce(int k) const { return plane_force_[std::size_t(k)]; }
+    const Vec3 &planeForce(int k) const { return plane_force_[std::size_t(k)]; }
 
     /// Builds neighbour lists and wall data now rather than at the first step (idempotent).
     void prepare() {
-        if (!initialised_) initialise();
+        if (!initialised_)
+            initialise();
     }
     /// One time step of the chosen integrator.
     void step();
@@ -91,17 +92,17 @@ public:
     /// dashpot limit m_min/k_n where one is set, 2/k_h (docs/physics.md §3.3).
     double stableTimeStepEstimate() const;
     Energies energies() const;
-    std::size_t contactCount() const;      ///< particle-particle contacts
-    std::size_t wallContactCount() const;  ///< particle-plane and particle-mesh contacts
+    std::size_t contactCount() const;     ///< particle-particle contacts
+    std::size_t wallContactCount() const; ///< particle-plane and particle-mesh contacts
     std::size_t neighbourPairs() const { return neighbours_.pairCount(); }
     std::uint64_t neighbourBuilds() const { return neighbours_.buildCount(); }
     double maxOverlapRatio() const { return max_overlap_ratio_; }
-    PhaseTimer& timer() { return timer_; }
+    PhaseTimer &timer() { return timer_; }
 
     /// Everything a checkpoint needs beyond the particle arrays (see Checkpoint.hpp).
     struct Internals;
     Internals saveInternals() const;
-    void restoreInternals(const Internals& state);
+    void restoreInternals(const Internals &state);
 
     // History of a particle's contacts with planes and meshes.
     struct MeshContactSlot {
@@ -132,10 +133,10 @@ private:
     void planeContacts();
     void meshContacts();
     void checkOverlaps();
-    void angularAcceleration(std::size_t i, Vec3& alpha) const;
+    void angularAcceleration(std::size_t i, Vec3 &alpha) const;
     Vec3 anisotropicAngularAcceleration(std::size_t i) const;
     void resizeWallHistories();
-    void permuteWallHistories(const std::vector<std::size_t>& order);
+    void permuteWallHistories(const std::vector<std::size_t> &order);
 
     DemSettings settings_;
     ContactLaw law_;
@@ -153,15 +154,15 @@ private:
     std::vector<Vec3> reference_position_;      ///< positions at the last list build
     std::vector<Vec3> mesh_reference_position_; ///< positions at the last mesh-candidate build
     std::vector<RigidBodyState> body_reference_;
-    std::vector<std::size_t> mesh_particles_;        ///< particles with mesh candidates
-    std::vector<std::size_t> mesh_candidate_first_;  ///< per entry of mesh_particles_, + end
+    std::vector<std::size_t> mesh_particles_;          ///< particles with mesh candidates
+    std::vector<std::size_t> mesh_candidate_first_;    ///< per entry of mesh_particles_, + end
     std::vector<std::pair<int, int>> mesh_candidates_; ///< (body, triangle)
-    std::vector<std::uint64_t> plane_mask_;          ///< planes within reach, bit per plane
+    std::vector<std::uint64_t> plane_mask_;            ///< planes within reach, bit per plane
     double max_displacement_sq_ = 0.0, max_mesh_displacement_sq_ = 0.0;
     bool displacement_known_ = false;
     CellGrid mesh_grid_;
-    std::vector<ContactHistory> plane_history_;  ///< [particle * planes + plane]
-    std::vector<MeshContactSlot> mesh_slots_;     ///< [particle * kMeshSlots + slot]
+    std::vector<ContactHistory> plane_history_; ///< [particle * planes + plane]
+    std::vector<MeshContactSlot> mesh_slots_;   ///< [particle * kMeshSlots + slot]
     bool candidates_stale_ = true;
     std::size_t prepared_particles_ = 0; ///< particle count the lists were built for
     std::size_t history_planes_ = 0;     ///< plane count plane_history_ is laid out for
@@ -172,9 +173,9 @@ private:
         Vec3 force_N;
         Vec3 torque_N_m;
     };
-    std::vector<std::vector<SideContribution>> side_; // [thread]
+    std::vector<std::vector<SideContribution>> side_;                       // [thread]
     std::vector<std::vector<Vec3>> thread_body_force_, thread_body_torque_; // [thread][body]
-    std::vector<std::vector<std::vector<Vec3>>> thread_triangle_force_;    // [thread][body][tri]
+    std::vector<std::vector<std::vector<Vec3>>> thread_triangle_force_;     // [thread][body][tri]
     std::vector<std::vector<Vec3>> thread_plane_force_;
     std::vector<double> thread_max_overlap_;
     std::vector<std::pair<ParticleId, ParticleId>> thread_max_overlap_pair_;

@@ -14,17 +14,19 @@ namespace grainlink::dem {
 class CellGrid {
 public:
     /// Bins `positions`; `min_cell_size_m` is the smallest admissible edge.
-    void bin(const std::vector<Vec3>& positions, double min_cell_size_m);
+    void bin(const std::vector<Vec3> &positions, double min_cell_size_m);
 
-    Eigen::Vector3i cellCoords(const Vec3& p) const;
-    int cellIndex(const Eigen::Vector3i& c) const { return (c.z() * dims_.y() + c.y()) * dims_.x() + c.x(); }
-    const Eigen::Vector3i& dims() const { return dims_; }
+    Eigen::Vector3i cellCoords(const Vec3 &p) const;
+    int cellIndex(const Eigen::Vector3i &c) const {
+        return (c.z() * dims_.y() + c.y()) * dims_.x() + c.x();
+    }
+    const Eigen::Vector3i &dims() const { return dims_; }
     double cellSize() const { return cell_size_; }
     /// Particles of cell c are cell_particles[cell_start[c] .. cell_start[c+1]).
-    const std::vector<int>& cellStart() const { return cell_start_; }
-    const std::vector<int>& cellParticles() const { return cell_particles_; }
+    const std::vector<int> &cellStart() const { return cell_start_; }
+    const std::vector<int> &cellParticles() const { return cell_particles_; }
     /// Cell index of particle i at binning time.
-    const std::vector<int>& particleCell() const { return particle_cell_; }
+    const std::vector<int> &particleCell() const { return particle_cell_; }
 
 private:
     Vec3 origin_ = Vec3::Zero();
@@ -38,11 +40,11 @@ class NeighbourList {
 public:
     /// Rebuilds from current positions and carries over histories of pairs that were in contact.
     /// `old_to_new` maps storage indices of the previous build to current ones (empty: identity).
-    void build(const std::vector<Vec3>& positions, const std::vector<double>& radii,
-               double skin_m, const std::vector<std::size_t>& old_to_new, int threads);
+    void build(const std::vector<Vec3> &positions, const std::vector<double> &radii, double skin_m,
+               const std::vector<std::size_t> &old_to_new, int threads);
 
     std::size_t pairCount() const { return neighbour.size(); }
-    const CellGrid& grid() const { return grid_; }
+    const CellGrid &grid() const { return grid_; }
     std::uint64_t buildCount() const { return builds_; }
     /// Sets the build counter (it schedules re-sorts), e.g. to continue a checkpointed run.
     void restoreBuildCount(std::uint64_t count) { builds_ = count; }
