@@ -223,17 +223,14 @@ void DemSystem::step() {
         clearForces();
         displacement_known_ = false;
         computeForces();
-        finishForces(0.0);
+        finishStep(false);
         forces_valid_ = true;
     }
     const double t_next = time() + settings_.time_step_s;
     advanceAndClear();
     moveBodies(t_next);
     computeForces();
-    if (settings_.integrator == Integrator::VelocityVerlet)
-        finishForces(0.5);
-    else
-        newmarkCorrect();
+    finishStep(true);
     ++step_;
 }
 
@@ -321,50 +318,39 @@ void DemSystem::advanceAndClear() {
     displacement_known_ = true;
 }
 
-void DemSystem::newmarkCorrect() {
+void DemSystem::finishStep(bool advance) {
+    // Adds gravity and drag, checks the forces, then (if `advance`) the second half kick of
+    // velocity Verlet or the Newmark corrector. `advance` is false at the initial evaluation.
     PhaseTimer::Scope scope(timer_, phase_.finish);
-    const double dt = settings_.time_step_s, beta = settings_.newmark_beta,
-                 gamma = settings_.newmark_gamma;
+    const bool newmark = settings_.integrator == Integrator::Newmark;
+    const double dt = settings_.time_step_s, h = 0.5 * dt;
+    const double drift_a = settings_.newmark_beta * dt * dt;
+    const double kick_a = settings_.newmark_gamma * dt;
     auto &p = particles_;
     const std::size_t n = p.size();
     std::size_t bad = n;
 #pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : bad)
     for (std::size_t i = 0; i < n; ++i) {
         addBodyForces(i);
-        if (!p.force[i].allFinite() || !p.torque[i].allFinite() || !p.position[i].allFinite())
-            bad = std::min(bad, i);
-        const Vec3 a = p.inv_mass[i] * p.force[i];
-        p.position[i] += (beta * dt * dt) * a;
-        p.velocity[i] += (gamma * dt) * a;
-        Vec3 alpha;
-        angularAcceleration(i, alpha);
-        rotate(p.orientation[i], (beta * dt * dt) * alpha);
-        p.angular_velocity[i] += (gamma * dt) * alpha;
-    }
-    if (bad < n)
-        reportNonFinite(bad);
-}
-
-void DemSystem::finishForces(double kick_fraction) {
-    PhaseTimer::Scope scope(timer_, phase_.finish);
-    const double h = kick_fraction * settings_.time_step_s;
-    auto &p = particles_;
-    const std::size_t n = p.size();
-    std::size_t bad = n;
-#pragma omp parallel for schedule(static) num_threads(settings_.threads) reduction(min : bad)
-    for (std::size_t i = 0; i < n; ++i) {
-        addBodyForces(i);
-        // Checked before the kick: the state stays finite for the failure snapshot.
+        // Checked before any update: the state stays finite for the failure snapshot.
         if (!p.force[i].allFinite() || !p.torque[i].allFinite() || !p.position[i].allFinite()) {
             bad = std::min(bad, i);
             continue;
         }
-        if (h == 0.0)
+        if (!advance)
             continue;
-        p.velocity[i] += (h * p.inv_mass[i]) * p.force[i];
         Vec3 alpha;
         angularAcceleration(i, alpha);
-        p.angular_velocity[i] += h * alpha;
+        if (newmark) {
+            const Vec3 a = p.inv_mass[i] * p.force[i];
+            p.position[i] += drift_a * a;
+            p.velocity[i] += kick_a * a;
+            rotate(p.orientation[i], drift_a * alpha);
+            p.angular_velocity[i] += kick_a * alpha;
+        } else {
+            p.velocity[i] += (h * p.inv_mass[i]) * p.force[i];
+            p.angular_velocity[i] += h * alpha;
+        }
     }
     if (bad < n)
         reportNonFinite(bad);

@@ -118,8 +118,7 @@ private:
     void prepareWalls();
     void validateTimeStep() const;
     void advanceAndClear();
-    void newmarkCorrect();
-    void finishForces(double kick_fraction);
+    void finishStep(bool advance);
     void addBodyForces(std::size_t i);
     [[noreturn]] void reportNonFinite(std::size_t i) const;
     void clearForces();
