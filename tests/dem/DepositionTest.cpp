@@ -15,14 +15,7 @@ std::unique_ptr<DemSystem> boxSystem(const Vec3 &upper) {
     settings.time_step_s = 1e-4;
     auto sys = std::make_unique<DemSystem>(hertzRestitution(0.3, 0.5),
                                            std::vector<Material>{soil(3e6, 0.2, 2400)}, settings);
-    for (int k = 0; k < 5; ++k) { // open-top box
-        PlaneWall w;
-        w.name = "wall" + std::to_string(k);
-        w.normal = Vec3::Zero();
-        w.normal[k / 2] = (k % 2 == 0) ? 1.0 : -1.0;
-        w.point_m = (k % 2 == 0) ? Vec3::Zero() : upper;
-        sys->addPlane(w);
-    }
+    addBoxPlanes(*sys, Vec3::Zero(), upper); // the top is far above every grain
     return sys;
 }
 
