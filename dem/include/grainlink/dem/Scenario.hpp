@@ -1,6 +1,6 @@
 #pragma once
 // A DEM-only run described by one YAML file (every key in docs/scenario.md).
-#include "grainlink/dem/ConfigNode.hpp"
+#include "grainlink/config/ConfigNode.hpp"
 #include "grainlink/dem/DemSystem.hpp"
 #include "grainlink/dem/Deposition.hpp"
 
@@ -10,6 +10,10 @@
 #include <vector>
 
 namespace grainlink::dem {
+
+// The scenario reader and its tests use the strict YAML node under short names.
+using config::ConfigError;
+using config::ConfigNode;
 
 /// A stretch of constant linear and angular velocity of a prescribed body.
 struct MotionSegment {

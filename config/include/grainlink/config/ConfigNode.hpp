@@ -1,7 +1,7 @@
 #pragma once
 // Strict reading of a YAML file: every error names the file, the key path and the line, and a
 // mapping whose keys were not all read is an error (unknown key, or a unit the key does not take).
-#include "grainlink/dem/Types.hpp"
+#include <Eigen/Core>
 
 #include <yaml-cpp/yaml.h>
 
@@ -12,7 +12,9 @@
 #include <string>
 #include <vector>
 
-namespace grainlink::dem {
+namespace grainlink::config {
+
+using Vec3 = Eigen::Vector3d;
 
 class ConfigError : public std::runtime_error {
 public:
@@ -63,4 +65,4 @@ private:
     std::shared_ptr<std::set<std::string>> used_;
 };
 
-} // namespace grainlink::dem
+} // namespace grainlink::config

@@ -1,9 +1,9 @@
-#include "grainlink/dem/ConfigNode.hpp"
+#include "grainlink/config/ConfigNode.hpp"
 
 #include <cmath>
 #include <sstream>
 
-namespace grainlink::dem {
+namespace grainlink::config {
 
 namespace {
 /// "time_step_ms" and "time_step_s" share the stem "time_step": a wrong unit, not a typo.
@@ -195,4 +195,4 @@ void ConfigNode::finish() const {
     }
 }
 
-} // namespace grainlink::dem
+} // namespace grainlink::config
