@@ -1,0 +1,245 @@
+#include "Codec.hpp"
+
+#include <cmath>
+
+namespace grainlink::coupling::codec {
+
+void toWire(const Vec3 &v, pb::Vec3 *out) {
+    out->set_x(v.x());
+    out->set_y(v.y());
+    out->set_z(v.z());
+}
+
+Vec3 fromWire(const pb::Vec3 &v) {
+    return Vec3(v.x(), v.y(), v.z());
+}
+
+void toWire(const BodyDescription &body, pb::BodyDescription *out) {
+    out->set_name(body.name);
+    auto *mass = out->mutable_mass();
+    mass->set_mass_kg(body.mass.mass_kg);
+    toWire(body.mass.center_of_mass_m, mass->mutable_center_of_mass_m());
+    toWire(body.mass.inertia_diagonal_kg_m2, mass->mutable_inertia_diagonal_kg_m2());
+    toWire(body.mass.inertia_off_diagonal_kg_m2, mass->mutable_inertia_off_diagonal_kg_m2());
+    if (const auto *mesh = std::get_if<MeshGeometry>(&body.geometry)) {
+        auto *m = out->mutable_mesh();
+        for (const auto &v : mesh->vertices_m)
+            toWire(v, m->add_vertices_m());
+        for (auto i : mesh->triangles)
+            m->add_triangle_indices(i);
+    } else if (const auto *wheel = std::get_if<WheelGeometry>(&body.geometry)) {
+        auto *w = out->mutable_wheel();
+        w->set_diameter_m(wheel->diameter_m);
+        w->set_width_m(wheel->width_m);
+        w->set_rim_thickness_m(wheel->rim_thickness_m);
+        w->set_grouser_count(wheel->grouser_count);
+        w->set_grouser_height_m(wheel->grouser_height_m);
+        w->set_grouser_thickness_m(wheel->grouser_thickness_m);
+        w->set_grouser_shape(wheel->grouser_shape == GrouserShape::Chevron
+                                 ? pb::GROUSER_SHAPE_CHEVRON
+                                 : pb::GROUSER_SHAPE_STRAIGHT);
+        w->set_chevron_angle_deg(wheel->chevron_angle_deg);
+        w->set_closed_sides(wheel->closed_sides);
+    }
+}
+
+BodyDescription fromWire(const pb::BodyDescription &body) {
+    BodyDescription out;
+    out.name = body.name();
+    out.mass.mass_kg = body.mass().mass_kg();
+    out.mass.center_of_mass_m = fromWire(body.mass().center_of_mass_m());
+    out.mass.inertia_diagonal_kg_m2 = fromWire(body.mass().inertia_diagonal_kg_m2());
+    out.mass.inertia_off_diagonal_kg_m2 = fromWire(body.mass().inertia_off_diagonal_kg_m2());
+    if (body.has_mesh()) {
+        MeshGeometry mesh;
+        for (const auto &v : body.mesh().vertices_m())
+            mesh.vertices_m.push_back(fromWire(v));
+        mesh.triangles.assign(body.mesh().triangle_indices().begin(),
+                              body.mesh().triangle_indices().end());
+        if (mesh.triangles.size() % 3 != 0)
+            throw ProtocolError(pb::Error::CODE_MALFORMED,
+                                "body '" + body.name() + "': triangle index count " +
+                                    std::to_string(mesh.triangles.size()) +
+                                    " is not a multiple of 3");
+        for (auto i : mesh.triangles)
+            if (i >= mesh.vertices_m.size())
+                throw ProtocolError(pb::Error::CODE_MALFORMED,
+                                    "body '" + body.name() + "': triangle index " +
+                                        std::to_string(i) + " beyond " +
+                                        std::to_string(mesh.vertices_m.size()) + " vertices");
+        out.geometry = std::move(mesh);
+    } else if (body.has_wheel()) {
+        const auto &w = body.wheel();
+        WheelGeometry wheel;
+        wheel.diameter_m = w.diameter_m();
+        wheel.width_m = w.width_m();
+        wheel.rim_thickness_m = w.rim_thickness_m();
+        wheel.grouser_count = w.grouser_count();
+        wheel.grouser_height_m = w.grouser_height_m();
+        wheel.grouser_thickness_m = w.grouser_thickness_m();
+        wheel.grouser_shape = w.grouser_shape() == pb::GROUSER_SHAPE_CHEVRON
+                                  ? GrouserShape::Chevron
+                                  : GrouserShape::Straight;
+        wheel.chevron_angle_deg = w.chevron_angle_deg();
+        wheel.closed_sides = w.closed_sides();
+        out.geometry = wheel;
+    }
+    return out;
+}
+
+void toWire(const BodyState &state, pb::BodyState *out) {
+    out->set_body(state.body);
+    toWire(state.position_m, out->mutable_position_m());
+    auto *q = out->mutable_orientation();
+    q->set_w(state.orientation.w());
+    q->set_x(state.orientation.x());
+    q->set_y(state.orientation.y());
+    q->set_z(state.orientation.z());
+    toWire(state.linear_velocity_m_s, out->mutable_linear_velocity_m_s());
+    toWire(state.angular_velocity_rad_s, out->mutable_angular_velocity_rad_s());
+    out->set_frame(pb::FRAME_WORLD);
+}
+
+BodyState fromWire(const pb::BodyState &state) {
+    if (state.frame() != pb::FRAME_WORLD)
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "state of body '" + state.body() + "' is not in the world frame");
+    if (!state.has_orientation())
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "state of body '" + state.body() + "' has no orientation");
+    BodyState out;
+    out.body = state.body();
+    out.position_m = fromWire(state.position_m());
+    const auto &q = state.orientation();
+    out.orientation = Quat(q.w(), q.x(), q.y(), q.z());
+    const double norm = out.orientation.norm();
+    if (!(std::abs(norm - 1.0) < 1e-6))
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "orientation of body '" + state.body() +
+                                "' is not a unit quaternion (|q| = " + std::to_string(norm) + ")");
+    out.linear_velocity_m_s = fromWire(state.linear_velocity_m_s());
+    out.angular_velocity_rad_s = fromWire(state.angular_velocity_rad_s());
+    return out;
+}
+
+void toWire(const std::vector<BodyState> &states, Ticks tick, pb::BodyStates *out) {
+    out->set_tick(tick);
+    for (const auto &s : states)
+        toWire(s, out->add_states());
+}
+
+std::vector<BodyState> fromWire(const pb::BodyStates &states) {
+    std::vector<BodyState> out;
+    out.reserve(states.states_size());
+    for (const auto &s : states.states())
+        out.push_back(fromWire(s));
+    return out;
+}
+
+void toWire(const Wrench &wrench, pb::BodyWrench *out) {
+    out->set_body(wrench.body);
+    toWire(wrench.force_N, out->mutable_force_n());
+    toWire(wrench.torque_N_m, out->mutable_torque_n_m());
+    for (const auto &f : wrench.triangle_forces_N)
+        toWire(f, out->add_triangle_forces_n());
+    out->set_frame(pb::FRAME_WORLD);
+}
+
+Wrench fromWire(const pb::BodyWrench &wrench) {
+    if (wrench.frame() != pb::FRAME_WORLD)
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "wrench on body '" + wrench.body() + "' is not in the world frame");
+    Wrench out;
+    out.body = wrench.body();
+    out.force_N = fromWire(wrench.force_n());
+    out.torque_N_m = fromWire(wrench.torque_n_m());
+    for (const auto &f : wrench.triangle_forces_n())
+        out.triangle_forces_N.push_back(fromWire(f));
+    return out;
+}
+
+void toWire(const std::vector<Wrench> &wrenches, Ticks start, Ticks end, pb::BodyWrenches *out) {
+    out->set_start_tick(start);
+    out->set_end_tick(end);
+    for (const auto &w : wrenches)
+        toWire(w, out->add_wrenches());
+}
+
+std::vector<Wrench> fromWire(const pb::BodyWrenches &wrenches) {
+    std::vector<Wrench> out;
+    out.reserve(wrenches.wrenches_size());
+    for (const auto &w : wrenches.wrenches())
+        out.push_back(fromWire(w));
+    return out;
+}
+
+pb::Role toWire(Role role) {
+    return role == Role::Multibody ? pb::ROLE_MULTIBODY : pb::ROLE_SOIL;
+}
+
+Role fromWire(pb::Role role, const std::string &who) {
+    switch (role) {
+    case pb::ROLE_MULTIBODY:
+        return Role::Multibody;
+    case pb::ROLE_SOIL:
+        return Role::Soil;
+    default:
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            who + ": Hello has no role (expected multibody or soil)");
+    }
+}
+
+pb::Scheme toWire(SchemeKind scheme) {
+    switch (scheme) {
+    case SchemeKind::ExplicitSerial:
+        return pb::SCHEME_EXPLICIT_SERIAL;
+    case SchemeKind::ExplicitParallel:
+        return pb::SCHEME_EXPLICIT_PARALLEL;
+    case SchemeKind::Implicit:
+        return pb::SCHEME_IMPLICIT;
+    }
+    return pb::SCHEME_UNSPECIFIED;
+}
+
+SchemeKind fromWire(pb::Scheme scheme) {
+    switch (scheme) {
+    case pb::SCHEME_EXPLICIT_SERIAL:
+        return SchemeKind::ExplicitSerial;
+    case pb::SCHEME_EXPLICIT_PARALLEL:
+        return SchemeKind::ExplicitParallel;
+    case pb::SCHEME_IMPLICIT:
+        return SchemeKind::Implicit;
+    default:
+        throw ProtocolError(pb::Error::CODE_MALFORMED, "Welcome names no coupling scheme");
+    }
+}
+
+std::string encode(const pb::Envelope &envelope) {
+    std::string bytes;
+    envelope.SerializeToString(&bytes);
+    return bytes;
+}
+
+pb::Envelope decode(const void *data, std::size_t size, const std::string &from) {
+    pb::Envelope envelope;
+    if (!envelope.ParseFromArray(data, static_cast<int>(size)))
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "malformed message from " + from + " (" + std::to_string(size) +
+                                " bytes that are not a grainlink.v1.Envelope)");
+    if (envelope.version() != kProtocolMajor)
+        throw ProtocolError(pb::Error::CODE_VERSION_MISMATCH,
+                            from + " speaks protocol major version " +
+                                std::to_string(envelope.version()) + ", this side speaks " +
+                                std::to_string(kProtocolMajor));
+    if (envelope.body_case() == pb::Envelope::BODY_NOT_SET)
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "message from " + from + " has no body (an unset body is an error)");
+    return envelope;
+}
+
+std::string bodyName(const pb::Envelope &envelope) {
+    const auto *field = pb::Envelope::descriptor()->FindFieldByNumber(envelope.body_case());
+    return field ? field->name() : "nothing";
+}
+
+} // namespace grainlink::coupling::codec

@@ -1,0 +1,52 @@
+#pragma once
+// Conversion between the plain coupling types and the wire messages (grainlink.v1), and the
+// envelope checks every received message goes through. Internal to coupling/.
+#include "grainlink/coupling/Types.hpp"
+#include "grainlink/v1/coupling.pb.h"
+
+#include <string>
+#include <vector>
+
+namespace grainlink::coupling::codec {
+
+namespace pb = grainlink::v1;
+
+/// A received message that breaks the protocol; `code` says how.
+class ProtocolError : public CouplingError {
+public:
+    ProtocolError(pb::Error::Code code, const std::string &what)
+        : CouplingError(what), code(code) {}
+    pb::Error::Code code;
+};
+
+void toWire(const Vec3 &v, pb::Vec3 *out);
+Vec3 fromWire(const pb::Vec3 &v);
+
+void toWire(const BodyDescription &body, pb::BodyDescription *out);
+BodyDescription fromWire(const pb::BodyDescription &body);
+
+void toWire(const BodyState &state, pb::BodyState *out);
+BodyState fromWire(const pb::BodyState &state);
+void toWire(const std::vector<BodyState> &states, Ticks tick, pb::BodyStates *out);
+std::vector<BodyState> fromWire(const pb::BodyStates &states);
+
+void toWire(const Wrench &wrench, pb::BodyWrench *out);
+Wrench fromWire(const pb::BodyWrench &wrench);
+void toWire(const std::vector<Wrench> &wrenches, Ticks start, Ticks end, pb::BodyWrenches *out);
+std::vector<Wrench> fromWire(const pb::BodyWrenches &wrenches);
+
+pb::Role toWire(Role role);
+Role fromWire(pb::Role role, const std::string &who);
+pb::Scheme toWire(SchemeKind scheme);
+SchemeKind fromWire(pb::Scheme scheme);
+
+std::string encode(const pb::Envelope &envelope);
+
+/// Parses and checks an envelope: well-formed bytes, our major version, a body set.
+/// `from` names the peer in error messages.
+pb::Envelope decode(const void *data, std::size_t size, const std::string &from);
+
+/// The name of the envelope's body ("hello", "advance_to", ...), for messages.
+std::string bodyName(const pb::Envelope &envelope);
+
+} // namespace grainlink::coupling::codec
