@@ -230,10 +230,12 @@ pb::Envelope decode(const void *data, std::size_t size, const std::string &from)
         throw ProtocolError(pb::Error::CODE_VERSION_MISMATCH,
                             from + " speaks protocol major version " +
                                 std::to_string(envelope.version()) + ", this side speaks " +
-                                std::to_string(kProtocolMajor));
+                                std::to_string(kProtocolMajor),
+                            envelope.sender());
     if (envelope.body_case() == pb::Envelope::BODY_NOT_SET)
         throw ProtocolError(pb::Error::CODE_MALFORMED,
-                            "message from " + from + " has no body (an unset body is an error)");
+                            "message from " + from + " has no body (an unset body is an error)",
+                            envelope.sender());
     return envelope;
 }
 

@@ -14,9 +14,10 @@ namespace pb = grainlink::v1;
 /// A received message that breaks the protocol; `code` says how.
 class ProtocolError : public CouplingError {
 public:
-    ProtocolError(pb::Error::Code code, const std::string &what)
-        : CouplingError(what), code(code) {}
+    ProtocolError(pb::Error::Code code, const std::string &what, std::string sender = {})
+        : CouplingError(what), code(code), sender(std::move(sender)) {}
     pb::Error::Code code;
+    std::string sender; ///< the envelope's sender when the bytes parsed, else empty
 };
 
 void toWire(const Vec3 &v, pb::Vec3 *out);

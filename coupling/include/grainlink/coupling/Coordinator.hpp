@@ -1,0 +1,87 @@
+#pragma once
+// The coordinator: binds a ROUTER socket, admits the expected participants, and drives the
+// windows of the coupling scheme until the end time. Any failure stops the run everywhere and
+// is thrown as one CouplingError naming who failed, in which window, and why.
+#include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/coupling/CouplingScheme.hpp"
+#include "grainlink/coupling/Security.hpp"
+#include "grainlink/coupling/Types.hpp"
+
+#include <atomic>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlink::coupling {
+
+struct ParticipantSpec {
+    std::string name;
+    Role role = Role::Multibody;
+    std::vector<std::string> command; ///< `grainlink run` starts it with this command line
+    bool external = false;            ///< `grainlink run` waits for it to connect instead
+};
+
+struct CoordinatorConfig {
+    std::string endpoint =
+        "tcp://127.0.0.1:5555"; ///< tcp://host:port, tcp://127.0.0.1:* , ipc://, inproc://
+    bool insecure = false;      ///< allow a non-loopback endpoint without CURVE (explicit opt-in)
+    std::optional<CurveServerKeys> curve;
+    std::vector<ParticipantSpec> participants;
+    SchemeSettings scheme;
+
+    double tick_s = 1e-9;          ///< [s] the time quantum on the wire
+    double start_time_s = 0.0;     ///< [s]
+    double end_time_s = 1.0;       ///< [s]
+    double macro_step_s = 1e-3;    ///< [s] window length
+    double min_macro_step_s = 0.0; ///< [s] adaptive stepping: lower bound (0 = fixed windows)
+    double max_macro_step_s = 0.0; ///< [s] adaptive stepping: upper bound
+
+    double heartbeat_interval_s = 0.2;  ///< [s]
+    double peer_timeout_s = 5.0;        ///< [s] silence after which a participant counts as dead
+    double window_timeout_s = 600.0;    ///< [s] wall time a participant may spend on one window
+    double handshake_timeout_s = 120.0; ///< [s] wait for every participant's Hello
+
+    unsigned checkpoint_every_windows = 0; ///< 0: never
+    std::string output_directory;          ///< coupling.csv and checkpoints/; empty: no files
+    bool resume = false;                   ///< continue from output_directory/checkpoints/latest
+    double progress_interval_s = 0.0;      ///< [s] wall time between progress lines; 0: none
+};
+
+struct CoordinatorSummary {
+    std::uint64_t windows = 0;    ///< windows run by this process (not counting resumed ones)
+    std::uint64_t iterations = 0; ///< passes over windows (= windows unless implicit)
+    double end_time_s = 0.0;
+    double wall_s = 0.0;
+    double cumulative_mismatch_J = 0.0; ///< Σ (multibody work - soil work) over all windows
+    std::vector<BodyState> final_states;
+    std::vector<Wrench> final_wrenches;
+};
+
+class Coordinator {
+public:
+    /// Validates the configuration and binds the socket (so boundEndpoint() is known at once).
+    explicit Coordinator(CoordinatorConfig config);
+    ~Coordinator();
+    Coordinator(const Coordinator &) = delete;
+    Coordinator &operator=(const Coordinator &) = delete;
+
+    /// The endpoint participants connect to (a tcp port chosen by the system is filled in).
+    const std::string &boundEndpoint() const;
+    /// Runs the whole coupled run. Throws CouplingError on any failure, after telling every
+    /// participant to stop and keeping coupling.csv readable.
+    CoordinatorSummary run();
+    /// Asks a running coordinator to stop (signal handler safe); run() then throws.
+    void requestStop();
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+/// Reads a YAML file with `coupling:` and `participants:` and nothing else (docs/protocol.md).
+CoordinatorConfig loadCoordinatorConfig(const std::string &path);
+/// The same sections inside a larger document (a scenario); other keys are the caller's.
+CoordinatorConfig coordinatorConfigFrom(const config::ConfigNode &root);
+
+} // namespace grainlink::coupling

@@ -1,0 +1,55 @@
+#pragma once
+// ZeroMQ socket set-up shared by the coordinator and the participants. Internal to coupling/.
+#include "Codec.hpp"
+#include "grainlink/coupling/Security.hpp"
+
+#include <zmq.hpp>
+
+#include <chrono>
+#include <optional>
+#include <string>
+
+namespace grainlink::coupling::sockets {
+
+using Clock = std::chrono::steady_clock;
+
+/// One ZeroMQ context per process, shared by the coordinator and every participant in it, so
+/// inproc:// endpoints connect them (tests). Never terminated: sockets close themselves.
+inline zmq::context_t &processContext() {
+    static auto *context = new zmq::context_t(1);
+    return *context;
+}
+
+inline double secondsSince(Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+}
+
+inline void makeCurveClient(zmq::socket_t &socket, const CurveClientKeys &keys) {
+    socket.set(zmq::sockopt::curve_serverkey, keys.coordinator_public_key);
+    socket.set(zmq::sockopt::curve_publickey, keys.participant.public_key);
+    socket.set(zmq::sockopt::curve_secretkey, keys.participant.secret_key);
+}
+
+/// A connected DEALER (participant side); linger bounds how long unsent messages keep a process.
+inline zmq::socket_t connectDealer(zmq::context_t &context, const std::string &endpoint,
+                                   const std::optional<CurveClientKeys> &curve, int linger_ms) {
+    zmq::socket_t socket(context, zmq::socket_type::dealer);
+    socket.set(zmq::sockopt::linger, linger_ms);
+    if (curve)
+        makeCurveClient(socket, *curve);
+    socket.connect(endpoint);
+    return socket;
+}
+
+inline void send(zmq::socket_t &socket, const codec::pb::Envelope &envelope) {
+    const std::string bytes = codec::encode(envelope);
+    socket.send(zmq::buffer(bytes), zmq::send_flags::none);
+}
+
+/// Waits up to `timeout_ms` for a message; false on timeout.
+inline bool poll(zmq::socket_t &socket, long timeout_ms) {
+    zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
+    return zmq::poll(&item, 1, std::chrono::milliseconds(timeout_ms)) > 0;
+}
+
+} // namespace grainlink::coupling::sockets
