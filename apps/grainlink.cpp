@@ -1,4 +1,5 @@
 // The `grainlink` command: one binary, one subcommand per job.
+#include "CouplingCommands.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 
 #include <CLI/CLI.hpp>
@@ -21,6 +22,32 @@ int main(int argc, char **argv) {
     dem->add_flag("--resume", resume, "continue from the last checkpoint in the output directory");
     dem->add_option("--progress-interval", progress_s, "seconds between progress lines");
 
+    grainlink::apps::CoupledRunOptions coupled;
+    auto *run = app.add_subcommand(
+        "run", "run a coupled scenario: the coordinator plus the participant processes it names");
+    auto *coordinator = app.add_subcommand(
+        "coordinator", "run only the coordinator; participants connect by themselves");
+    for (auto *command : {run, coordinator}) {
+        command->add_option("config", coupled.config_path, "YAML file (keys: docs/protocol.md)")
+            ->required();
+        command->add_option("--out", coupled.output_directory,
+                            "output directory (default: out/<file name>)");
+        command->add_flag("--resume", coupled.resume,
+                          "continue from the last complete checkpoint in the output directory");
+        command->add_option("--endpoint", coupled.endpoint, "overrides coupling.endpoint");
+        command->add_flag("--insecure", coupled.insecure,
+                          "allow a non-loopback endpoint without CURVE keys");
+        command->add_option("--progress-interval", coupled.progress_interval_s,
+                            "seconds between progress lines (0: none)");
+    }
+    auto *keygen = app.add_subcommand("keygen", "make CURVE keys for a run across machines");
+    std::string key_directory;
+    std::vector<std::string> key_names;
+    keygen->add_option("directory", key_directory, "where to write the key files")->required();
+    keygen->add_option("--participants", key_names, "participant names, comma separated")
+        ->delimiter(',')
+        ->required();
+
     CLI11_PARSE(app, argc, argv);
     try {
         if (dem->parsed()) {
@@ -30,6 +57,12 @@ int main(int argc, char **argv) {
             options.resume = resume;
             options.progress_interval_s = progress_s;
             grainlink::dem::runScenario(scenario, options);
+        } else if (run->parsed()) {
+            return grainlink::apps::runCoupled(coupled);
+        } else if (coordinator->parsed()) {
+            return grainlink::apps::runCoordinator(coupled);
+        } else if (keygen->parsed()) {
+            return grainlink::apps::generateKeys(key_directory, key_names);
         }
     } catch (const std::exception &e) {
         std::fprintf(stderr, "grainlink: error: %s\n", e.what());

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <mutex>
 #include <random>
 #include <set>
 #include <sstream>
@@ -72,6 +73,8 @@ struct Coordinator::Impl {
     std::atomic<int> refused_connections{0};
     std::string last_refused_key;
     std::atomic<bool> stop_requested{false};
+    std::mutex reported_mutex;
+    std::optional<std::pair<std::string, std::string>> reported_failure;
 
     std::vector<Peer> peers;
     std::vector<std::string> body_names;
@@ -327,6 +330,14 @@ struct Coordinator::Impl {
     void checkHealth() {
         if (stop_requested)
             fail("the run", "interrupted (Ctrl-C or a stop signal)");
+        {
+            std::unique_lock<std::mutex> lock(reported_mutex);
+            if (reported_failure) {
+                const auto [who, why] = *reported_failure;
+                lock.unlock();
+                fail("participant '" + who + "'", why);
+            }
+        }
         if (!handshake_done)
             return;
         for (auto &peer : peers) {
@@ -727,6 +738,8 @@ struct Coordinator::Impl {
 Coordinator::Coordinator(CoordinatorConfig config)
     : impl_(std::make_unique<Impl>(std::move(config))) {
     auto &s = *impl_;
+    if (s.config.endpoint.empty())
+        s.config.endpoint = "tcp://127.0.0.1:5555";
     const auto &c = s.config;
     if (c.participants.empty())
         throw CouplingError("the coordinator needs at least one participant of each role");
@@ -795,6 +808,12 @@ const std::string &Coordinator::boundEndpoint() const {
 
 void Coordinator::requestStop() {
     impl_->stop_requested = true;
+}
+
+void Coordinator::reportFailure(const std::string &participant, const std::string &why) {
+    std::lock_guard<std::mutex> lock(impl_->reported_mutex);
+    if (!impl_->reported_failure)
+        impl_->reported_failure.emplace(participant, why);
 }
 
 CoordinatorSummary Coordinator::run() {

@@ -40,7 +40,7 @@ unsigned count(const ConfigNode &node, long long minimum) {
 CoordinatorConfig coordinatorConfigFrom(const ConfigNode &root) {
     CoordinatorConfig c;
     const ConfigNode coupling = root["coupling"];
-    c.endpoint = coupling.text("endpoint", c.endpoint);
+    c.endpoint = coupling.text("endpoint", ""); // empty: the command picks its default
     c.insecure = coupling.boolean("insecure", false);
     if (auto keys = coupling.optional("keys_directory"))
         c.curve = loadServerKeys(besideFile(*keys));

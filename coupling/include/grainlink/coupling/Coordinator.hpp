@@ -73,6 +73,9 @@ public:
     CoordinatorSummary run();
     /// Asks a running coordinator to stop (signal handler safe); run() then throws.
     void requestStop();
+    /// Reports, from another thread, that a participant failed outside the protocol (its
+    /// process exited); run() stops everything and throws naming it.
+    void reportFailure(const std::string &participant, const std::string &why);
 
 private:
     struct Impl;

@@ -1,0 +1,147 @@
+#include "CouplingCommands.hpp"
+
+#include "ChildProcesses.hpp"
+#include "grainlink/coupling/Coordinator.hpp"
+
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+
+namespace grainlink::apps {
+
+namespace {
+
+using coupling::Coordinator;
+using coupling::CoordinatorConfig;
+
+std::atomic<Coordinator *> running{nullptr};
+
+extern "C" void onStopSignal(int) {
+    if (Coordinator *c = running.load())
+        c->requestStop();
+}
+
+/// Ctrl-C and SIGTERM stop the run cleanly: participants are told, files stay readable.
+struct StopSignals {
+    explicit StopSignals(Coordinator &c) {
+        running = &c;
+        std::signal(SIGINT, onStopSignal);
+        std::signal(SIGTERM, onStopSignal);
+    }
+    ~StopSignals() {
+        std::signal(SIGINT, SIG_DFL);
+        std::signal(SIGTERM, SIG_DFL);
+        running = nullptr;
+    }
+};
+
+CoordinatorConfig configFor(const CoupledRunOptions &options, const char *default_endpoint) {
+    CoordinatorConfig config = coupling::loadCoordinatorConfig(options.config_path);
+    if (!options.endpoint.empty())
+        config.endpoint = options.endpoint;
+    if (config.endpoint.empty())
+        config.endpoint = default_endpoint;
+    config.insecure = config.insecure || options.insecure;
+    config.output_directory =
+        options.output_directory.empty()
+            ? "out/" + std::filesystem::path(options.config_path).stem().string()
+            : options.output_directory;
+    config.resume = options.resume;
+    config.progress_interval_s = options.progress_interval_s;
+    return config;
+}
+
+void printSummary(const coupling::CoordinatorSummary &s, const CoordinatorConfig &config) {
+    std::printf("coupling: %llu windows (%.2f passes each) to t = %.6g s in %.2f s wall; "
+                "coupling energy mismatch %.3g J\n",
+                static_cast<unsigned long long>(s.windows),
+                s.windows ? double(s.iterations) / double(s.windows) : 0.0, s.end_time_s, s.wall_s,
+                s.cumulative_mismatch_J);
+    for (std::size_t b = 0; b < s.final_states.size(); ++b) {
+        const auto &st = s.final_states[b];
+        const auto &w = s.final_wrenches[b];
+        std::printf("  %s: position (%.6g, %.6g, %.6g) m, force (%.6g, %.6g, %.6g) N\n",
+                    st.body.c_str(), st.position_m.x(), st.position_m.y(), st.position_m.z(),
+                    w.force_N.x(), w.force_N.y(), w.force_N.z());
+    }
+    std::printf("coupling: time series in %s/coupling.csv\n", config.output_directory.c_str());
+}
+
+std::string substitute(std::string text, const std::string &key, const std::string &value) {
+    for (auto at = text.find(key); at != std::string::npos; at = text.find(key, at + value.size()))
+        text.replace(at, key.size(), value);
+    return text;
+}
+
+} // namespace
+
+int runCoordinator(const CoupledRunOptions &options) {
+    const CoordinatorConfig config = configFor(options, "tcp://127.0.0.1:5555");
+    Coordinator coordinator(config);
+    std::printf("coordinator: waiting for participants at %s\n",
+                coordinator.boundEndpoint().c_str());
+    std::fflush(stdout);
+    StopSignals signals(coordinator);
+    printSummary(coordinator.run(), config);
+    return 0;
+}
+
+int runCoupled(const CoupledRunOptions &options) {
+    const CoordinatorConfig config = configFor(options, "tcp://127.0.0.1:*");
+    for (const auto &p : config.participants) {
+        if (p.external && config.endpoint.find(":*") != std::string::npos)
+            throw coupling::CouplingError("participant '" + p.name +
+                                          "' is external: give coupling.endpoint a fixed port so "
+                                          "it knows where to connect");
+        if (!p.external && p.command.empty())
+            throw coupling::CouplingError("participant '" + p.name +
+                                          "' has no command and is not marked external");
+    }
+    Coordinator coordinator(config);
+    const std::string endpoint = coordinator.boundEndpoint();
+    ChildProcesses children([&](const std::string &name, const std::string &how) {
+        coordinator.reportFailure(name, "its process " + how);
+    });
+    std::filesystem::create_directories(config.output_directory);
+    for (const auto &p : config.participants) {
+        if (p.external) {
+            std::printf("run: waiting for external participant '%s' at %s\n", p.name.c_str(),
+                        endpoint.c_str());
+            continue;
+        }
+        std::vector<std::string> argv;
+        for (const auto &arg : p.command)
+            argv.push_back(substitute(substitute(substitute(arg, "{endpoint}", endpoint), "{out}",
+                                                 config.output_directory),
+                                      "{name}", p.name));
+        children.start(p.name, argv);
+    }
+    std::fflush(stdout);
+    StopSignals signals(coordinator);
+    try {
+        const auto summary = coordinator.run();
+        const auto failed = children.stopAll(10.0);
+        printSummary(summary, config);
+        for (const auto &f : failed)
+            std::fprintf(stderr, "run: participant %s\n", f.c_str());
+        return failed.empty() ? 0 : 1;
+    } catch (...) {
+        children.stopAll(5.0);
+        throw;
+    }
+}
+
+int generateKeys(const std::string &directory, const std::vector<std::string> &participants) {
+    if (participants.empty())
+        throw coupling::CouplingError("name the participants: --participants mbs,soil");
+    coupling::writeKeyPair(directory, "coordinator", coupling::generateKeyPair());
+    for (const auto &name : participants)
+        coupling::writeKeyPair(directory, name, coupling::generateKeyPair());
+    std::printf("keygen: wrote coordinator.key/.pub and %zu participant key pairs to %s\n"
+                "keygen: the coordinator host needs coordinator.key and every <name>.pub;\n"
+                "        each participant host needs its <name>.key and coordinator.pub.\n",
+                participants.size(), directory.c_str());
+    return 0;
+}
+
+} // namespace grainlink::apps

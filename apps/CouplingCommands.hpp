@@ -1,0 +1,24 @@
+#pragma once
+// The coupling subcommands of `grainlink`: coordinator, run, keygen.
+#include <string>
+#include <vector>
+
+namespace grainlink::apps {
+
+struct CoupledRunOptions {
+    std::string config_path;
+    std::string output_directory; ///< empty: out/<file stem>
+    bool resume = false;
+    bool insecure = false;
+    std::string endpoint; ///< overrides the file's coupling.endpoint
+    double progress_interval_s = 5.0;
+};
+
+/// `grainlink coordinator`: only the coordinator; every participant is started by the user.
+int runCoordinator(const CoupledRunOptions &options);
+/// `grainlink run`: the coordinator plus the participant processes the file names.
+int runCoupled(const CoupledRunOptions &options);
+/// `grainlink keygen`: CURVE key pairs for the coordinator and each named participant.
+int generateKeys(const std::string &directory, const std::vector<std::string> &participants);
+
+} // namespace grainlink::apps
