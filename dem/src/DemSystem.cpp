@@ -141,6 +141,7 @@ void DemSystem::initialise() {
         history_planes_ != planes_.size())
         resizeWallHistories();
     body_reference_.resize(bodies_.size());
+    neighbours_.keepRollingHistory(std::holds_alternative<RollingEpsd>(law_.rolling));
     initialised_ = true;
     prepared_particles_ = n;
     if (reference_position_.size() != n)
@@ -574,6 +575,7 @@ void DemSystem::pairContacts() {
     withConcreteLaw(law_, [&](const auto &normal, const auto &damping, const auto &tangential,
                               const auto &rolling, const auto &cohesion) {
         using Normal = std::decay_t<decltype(normal)>;
+        constexpr bool kRolling = std::is_same_v<std::decay_t<decltype(rolling)>, RollingEpsd>;
 #pragma omp parallel num_threads(threads)
         {
             // Thread t owns particles [begin, end) and writes their forces directly. The
@@ -596,31 +598,47 @@ void DemSystem::pairContacts() {
             const int *__restrict material = p.material.data();
             double max_ratio = 0.0;
             std::pair<ParticleId, ParticleId> max_pair{0, 0};
-            const std::size_t *__restrict first = neighbours_.first.data();
             const int *__restrict neighbour = neighbours_.neighbour.data();
-            std::uint8_t *__restrict touching = neighbours_.touching.data();
-            ContactHistory *__restrict history = neighbours_.history.data();
-            ContactGeometry g;
-            ContactResult r;
-            for (std::size_t i = begin; i < end; ++i) {
-                const Vec3 xi = position[i];
-                const double ri = radius[i];
-                Vec3 fi = Vec3::Zero(), ti = Vec3::Zero();
-                for (std::size_t k = first[i]; k < first[i + 1]; ++k) {
+            std::uint8_t *__restrict state = neighbours_.state.data();
+            Vec3 *__restrict tangential_history = neighbours_.tangential_m.data();
+            Vec3 *__restrict rolling_history = neighbours_.rolling_N_m.data();
+            const int *__restrict owner = neighbours_.owner.data();
+            // Entries are walked in order, in batches, not row by row: rows are short (4 pairs)
+            // and of varying length, and each row's end would be a mispredicted branch.
+            constexpr std::size_t kBatch = 128;
+            std::size_t overlapping[kBatch];
+            const std::size_t k_end = neighbours_.first[end];
+            for (std::size_t k0 = neighbours_.first[begin]; k0 < k_end; k0 += kBatch) {
+                const std::size_t k1 = std::min(k0 + kBatch, k_end);
+                // 1. Which listed pairs overlap, without a branch on the answer: about half do,
+                //    unpredictably. A contact just lost drops its history.
+                std::size_t count = 0;
+                for (std::size_t k = k0; k < k1; ++k) {
+                    const std::size_t i = std::size_t(owner[k]);
                     const std::size_t j = std::size_t(neighbour[k]);
-                    const Vec3 d = xi - position[j];
-                    const double dist_sq = d.squaredNorm();
-                    const double rj = radius[j];
-                    const double r_sum = ri + rj;
-                    if (dist_sq >= r_sum * r_sum) {
-                        if (touching[k]) { // contact lost: its history lapses
-                            touching[k] = 0;
-                            history[k] = ContactHistory{};
-                        }
-                        continue;
+                    const double r_sum = radius[i] + radius[j];
+                    const unsigned overlaps =
+                        (position[i] - position[j]).squaredNorm() < r_sum * r_sum ? 1 : 0;
+                    overlapping[count] = k;
+                    count += overlaps;
+                    // One test, not two branches (the first would be unpredictable).
+                    if (state[k] & (overlaps - 1)) {
+                        state[k] = 0;
+                        tangential_history[k].setZero();
+                        if constexpr (kRolling)
+                            rolling_history[k].setZero();
                     }
-                    touching[k] = 1;
-                    const double dist = std::sqrt(dist_sq);
+                }
+                // 2. The contacts, in entry order: forces on i and j are summed in that order.
+                for (std::size_t c = 0; c < count; ++c) {
+                    const std::size_t k = overlapping[c];
+                    const std::size_t i = std::size_t(owner[k]);
+                    const std::size_t j = std::size_t(neighbour[k]);
+                    const Vec3 d = position[i] - position[j];
+                    const double dist = std::sqrt(d.squaredNorm());
+                    const double ri = radius[i], rj = radius[j];
+                    const double r_sum = ri + rj;
+                    ContactGeometry g;
                     g.normal = d * (1.0 / dist);
                     g.overlap_m = r_sum - dist;
                     g.radius_eff_m = ri * rj / r_sum;
@@ -631,12 +649,23 @@ void DemSystem::pairContacts() {
                         velocity[i] - velocity[j] -
                         (g.arm_i_m * spin[i] + g.arm_j_m * spin[j]).cross(g.normal);
                     g.relative_spin_rad_s = spin[i] - spin[j];
-                    const PairProperties &props =
-                        pair_props_[std::size_t(material[i]) * nm + std::size_t(material[j])];
-                    evaluateContact<Normal>(damping, tangential, rolling, cohesion, props, g, dt,
-                                            history[k], r);
-                    fi += r.force_on_i_N;
-                    ti += r.torque_on_i_N_m;
+                    ContactHistory h;
+                    h.tangential_m = tangential_history[k];
+                    if constexpr (kRolling)
+                        h.rolling_N_m = rolling_history[k];
+                    h.sliding = (state[k] & NeighbourList::kSliding) != 0;
+                    ContactResult r;
+                    evaluateContact<Normal>(
+                        damping, tangential, rolling, cohesion,
+                        pair_props_[std::size_t(material[i]) * nm + std::size_t(material[j])], g,
+                        dt, h, r);
+                    tangential_history[k] = h.tangential_m;
+                    if constexpr (kRolling)
+                        rolling_history[k] = h.rolling_N_m;
+                    state[k] = std::uint8_t(NeighbourList::kTouching |
+                                            (h.sliding ? NeighbourList::kSliding : 0));
+                    force[i] += r.force_on_i_N;
+                    torque[i] += r.torque_on_i_N_m;
                     if (j < end) {
                         force[j] -= r.force_on_i_N;
                         torque[j] += r.torque_on_j_N_m;
@@ -649,8 +678,6 @@ void DemSystem::pairContacts() {
                         max_pair = {p.id[i], p.id[j]};
                     }
                 }
-                force[i] += fi;
-                torque[i] += ti;
             }
             thread_max_overlap_[std::size_t(t)] = max_ratio;
             thread_max_overlap_pair_[std::size_t(t)] = max_pair;
@@ -963,7 +990,7 @@ Energies DemSystem::energies() const {
                 pair_props_[std::size_t(p.material[i]) * nm + std::size_t(p.material[j])];
             const double r_eff = p.radius[i] * p.radius[j] / r_sum;
             e.elastic_J += hertz_energy(props, r_eff, overlap) +
-                           tangential_energy(props, r_eff, overlap, neighbours_.history[k]);
+                           tangential_energy(props, r_eff, overlap, neighbours_.history(k));
         }
     for (std::size_t i = 0; i < p.size() && !plane_props_.empty(); ++i)
         for (std::size_t w = 0; w < planes_.size(); ++w) {

@@ -55,8 +55,8 @@ std::vector<NeighbourList::StoredContact> NeighbourList::activeContacts() const 
     std::vector<StoredContact> out;
     for (std::size_t i = 0; i + 1 < first.size(); ++i)
         for (std::size_t k = first[i]; k < first[i + 1]; ++k)
-            if (touching[k])
-                out.push_back({i, std::size_t(neighbour[k]), history[k]});
+            if (state[k] & kTouching)
+                out.push_back({i, std::size_t(neighbour[k]), history(k)});
     return out;
 }
 
@@ -67,17 +67,14 @@ void NeighbourList::build(const std::vector<Vec3> &positions, const std::vector<
     //    and sorted per particle, so it is merged entry by entry (step 3); otherwise the active
     //    contacts are re-indexed, oriented so that i < j, and sorted.
     const bool same_indexing = old_to_new.empty() && pending_.empty() && first.size() == n + 1;
-    std::vector<std::size_t> old_first;
-    std::vector<int> old_neighbour;
-    std::vector<ContactHistory> old_history;
-    std::vector<std::uint8_t> old_touching;
     std::vector<StoredContact> carried;
-    std::vector<std::size_t> carried_first(n + 1, 0);
+    std::vector<std::size_t> carried_first(same_indexing ? 0 : n + 1, 0);
     if (same_indexing) {
-        old_first.swap(first);
-        old_neighbour.swap(neighbour);
-        old_history.swap(history);
-        old_touching.swap(touching);
+        old_first_.swap(first);
+        old_neighbour_.swap(neighbour);
+        old_state_.swap(state);
+        old_tangential_.swap(tangential_m);
+        old_rolling_.swap(rolling_N_m);
     } else {
         carried = activeContacts();
         carried.insert(carried.end(), pending_.begin(), pending_.end());
@@ -112,8 +109,8 @@ void NeighbourList::build(const std::vector<Vec3> &positions, const std::vector<
     const auto &dims = grid_.dims();
 
     threads = std::max(1, threads);
-    std::vector<std::vector<int>> chunk_neighbours(threads);
-    std::vector<std::vector<std::size_t>> chunk_counts(threads);
+    chunk_neighbours_.resize(std::size_t(threads));
+    chunk_counts_.resize(std::size_t(threads));
     std::vector<std::size_t> chunk_begin(threads + 1);
     for (int t = 0; t <= threads; ++t)
         chunk_begin[t] = n * std::size_t(t) / std::size_t(threads);
@@ -121,8 +118,10 @@ void NeighbourList::build(const std::vector<Vec3> &positions, const std::vector<
 #pragma omp parallel num_threads(threads)
     {
         const int t = omp_get_thread_num();
-        auto &out = chunk_neighbours[t];
-        auto &counts = chunk_counts[t];
+        auto &out = chunk_neighbours_[t];
+        auto &counts = chunk_counts_[t];
+        out.clear();
+        counts.clear();
         for (std::size_t i = chunk_begin[t]; i < chunk_begin[t + 1]; ++i) {
             const std::size_t before = out.size();
             const Eigen::Vector3i c = grid_.cellCoords(positions[i]);
@@ -159,29 +158,39 @@ void NeighbourList::build(const std::vector<Vec3> &positions, const std::vector<
     // 3. Concatenate in thread order and attach carried histories.
     first.assign(n + 1, 0);
     for (int t = 0; t < threads; ++t)
-        for (std::size_t k = 0; k < chunk_counts[t].size(); ++k)
-            first[chunk_begin[t] + k + 1] = chunk_counts[t][k];
+        for (std::size_t k = 0; k < chunk_counts_[t].size(); ++k)
+            first[chunk_begin[t] + k + 1] = chunk_counts_[t][k];
     for (std::size_t i = 0; i < n; ++i)
         first[i + 1] += first[i];
     neighbour.clear();
     neighbour.reserve(first[n]);
     for (int t = 0; t < threads; ++t)
-        neighbour.insert(neighbour.end(), chunk_neighbours[t].begin(), chunk_neighbours[t].end());
-    history.assign(neighbour.size(), ContactHistory{});
-    touching.assign(neighbour.size(), 0);
+        neighbour.insert(neighbour.end(), chunk_neighbours_[t].begin(), chunk_neighbours_[t].end());
+    const std::size_t entries = neighbour.size();
+    owner.resize(entries);
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (std::size_t i = 0; i < n; ++i)
+        std::fill(owner.begin() + std::ptrdiff_t(first[i]),
+                  owner.begin() + std::ptrdiff_t(first[i + 1]), int(i));
+    state.assign(entries, 0);
+    tangential_m.assign(entries, Vec3::Zero());
+    rolling_N_m.assign(keep_rolling_ ? entries : 0, Vec3::Zero());
     // A pair beyond the search radius cannot be in contact: its history lapses.
     if (same_indexing) {
+        const bool rolling = keep_rolling_ && old_rolling_.size() == old_state_.size();
 #pragma omp parallel for schedule(static) num_threads(threads)
         for (std::size_t i = 0; i < n; ++i) {
             std::size_t k = first[i];
-            for (std::size_t o = old_first[i]; o < old_first[i + 1]; ++o) {
-                if (!old_touching[o])
+            for (std::size_t o = old_first_[i]; o < old_first_[i + 1]; ++o) {
+                if (!(old_state_[o] & kTouching))
                     continue;
-                while (k < first[i + 1] && neighbour[k] < old_neighbour[o])
+                while (k < first[i + 1] && neighbour[k] < old_neighbour_[o])
                     ++k;
-                if (k < first[i + 1] && neighbour[k] == old_neighbour[o]) {
-                    history[k] = old_history[o];
-                    touching[k] = 1;
+                if (k < first[i + 1] && neighbour[k] == old_neighbour_[o]) {
+                    state[k] = old_state_[o];
+                    tangential_m[k] = old_tangential_[o];
+                    if (rolling)
+                        rolling_N_m[k] = old_rolling_[o];
                 }
             }
         }
@@ -191,10 +200,8 @@ void NeighbourList::build(const std::vector<Vec3> &positions, const std::vector<
                 const auto begin = neighbour.begin() + std::ptrdiff_t(first[i]);
                 const auto end = neighbour.begin() + std::ptrdiff_t(first[i + 1]);
                 const auto it = std::lower_bound(begin, end, int(carried[c].j));
-                if (it != end && *it == int(carried[c].j)) {
-                    history[std::size_t(it - neighbour.begin())] = carried[c].history;
-                    touching[std::size_t(it - neighbour.begin())] = 1;
-                }
+                if (it != end && *it == int(carried[c].j))
+                    setHistory(std::size_t(it - neighbour.begin()), carried[c].history);
             }
     }
     ++builds_;

@@ -49,13 +49,38 @@ public:
     /// Sets the build counter (it schedules re-sorts), e.g. to continue a checkpointed run.
     void restoreBuildCount(std::uint64_t count) { builds_ = count; }
 
-    /// Entries of particle i are [first[i], first[i+1]).
+    /// Keeps the rolling moment per entry (only the EPSD rolling model needs it); set before
+    /// the first build.
+    void keepRollingHistory(bool keep) { keep_rolling_ = keep; }
+    bool keepsRollingHistory() const { return keep_rolling_; }
+
+    /// Bits of `state`: the pair overlaps; its Coulomb state is sliding.
+    static constexpr std::uint8_t kTouching = 1, kSliding = 2;
+
+    // Per-entry history as parallel arrays, so that the contact loop streams only what the
+    // contact law uses (docs/physics.md §4). Entries of particle i are [first[i], first[i+1]).
     std::vector<std::size_t> first;
+    std::vector<int> owner; ///< i of each entry, so that a loop can walk entries, not rows
     std::vector<int> neighbour;
-    std::vector<ContactHistory> history;
-    /// 1 while the pair overlaps: the contact loop reads one byte, not the history, for the
-    /// many listed pairs that do not touch.
-    std::vector<std::uint8_t> touching;
+    std::vector<std::uint8_t> state; ///< kTouching | kSliding; 0 for pairs that do not touch
+    std::vector<Vec3> tangential_m;  ///< accumulated tangential displacement of i rel. to j [m]
+    std::vector<Vec3> rolling_N_m;   ///< elastic rolling moment on i [N m]; empty unless kept
+
+    /// History of entry k as one value, and back (sets kTouching).
+    ContactHistory history(std::size_t k) const {
+        ContactHistory h;
+        h.tangential_m = tangential_m[k];
+        if (keep_rolling_)
+            h.rolling_N_m = rolling_N_m[k];
+        h.sliding = (state[k] & kSliding) != 0;
+        return h;
+    }
+    void setHistory(std::size_t k, const ContactHistory &h) {
+        tangential_m[k] = h.tangential_m;
+        if (keep_rolling_)
+            rolling_N_m[k] = h.rolling_N_m;
+        state[k] = std::uint8_t(kTouching | (h.sliding ? kSliding : 0));
+    }
 
     /// Active contact histories with their particles, for checkpoints.
     struct StoredContact {
@@ -70,6 +95,14 @@ private:
     CellGrid grid_;
     std::vector<StoredContact> pending_;
     std::uint64_t builds_ = 0;
+    bool keep_rolling_ = false;
+    // The previous build's arrays and per-thread search output, kept to reuse their memory.
+    std::vector<std::size_t> old_first_;
+    std::vector<int> old_neighbour_;
+    std::vector<std::uint8_t> old_state_;
+    std::vector<Vec3> old_tangential_, old_rolling_;
+    std::vector<std::vector<int>> chunk_neighbours_;
+    std::vector<std::vector<std::size_t>> chunk_counts_;
 };
 
 } // namespace grainlink::dem
