@@ -11,11 +11,15 @@
 
 namespace grainlink::examples {
 
-/// Test hooks: misbehave at a given window, to exercise the coordinator's fault handling.
-struct Misbehaviour {
+/// Test hooks: misbehave at a given window (the coordinator's fault tests), watch the windows,
+/// or ask for another macro step (adaptive stepping).
+struct SideHooks {
     long die_at_window = -1;    ///< the process kills itself (SIGKILL) when this window opens
     long hang_at_window = -1;   ///< the model never returns from this window (heartbeats go on)
     long freeze_at_window = -1; ///< the whole process stops (SIGSTOP), heartbeats too
+    long fail_at_window = -1;   ///< reports a failure to the coordinator and gives up
+    std::function<void(std::uint64_t window)> on_window;  ///< called as each window opens
+    std::function<double(double start_s)> suggest_step_s; ///< hint sent with each window
 };
 
 inline coupling::ParticipantConfig twoMassConfig(coupling::Role side, const std::string &name,
@@ -39,7 +43,7 @@ inline coupling::ParticipantConfig twoMassConfig(coupling::Role side, const std:
 
 /// Runs one side until the coordinator ends the run; returns mass 1's (or mass 2's) final x.
 inline double runTwoMassSide(coupling::Participant &participant, const TwoMassParameters &p = {},
-                             const Misbehaviour &misbehave = {}) {
+                             const SideHooks &hooks = {}) {
     using coupling::Command;
     MassOneSide one(p);
     MassTwoSide two(p);
@@ -59,13 +63,22 @@ inline double runTwoMassSide(coupling::Participant &participant, const TwoMassPa
         case Command::Advance: {
             const auto &in = participant.inputs();
             const long window = static_cast<long>(in.window);
-            if (window == misbehave.die_at_window)
+            if (hooks.on_window)
+                hooks.on_window(in.window);
+            if (window == hooks.die_at_window)
                 std::raise(SIGKILL);
-            if (window == misbehave.freeze_at_window)
+            if (window == hooks.freeze_at_window)
                 std::raise(SIGSTOP);
-            while (window == misbehave.hang_at_window)
+            while (window == hooks.hang_at_window)
                 std::this_thread::sleep_for(std::chrono::seconds(1));
+            if (window == hooks.fail_at_window) {
+                participant.fail("simulated failure of the model");
+                throw coupling::CouplingError("simulated failure at window " +
+                                              std::to_string(window));
+            }
             coupling::WindowOutputs out;
+            if (hooks.suggest_step_s)
+                out.suggested_macro_step_s = hooks.suggest_step_s(in.start_s);
             if (is_one) {
                 if (in.restore_state)
                     one.restore();

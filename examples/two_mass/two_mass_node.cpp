@@ -11,7 +11,7 @@ int main(int argc, char **argv) {
     using namespace grainlink;
     CLI::App app{"one side of the two-mass coupling example"};
     std::string side, name, endpoint = "tcp://127.0.0.1:5555", keys;
-    examples::Misbehaviour misbehave;
+    examples::SideHooks misbehave;
     app.add_option("--side", side, "multibody (mass 1) or soil (mass 2 and the coupling spring)")
         ->required()
         ->check(CLI::IsMember({"multibody", "soil"}));
