@@ -5,8 +5,12 @@
 
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <fstream>
 #include <future>
+#include <sstream>
 #include <thread>
+#include <unistd.h>
 
 using namespace grainlink::coupling;
 using grainlink::examples::runTwoMassSide;
@@ -73,4 +77,117 @@ TEST_CASE("Networked two-mass runs equal the in-process scheme bit for bit",
                 CHECK(networked.summary.iterations == reference.total_iterations);
         }
     }
+}
+
+TEST_CASE("Adaptive stepping follows the smallest hint and lands on the end tick exactly",
+          "[coupling][coordinator]") {
+    // Nominal 10 ms windows; the soil side asks for 2.5 ms while 0.1 s <= t < 0.2 s (an impact,
+    // say). A hint shapes the window after the one it came with, so: windows 0..10 at 10 ms
+    // (0 .. 0.11 s; the hint of the window starting at 0.1 s applies from 0.11 s), then 2.5 ms
+    // windows while the hints last: 0.11 .. 0.2025 s is 37 windows, then back to 10 ms.
+    auto config = twoMassRun(SchemeKind::ExplicitSerial, "inproc://adaptive", 0.01, 0.5);
+    config.min_macro_step_s = 0.001;
+    config.max_macro_step_s = 0.01;
+    const std::string out = (std::filesystem::temp_directory_path() /
+                             ("grainlink-adaptive-" + std::to_string(::getpid())))
+                                .string();
+    config.output_directory = out;
+    Coordinator coordinator(config);
+    grainlink::examples::SideHooks hooks;
+    hooks.suggest_step_s = [](double t) { return t >= 0.1 - 1e-12 && t < 0.2 ? 0.0025 : 0.0; };
+    auto mbs = std::async(std::launch::async, [&] {
+        Participant p(twoMassConfig(Role::Multibody, "mbs", coordinator.boundEndpoint()));
+        return runTwoMassSide(p);
+    });
+    auto soil = std::async(std::launch::async, [&] {
+        Participant p(twoMassConfig(Role::Soil, "soil", coordinator.boundEndpoint()));
+        return runTwoMassSide(p, {}, hooks);
+    });
+    const auto summary = coordinator.run();
+    mbs.get();
+    soil.get();
+    CHECK(summary.end_time_s == 0.5);
+    // 11 + 37 windows to 0.2025 s, then 10 ms windows to 0.4925 s (29) and a last 7.5 ms one.
+    CHECK(summary.windows == 11 + 37 + 29 + 1);
+    std::ifstream csv(out + "/coupling.csv");
+    std::string line, last;
+    int rows = -1;
+    while (std::getline(csv, line)) {
+        last = line;
+        ++rows;
+    }
+    CHECK(rows == int(summary.windows));
+    CHECK_THAT(last, Catch::StartsWith("77,0.4925"));
+    CHECK_THAT(last, Catch::Contains(",0.5,0.0074999"));
+    std::filesystem::remove_all(out);
+}
+
+TEST_CASE("A failed run resumes from its last checkpoint and ends as if never stopped",
+          "[coupling][coordinator][checkpoint]") {
+    const std::string base = (std::filesystem::temp_directory_path() /
+                              ("grainlink-resume-" + std::to_string(::getpid())))
+                                 .string();
+    int runs = 0;
+    auto run = [&](const std::string &out, bool resume, long fail_at) {
+        // A closed inproc endpoint is released asynchronously: a new name for each run.
+        const std::string endpoint = "inproc://resume-" + std::to_string(++runs);
+        auto config = twoMassRun(SchemeKind::Implicit, endpoint, 0.01, 0.5);
+        config.output_directory = out;
+        config.checkpoint_every_windows = 10;
+        config.resume = resume;
+        Coordinator coordinator(config);
+        grainlink::examples::SideHooks hooks;
+        hooks.fail_at_window = fail_at;
+        auto mbs = std::async(std::launch::async, [&] {
+            Participant p(twoMassConfig(Role::Multibody, "mbs", coordinator.boundEndpoint()));
+            return runTwoMassSide(p);
+        });
+        auto soil = std::async(std::launch::async, [&] {
+            Participant p(twoMassConfig(Role::Soil, "soil", coordinator.boundEndpoint()));
+            return runTwoMassSide(p, {}, hooks);
+        });
+        std::string failure;
+        try {
+            coordinator.run();
+        } catch (const CouplingError &e) {
+            failure = e.what();
+        }
+        for (auto *side : {&mbs, &soil})
+            try {
+                side->get();
+            } catch (const CouplingError &) {
+            }
+        return failure;
+    };
+    // Every column but the wall time.
+    auto rows = [](const std::string &out) {
+        std::ifstream csv(out + "/coupling.csv");
+        std::vector<std::string> lines;
+        for (std::string line; std::getline(csv, line);) {
+            std::vector<std::string> cells;
+            std::stringstream ss(line);
+            for (std::string cell; std::getline(ss, cell, ',');)
+                cells.push_back(cell);
+            cells.erase(cells.begin() + 10); // wall_s
+            std::string joined;
+            for (const auto &c : cells)
+                joined += c + ",";
+            lines.push_back(joined);
+        }
+        return lines;
+    };
+    CHECK(run(base + "/straight", false, -1).empty());
+    CHECK_THAT(run(base + "/broken", false, 35),
+               Catch::StartsWith("participant 'soil' failed in window 35"));
+    std::ifstream latest(base + "/broken/checkpoints/latest");
+    std::string name;
+    latest >> name;
+    CHECK(name == "window_000000030");
+    CHECK(rows(base + "/broken").size() >= 31); // rows up to the failure stay readable
+    CHECK(run(base + "/broken", true, -1).empty());
+    const auto straight = rows(base + "/straight");
+    const auto resumed = rows(base + "/broken");
+    CHECK(straight.size() == 51);
+    CHECK(resumed == straight); // bit-identical: same numbers printed with 17 digits
+    std::filesystem::remove_all(base);
 }

@@ -1,0 +1,160 @@
+// The participant lifecycle is enforced with messages that say what to do, and outputs are
+// checked before they leave; CURVE keys admit exactly the participants that hold them.
+#include "TwoMassParticipant.hpp"
+#include "grainlink/coupling/Coordinator.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <future>
+#include <unistd.h>
+
+using namespace grainlink::coupling;
+using grainlink::examples::runTwoMassSide;
+using grainlink::examples::twoMassConfig;
+
+namespace {
+
+CoordinatorConfig smallRun(double end_s = 0.05) {
+    CoordinatorConfig c;
+    c.endpoint = "tcp://127.0.0.1:*";
+    c.participants = {{"mbs", Role::Multibody, {}, false}, {"soil", Role::Soil, {}, false}};
+    c.macro_step_s = 0.01;
+    c.end_time_s = end_s;
+    c.handshake_timeout_s = 10.0;
+    return c;
+}
+
+/// A fresh directory per test process (ctest runs test cases in parallel processes).
+std::string scratch(const std::string &name) {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("grainlink-coupling-" + std::to_string(::getpid())) / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir.string();
+}
+
+} // namespace
+
+TEST_CASE("Calls out of lifecycle order say what to do", "[coupling][participant]") {
+    Participant p(twoMassConfig(Role::Soil, "soil", "tcp://127.0.0.1:1"));
+    CHECK(p.state() == Participant::State::Created);
+    CHECK_THROWS_WITH(p.waitForCommand(), "participant 'soil': waitForCommand() called in state "
+                                          "'created'; call initialize() first");
+    CHECK_THROWS_WITH(p.advance(), "participant 'soil': advance() called in state 'created'; "
+                                   "call initialize() first");
+    CHECK_THROWS_AS(p.inputs(), LifecycleError);
+    CHECK_THROWS_WITH(p.finalize(), Catch::Contains("finalize once waitForCommand() returned "
+                                                    "Command::Finish"));
+}
+
+TEST_CASE("Inside a window: outputs before advance, only for the participant's bodies",
+          "[coupling][participant]") {
+    Coordinator coordinator(smallRun());
+    auto run = std::async(std::launch::async, [&] { return coordinator.run(); });
+    auto mbs = std::async(std::launch::async, [endpoint = coordinator.boundEndpoint()] {
+        Participant p(twoMassConfig(Role::Multibody, "mbs", endpoint));
+        return runTwoMassSide(p);
+    });
+    Participant soil(twoMassConfig(Role::Soil, "soil", coordinator.boundEndpoint()));
+    const auto &info = soil.initialize();
+    CHECK(info.bodies.size() == 1);
+    CHECK(info.bodies[0].name == "mass1");
+    CHECK(info.end_tick == 50'000'000);
+    REQUIRE(soil.waitForCommand() == Command::Advance);
+    CHECK(soil.inputs().end_states.at(0).body == "mass1");
+    CHECK_THROWS_WITH(soil.waitForCommand(),
+                      Catch::EndsWith("write this window's outputs with writeOutputs(), then "
+                                      "call advance()"));
+    CHECK_THROWS_WITH(soil.advance(), Catch::Contains("write this window's outputs"));
+    WindowOutputs wrong;
+    wrong.wrenches = {Wrench{"wheel", Vec3::Zero(), Vec3::Zero(), {}}};
+    CHECK_THROWS_WITH(soil.writeOutputs(wrong),
+                      "participant 'soil': writeOutputs() got wrenches for { wheel } but must "
+                      "give exactly one for each of { mass1 }");
+    WindowOutputs nan;
+    nan.wrenches = {Wrench{"mass1", Vec3(NAN, 0, 0), Vec3::Zero(), {}}};
+    CHECK_THROWS_WITH(soil.writeOutputs(nan), "participant 'soil': non-finite wrench on body "
+                                              "'mass1' in window 0");
+    // Then behave: zero force for every window until the end.
+    for (Command c = Command::Advance; c != Command::Finish; c = soil.waitForCommand()) {
+        WindowOutputs out;
+        out.wrenches = {Wrench{"mass1", Vec3::Zero(), Vec3::Zero(), {}}};
+        soil.writeOutputs(out);
+        CHECK_THROWS_AS(soil.writeOutputs(out), LifecycleError);
+        soil.advance();
+    }
+    soil.finalize();
+    CHECK(soil.state() == Participant::State::Finalized);
+    CHECK(run.get().windows == 5);
+    mbs.get();
+}
+
+TEST_CASE("CURVE: keyed participants run, a wrong key is refused and named",
+          "[coupling][security]") {
+    if (!curveAvailable()) {
+        WARN("libzmq without CURVE: skipped");
+        return;
+    }
+    const std::string keys = scratch("keys");
+    writeKeyPair(keys, "coordinator", generateKeyPair());
+    writeKeyPair(keys, "mbs", generateKeyPair());
+    writeKeyPair(keys, "soil", generateKeyPair());
+    CHECK_THROWS_WITH(writeKeyPair(keys, "mbs", generateKeyPair()),
+                      Catch::EndsWith("mbs.key exists; remove it first to make a new key"));
+    auto config = smallRun();
+    config.curve = loadServerKeys(keys);
+    CHECK(config.curve->allowed_participants.size() == 2);
+
+    auto side = [&keys](Role role, const char *name, const std::string &endpoint,
+                        const std::string &key_directory) {
+        return std::async(std::launch::async, [=] {
+            auto c = twoMassConfig(role, name, endpoint);
+            c.curve = loadClientKeys(key_directory, name);
+            c.handshake_timeout_s = 4.0;
+            Participant p(c);
+            return runTwoMassSide(p);
+        });
+    };
+    SECTION("both hold the right keys") {
+        Coordinator coordinator(config);
+        auto mbs = side(Role::Multibody, "mbs", coordinator.boundEndpoint(), keys);
+        auto soil = side(Role::Soil, "soil", coordinator.boundEndpoint(), keys);
+        CHECK(coordinator.run().windows == 5);
+        mbs.get();
+        soil.get();
+    }
+    SECTION("the soil side holds a key the coordinator does not know") {
+        const std::string other = scratch("other-keys");
+        std::filesystem::copy(keys + "/coordinator.pub", other + "/coordinator.pub");
+        writeKeyPair(other, "soil", generateKeyPair());
+        config.handshake_timeout_s = 2.0;
+        Coordinator coordinator(config);
+        auto mbs = side(Role::Multibody, "mbs", coordinator.boundEndpoint(), keys);
+        auto soil = side(Role::Soil, "soil", coordinator.boundEndpoint(), other);
+        std::string failure;
+        try {
+            coordinator.run();
+        } catch (const CouplingError &e) {
+            failure = e.what();
+        }
+        CHECK_THAT(failure, Catch::Matches("participant 'soil' failed during the handshake: did "
+                                           "not join within handshake_timeout_s = 2 s \\([0-9]+ "
+                                           "connection\\(s\\) refused by CURVE authentication.*"));
+        CHECK_THROWS_AS(soil.get(), CouplingError);
+        CHECK_THROWS_AS(mbs.get(), CouplingError);
+    }
+}
+
+TEST_CASE("Only loopback without keys, unless --insecure", "[coupling][security]") {
+    auto config = smallRun();
+    config.endpoint = "tcp://0.0.0.0:*";
+    CHECK_THROWS_WITH(Coordinator(config),
+                      "endpoint tcp://0.0.0.0:* is reachable from other machines: give CURVE "
+                      "keys (`grainlink keygen`, key `keys_directory`) or pass --insecure");
+    config.insecure = true;
+    CHECK_NOTHROW(Coordinator(config));
+    CHECK(isLocalEndpoint("ipc:///tmp/x"));
+    CHECK(isLocalEndpoint("tcp://127.0.0.1:5555"));
+    CHECK_FALSE(isLocalEndpoint("tcp://192.168.1.4:5555"));
+}
