@@ -126,7 +126,7 @@ int runCoupled(const CoupledRunOptions &options) {
             std::fprintf(stderr, "run: participant %s\n", f.c_str());
         return failed.empty() ? 0 : 1;
     } catch (...) {
-        children.stopAll(5.0);
+        children.stopAll(3.0); // a frozen process will not exit by itself
         throw;
     }
 }
