@@ -5,6 +5,7 @@
 
 #include <zmq.hpp>
 
+#include <cerrno>
 #include <chrono>
 #include <optional>
 #include <string>
@@ -46,10 +47,17 @@ inline void send(zmq::socket_t &socket, const codec::pb::Envelope &envelope) {
     socket.send(zmq::buffer(bytes), zmq::send_flags::none);
 }
 
-/// Waits up to `timeout_ms` for a message; false on timeout.
+/// Waits up to `timeout_ms` for a message; false on timeout or when a signal (Ctrl-C)
+/// interrupted the wait, so the caller can look at its stop flag.
 inline bool poll(zmq::socket_t &socket, long timeout_ms) {
     zmq::pollitem_t item{socket.handle(), 0, ZMQ_POLLIN, 0};
-    return zmq::poll(&item, 1, std::chrono::milliseconds(timeout_ms)) > 0;
+    try {
+        return zmq::poll(&item, 1, std::chrono::milliseconds(timeout_ms)) > 0;
+    } catch (const zmq::error_t &error) {
+        if (error.num() == EINTR)
+            return false;
+        throw;
+    }
 }
 
 } // namespace grainlink::coupling::sockets

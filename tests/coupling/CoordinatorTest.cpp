@@ -61,7 +61,9 @@ TEST_CASE("Networked two-mass runs equal the in-process scheme bit for bit",
     // The transport must not change a single bit: same scheme, same participants' arithmetic.
     for (auto kind :
          {SchemeKind::ExplicitSerial, SchemeKind::ExplicitParallel, SchemeKind::Implicit}) {
-        for (const char *endpoint : {"inproc://two-mass", "tcp://127.0.0.1:*"}) {
+        const std::string ipc = "ipc:///tmp/grainlink-test-" + std::to_string(::getpid());
+        for (const std::string &endpoint : {std::string("inproc://two-mass-") + schemeName(kind),
+                                            std::string("tcp://127.0.0.1:*"), ipc}) {
             auto config = twoMassRun(kind, endpoint, 0.01, 0.5);
             const auto networked = runTwoMassNetworked(config);
             // The window as the participants see it: a whole number of ticks.
