@@ -212,8 +212,10 @@ class Link:
                     socket.send(heartbeat, zmq.NOBLOCK)
                 except zmq.Again:
                     pass  # not connected yet
-                deadline = time.monotonic() + self.heartbeat_interval_s
-                while not self.stop_heartbeats.is_set() and time.monotonic() < deadline:
+                sent = time.monotonic()
+                # The interval is read each turn: the Welcome may shorten it meanwhile.
+                while (not self.stop_heartbeats.is_set()
+                       and time.monotonic() - sent < self.heartbeat_interval_s):
                     if socket.poll(50):
                         socket.recv()
                         self.last_heard = time.monotonic()
