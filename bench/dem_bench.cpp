@@ -51,9 +51,11 @@ std::unique_ptr<DemSystem> makeBenchSystem(int threads) {
     return sys;
 }
 
-std::string bedCheckpoint(const fs::path& dir) { return (dir / "bed.checkpoint").string(); }
+std::string bedCheckpoint(const fs::path &dir) {
+    return (dir / "bed.checkpoint").string();
+}
 
-int prepare(const fs::path& dir) {
+int prepare(const fs::path &dir) {
     fs::create_directories(dir);
     auto sys = makeBenchSystem(2);
     if (!fs::exists(bedCheckpoint(dir))) {
@@ -67,17 +69,18 @@ int prepare(const fs::path& dir) {
         spec.settle_kinetic_energy_J = 1e-10;
         spec.max_settle_time_s = 2.0;
         Progress progress("bench bed", 10.0);
-        const auto report = deposit(*sys, spec, [&](const DepositionReport& r) {
+        const auto report = deposit(*sys, spec, [&](const DepositionReport &r) {
             progress.update(sys->time(), r.settle_time_s / spec.max_settle_time_s,
                             sys->stepCount() * sys->particles().size());
         });
-        std::fprintf(stderr, "bed: %zu particles settled in %.2f s simulated (KE/particle %.2g J)\n",
-                     report.inserted, report.settle_time_s, report.final_kinetic_energy_per_particle_J);
+        std::fprintf(
+            stderr, "bed: %zu particles settled in %.2f s simulated (KE/particle %.2g J)\n",
+            report.inserted, report.settle_time_s, report.final_kinetic_energy_per_particle_J);
         writeCheckpoint(*sys, bedCheckpoint(dir));
     } else {
         readCheckpoint(*sys, bedCheckpoint(dir));
     }
-    const ParticleStore& p = sys->particles();
+    const ParticleStore &p = sys->particles();
     std::ofstream data(dir / "bed.data");
     data.precision(17);
     data << "grainlink settled bed for the speed benchmark\n\n"
@@ -100,10 +103,11 @@ int prepare(const fs::path& dir) {
 
 /// The cylinder's start centre, computed as bench/liggghts/run.sh does: x = 0.15, bottom 3 cm
 /// below the 99th percentile of grain tops; grains inside its start volume are removed.
-Vec3 placeCylinder(DemSystem& sys) {
-    ParticleStore& p = sys.particles();
+Vec3 placeCylinder(DemSystem &sys) {
+    ParticleStore &p = sys.particles();
     std::vector<double> tops;
-    for (std::size_t i = 0; i < p.size(); ++i) tops.push_back(p.position[i].z() + p.radius[i]);
+    for (std::size_t i = 0; i < p.size(); ++i)
+        tops.push_back(p.position[i].z() + p.radius[i]);
     std::sort(tops.begin(), tops.end());
     const Vec3 centre(0.15, 0.5 * kBoxUpper.y(),
                       tops[std::size_t(0.99 * double(tops.size())) - 1] - 0.03 + kCylinderRadius);
@@ -111,7 +115,8 @@ Vec3 placeCylinder(DemSystem& sys) {
     std::vector<std::size_t> keep;
     for (std::size_t i = 0; i < p.size(); ++i) {
         const double dx = p.position[i].x() - centre.x(), dz = p.position[i].z() - centre.z();
-        if (dx * dx + dz * dz >= reach * reach) keep.push_back(i);
+        if (dx * dx + dz * dz >= reach * reach)
+            keep.push_back(i);
     }
     ParticleStore kept;
     kept.setNextId(p.nextId());
@@ -128,7 +133,7 @@ Vec3 placeCylinder(DemSystem& sys) {
     return centre;
 }
 
-int run(const fs::path& dir, const std::string& which, int threads, std::uint64_t steps) {
+int run(const fs::path &dir, const std::string &which, int threads, std::uint64_t steps) {
     auto sys = makeBenchSystem(threads);
     {
         // Start from the exported bed at rest, as LIGGGHTS does (contact histories from zero).
@@ -149,8 +154,9 @@ int run(const fs::path& dir, const std::string& which, int threads, std::uint64_
         start.position_m = placeCylinder(*sys);
         start.velocity_m_s = Vec3(kSpeed, 0, 0);
         start.angular_velocity_rad_s = Vec3(0, kSpin, 0);
-        sys->addBody(MeshBody("cylinder", makeCylinder(kCylinderRadius, kCylinderWidth, 360), start),
-                     [start](double t) { return constantVelocityMotion(start, t); });
+        sys->addBody(
+            MeshBody("cylinder", makeCylinder(kCylinderRadius, kCylinderWidth, 360), start),
+            [start](double t) { return constantVelocityMotion(start, t); });
     } else if (which != "settle") {
         std::fprintf(stderr, "unknown case '%s' (settle | cylinder)\n", which.c_str());
         return 2;
@@ -163,16 +169,19 @@ int run(const fs::path& dir, const std::string& which, int threads, std::uint64_
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     const double rate = double(sys->particles().size()) * double(steps) / seconds;
     std::fprintf(stderr, "%s", sys->timer().table().c_str());
-    std::fprintf(stderr, "per particle: %.2f listed pairs, %.2f contacts; %llu list builds\n",
+    std::fprintf(stderr,
+                 "per particle: %.2f listed pairs, %.2f contacts, %.3f wall contacts; %llu list "
+                 "builds\n",
                  double(sys->neighbourPairs()) / double(sys->particles().size()),
                  double(sys->contactCount()) / double(sys->particles().size()),
+                 double(sys->wallContactCount()) / double(sys->particles().size()),
                  static_cast<unsigned long long>(sys->neighbourBuilds()));
     // Digest of the final state: variants of the code that must not change the results are
     // compared by it (FNV-1a over the bytes of positions, velocities and spins).
     std::uint64_t digest = 1469598103934665603ull;
-    for (const auto* array : {&sys->particles().position, &sys->particles().velocity,
+    for (const auto *array : {&sys->particles().position, &sys->particles().velocity,
                               &sys->particles().angular_velocity}) {
-        const auto* bytes = reinterpret_cast<const unsigned char*>(array->data());
+        const auto *bytes = reinterpret_cast<const unsigned char *>(array->data());
         for (std::size_t k = 0; k < array->size() * sizeof(Vec3); ++k)
             digest = (digest ^ bytes[k]) * 1099511628211ull;
     }
@@ -186,15 +195,18 @@ int run(const fs::path& dir, const std::string& which, int threads, std::uint64_
 
 } // namespace
 
-int main(int argc, char** argv) {
+int main(int argc, char **argv) {
     try {
         const std::string verb = argc > 1 ? argv[1] : "";
-        if (verb == "prepare" && argc == 3) return prepare(argv[2]);
+        if (verb == "prepare" && argc == 3)
+            return prepare(argv[2]);
         if (verb == "run" && (argc == 5 || argc == 6))
-            return run(argv[2], argv[3], std::stoi(argv[4]), argc == 6 ? std::stoull(argv[5]) : 2000);
-        std::fprintf(stderr, "usage: dem_bench prepare DIR | dem_bench run DIR CASE THREADS [STEPS]\n");
+            return run(argv[2], argv[3], std::stoi(argv[4]),
+                       argc == 6 ? std::stoull(argv[5]) : 2000);
+        std::fprintf(stderr,
+                     "usage: dem_bench prepare DIR | dem_bench run DIR CASE THREADS [STEPS]\n");
         return 2;
-    } catch (const std::exception& e) {
+    } catch (const std::exception &e) {
         std::fprintf(stderr, "dem_bench: error: %s\n", e.what());
         return 1;
     }

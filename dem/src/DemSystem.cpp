@@ -43,8 +43,7 @@ DemSystem::DemSystem(ContactLaw law, std::vector<Material> materials, DemSetting
                                                                  : "halfKick+drift+clearForces");
     phase_.bodies = timer_.phase("moveBodies");
     phase_.neighbours = timer_.phase("updateNeighbours");
-    phase_.contacts = timer_.phase("pairContacts");
-    phase_.walls = timer_.phase("planeContacts");
+    phase_.contacts = timer_.phase("pairContacts+planeContacts");
     phase_.meshes = timer_.phase("meshContacts");
     phase_.check = timer_.phase("checkOverlaps");
     phase_.finish = timer_.phase(
@@ -391,7 +390,6 @@ void DemSystem::moveBodies(double t_s) {
 void DemSystem::computeForces() {
     updateNeighbours();
     pairContacts();
-    planeContacts();
     meshContacts();
     checkOverlaps();
 }
@@ -483,6 +481,11 @@ void DemSystem::updatePlaneMasks() {
         }
         plane_mask_[i] = mask;
     }
+    // The same as a list of (particle, plane) in particle order, walked by the contact loop.
+    plane_candidates_.clear();
+    for (std::size_t i = 0; i < n; ++i)
+        for (std::uint64_t mask = plane_mask_[i]; mask != 0; mask &= mask - 1)
+            plane_candidates_.push_back({i, std::size_t(__builtin_ctzll(mask))});
 }
 
 void DemSystem::permuteWallHistories(const std::vector<std::size_t> &order) {
@@ -566,9 +569,10 @@ void DemSystem::rebuildMeshCandidates() {
 // Forces
 
 void DemSystem::pairContacts() {
+    // Particle-particle, then particle-plane contacts, one parallel pass.
     PhaseTimer::Scope scope(timer_, phase_.contacts);
     const int threads = settings_.threads;
-    const std::size_t n = particles_.size();
+    const std::size_t n = particles_.size(), np = planes_.size();
     const std::size_t nm = materials_.size();
     const double dt = settings_.time_step_s;
     auto &p = particles_;
@@ -606,28 +610,30 @@ void DemSystem::pairContacts() {
             // Entries are walked in order, in batches, not row by row: rows are short (4 pairs)
             // and of varying length, and each row's end would be a mispredicted branch.
             constexpr std::size_t kBatch = 128;
-            std::size_t overlapping[kBatch];
+            std::size_t overlapping[kBatch], lost[kBatch];
             const std::size_t k_end = neighbours_.first[end];
             for (std::size_t k0 = neighbours_.first[begin]; k0 < k_end; k0 += kBatch) {
                 const std::size_t k1 = std::min(k0 + kBatch, k_end);
-                // 1. Which listed pairs overlap, without a branch on the answer: about half do,
-                //    unpredictably. A contact just lost drops its history.
-                std::size_t count = 0;
+                // 1. Which listed pairs overlap, and which contacts were just lost, without a
+                //    branch on either answer: about half the pairs overlap, unpredictably.
+                std::size_t count = 0, lost_count = 0;
                 for (std::size_t k = k0; k < k1; ++k) {
                     const std::size_t i = std::size_t(owner[k]);
                     const std::size_t j = std::size_t(neighbour[k]);
                     const double r_sum = radius[i] + radius[j];
                     const unsigned overlaps =
-                        (position[i] - position[j]).squaredNorm() < r_sum * r_sum ? 1 : 0;
+                        (position[i] - position[j]).squaredNorm() < r_sum * r_sum;
                     overlapping[count] = k;
                     count += overlaps;
-                    // One test, not two branches (the first would be unpredictable).
-                    if (state[k] & (overlaps - 1)) {
-                        state[k] = 0;
-                        tangential_history[k].setZero();
-                        if constexpr (kRolling)
-                            rolling_history[k].setZero();
-                    }
+                    lost[lost_count] = k;
+                    lost_count += unsigned(state[k] != 0) & (overlaps ^ 1u);
+                }
+                // A contact just lost drops its history.
+                for (std::size_t c = 0; c < lost_count; ++c) {
+                    state[lost[c]] = 0;
+                    tangential_history[lost[c]].setZero();
+                    if constexpr (kRolling)
+                        rolling_history[lost[c]].setZero();
                 }
                 // 2. The contacts, in entry order: forces on i and j are summed in that order.
                 for (std::size_t c = 0; c < count; ++c) {
@@ -679,6 +685,51 @@ void DemSystem::pairContacts() {
                     }
                 }
             }
+            // Plane contacts of this thread's particles, in the same pass: candidates (within
+            // reach at the last rebuild) are in particle order.
+            auto &plane_force = thread_plane_force_[std::size_t(t)];
+            std::fill(plane_force.begin(), plane_force.end(), Vec3::Zero());
+            const auto by_particle = [](const PlaneCandidate &c, std::size_t i) {
+                return c.particle < i;
+            };
+            const auto c_begin = std::lower_bound(plane_candidates_.begin(),
+                                                  plane_candidates_.end(), begin, by_particle);
+            const auto c_end = std::lower_bound(c_begin, plane_candidates_.end(), end, by_particle);
+            for (auto c = c_begin; c != c_end; ++c) {
+                const std::size_t i = c->particle, w = c->plane;
+                const PlaneWall &wall = planes_[w];
+                ContactHistory &h = plane_history_[i * np + w];
+                const double ri = radius[i];
+                const double dist = (position[i] - wall.point_m).dot(wall.normal);
+                if (dist >= ri) {
+                    if (h.active())
+                        h = ContactHistory{};
+                    continue;
+                }
+                ContactGeometry g;
+                g.normal = wall.normal;
+                g.overlap_m = ri - dist;
+                g.radius_eff_m = ri;
+                g.mass_eff_kg = p.mass[i];
+                g.arm_i_m = dist;
+                g.arm_j_m = 0.0;
+                g.contact_velocity_m_s = velocity[i] - dist * spin[i].cross(g.normal);
+                g.relative_spin_rad_s = spin[i];
+                const Vec3 contact_point = position[i] - dist * wall.normal;
+                std::size_t slot = std::size_t(material[i]);
+                if (wall.track && wall.track->contains(contact_point))
+                    slot += nm;
+                ContactResult r;
+                evaluateContact<Normal>(damping, tangential, rolling, cohesion,
+                                        plane_props_[w][slot], g, dt, h, r);
+                force[i] += r.force_on_i_N;
+                torque[i] += r.torque_on_i_N_m;
+                plane_force[w] -= r.force_on_i_N;
+                if (g.overlap_m > max_ratio * ri) {
+                    max_ratio = g.overlap_m / ri;
+                    max_pair = {p.id[i], p.id[i]};
+                }
+            }
             thread_max_overlap_[std::size_t(t)] = max_ratio;
             thread_max_overlap_pair_[std::size_t(t)] = max_pair;
             if (threads > 1) {
@@ -692,69 +743,10 @@ void DemSystem::pairContacts() {
             }
         }
     });
-}
-
-void DemSystem::planeContacts() {
-    if (planes_.empty())
-        return;
-    PhaseTimer::Scope scope(timer_, phase_.walls);
-    const int threads = settings_.threads;
-    const std::size_t n = particles_.size(), np = planes_.size(), nm = materials_.size();
-    const double dt = settings_.time_step_s;
-    auto &p = particles_;
-    withConcreteLaw(law_, [&](const auto &normal, const auto &damping, const auto &tangential,
-                              const auto &rolling, const auto &cohesion) {
-        using Normal = std::decay_t<decltype(normal)>;
-#pragma omp parallel num_threads(threads)
-        {
-            const int t = omp_get_thread_num();
-            auto &plane_force = thread_plane_force_[t];
-            std::fill(plane_force.begin(), plane_force.end(), Vec3::Zero());
-            ContactGeometry g;
-            ContactResult r;
-#pragma omp for schedule(static)
-            for (std::size_t i = 0; i < n; ++i) {
-                for (std::uint64_t mask = plane_mask_[i]; mask != 0; mask &= mask - 1) {
-                    const std::size_t w = std::size_t(__builtin_ctzll(mask));
-                    const PlaneWall &wall = planes_[w];
-                    ContactHistory &h = plane_history_[i * np + w];
-                    const double dist = (p.position[i] - wall.point_m).dot(wall.normal);
-                    if (dist >= p.radius[i]) {
-                        if (h.active())
-                            h = ContactHistory{};
-                        continue;
-                    }
-                    g.normal = wall.normal;
-                    g.overlap_m = p.radius[i] - dist;
-                    g.radius_eff_m = p.radius[i];
-                    g.mass_eff_kg = p.mass[i];
-                    g.arm_i_m = dist;
-                    g.arm_j_m = 0.0;
-                    g.contact_velocity_m_s =
-                        p.velocity[i] - dist * p.angular_velocity[i].cross(g.normal);
-                    g.relative_spin_rad_s = p.angular_velocity[i];
-                    const Vec3 contact_point = p.position[i] - dist * wall.normal;
-                    std::size_t slot = std::size_t(p.material[i]);
-                    if (wall.track && wall.track->contains(contact_point))
-                        slot += nm;
-                    evaluateContact<Normal>(damping, tangential, rolling, cohesion,
-                                            plane_props_[w][slot], g, dt, h, r);
-                    p.force[i] += r.force_on_i_N;
-                    p.torque[i] += r.torque_on_i_N_m;
-                    plane_force[w] -= r.force_on_i_N;
-                    const double ratio = g.overlap_m / p.radius[i];
-                    if (ratio > thread_max_overlap_[t]) {
-                        thread_max_overlap_[t] = ratio;
-                        thread_max_overlap_pair_[t] = {p.id[i], p.id[i]};
-                    }
-                }
-            }
-        }
-    });
     for (std::size_t w = 0; w < np; ++w) {
         plane_force_[w].setZero();
         for (int t = 0; t < threads; ++t)
-            plane_force_[w] += thread_plane_force_[t][w];
+            plane_force_[w] += thread_plane_force_[std::size_t(t)][w];
     }
 }
 

@@ -49,11 +49,13 @@ inline void rotateIntoPlane(Vec3 &history, const Vec3 &normal) {
 }
 } // namespace detail
 
+// Always inlined: a call would pass the geometry through memory, and the contact loop calls it
+// from more than one place.
 template <class Normal, class Damping, class Tangential, class Rolling, class Cohesion>
-inline void evaluateContact(const Damping &damping, const Tangential &tangential,
-                            const Rolling &rolling, const Cohesion &cohesion,
-                            const PairProperties &pair, const ContactGeometry &g, double dt_s,
-                            ContactHistory &history, ContactResult &out) {
+[[gnu::always_inline]] inline void
+evaluateContact(const Damping &damping, const Tangential &tangential, const Rolling &rolling,
+                const Cohesion &cohesion, const PairProperties &pair, const ContactGeometry &g,
+                double dt_s, ContactHistory &history, ContactResult &out) {
     static_assert(std::is_same_v<Normal, NormalHertz>, "only Hertz normal contact exists");
     const Vec3 &n = g.normal;
     const double sqrt_r_delta = std::sqrt(g.radius_eff_m * g.overlap_m);

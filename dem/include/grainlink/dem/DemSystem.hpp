@@ -128,8 +128,7 @@ private:
     void updatePlaneMasks();
     void rebuildMeshCandidates();
     void computeForces();
-    void pairContacts();
-    void planeContacts();
+    void pairContacts(); ///< and plane contacts
     void meshContacts();
     void checkOverlaps();
     void angularAcceleration(std::size_t i, Vec3 &alpha) const;
@@ -157,6 +156,10 @@ private:
     std::vector<std::size_t> mesh_candidate_first_;    ///< per entry of mesh_particles_, + end
     std::vector<std::pair<int, int>> mesh_candidates_; ///< (body, triangle)
     std::vector<std::uint64_t> plane_mask_;            ///< planes within reach, bit per plane
+    struct PlaneCandidate {
+        std::size_t particle, plane;
+    };
+    std::vector<PlaneCandidate> plane_candidates_; ///< the masks as a list, in particle order
     double max_displacement_sq_ = 0.0, max_mesh_displacement_sq_ = 0.0;
     bool displacement_known_ = false;
     CellGrid mesh_grid_;
@@ -187,7 +190,7 @@ private:
     double max_overlap_ratio_ = 0.0;
     PhaseTimer timer_;
     struct PhaseIds {
-        int kick_drift, bodies, neighbours, contacts, walls, meshes, check, finish;
+        int kick_drift, bodies, neighbours, contacts, meshes, check, finish;
     } phase_{};
 };
 
