@@ -25,8 +25,8 @@ file(REMOVE_RECURSE ${OUT})
 file(MAKE_DIRECTORY ${OUT})
 
 # The Python side, and the C++ node that plays the same side, as command lists.
-set(PYTHON_MBS ${PYTHON} ${EXAMPLE} --endpoint {endpoint} --name {name}
-               --python-protocol-dir ${PROTOCOL})
+set(PYTHON_MBS_ARGS --endpoint {endpoint} --name {name} --python-protocol-dir ${PROTOCOL})
+set(PYTHON_MBS ${PYTHON} ${EXAMPLE} ${PYTHON_MBS_ARGS})
 set(CPP_MBS grainlink-two-mass-node --side multibody --name {name} --endpoint {endpoint})
 
 # Writes a two-mass run to `path`: `coupling` holds the lines under `coupling:`, mass 1 is played
