@@ -31,6 +31,7 @@ import threading
 import time
 
 import zmq
+from google.protobuf.message import DecodeError
 
 
 # --------------------------------------------------------------------------------------------
@@ -118,7 +119,7 @@ def import_protocol(directory):
         raise CouplingError(
             f"cannot import grainlink.v1.coupling_pb2 ({error}): build the project, then pass "
             "--python-protocol-dir <build>/python or put that folder in PYTHONPATH"
-        )
+        ) from None
     return coupling_pb2
 
 
@@ -181,8 +182,11 @@ class Link:
         message = self.pb.Envelope()
         try:
             message.ParseFromString(data)
-        except Exception:
-            raise CouplingError(f"malformed message from the coordinator ({len(data)} bytes)")
+        except DecodeError:
+            raise CouplingError(
+                f"malformed message from the coordinator ({len(data)} bytes that are not a "
+                "grainlink.v1.Envelope)"
+            ) from None
         if message.version != self.PROTOCOL_MAJOR:
             raise CouplingError(
                 f"the coordinator speaks protocol major version {message.version}, "
@@ -216,7 +220,7 @@ class Link:
                 # The interval is read each turn: the Welcome may shorten it meanwhile.
                 while (not self.stop_heartbeats.is_set()
                        and time.monotonic() - sent < self.heartbeat_interval_s):
-                    if socket.poll(50):
+                    if socket.poll(min(50, int(self.heartbeat_interval_s * 1000) + 1)):
                         socket.recv()
                         self.last_heard = time.monotonic()
             socket.close()
@@ -360,7 +364,9 @@ def main(argv=None, link_class=Link):
         link = link_class(pb, args.endpoint, args.name)
         run(link, body)
     except Exception as error:  # our own failures and the model's: one line, exit status 1
-        reason = str(error) if isinstance(error, CouplingError) else repr(error)
+        reason = str(error)
+        if not isinstance(error, CouplingError):
+            reason = f"{type(error).__name__}: {reason}"  # e.g. "ValueError: math domain error"
         if link and not isinstance(error, StoppedByCoordinator):
             link.fail(reason)
         print(f"{args.name}: error: participant '{args.name}': {reason}", file=sys.stderr)

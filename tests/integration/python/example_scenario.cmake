@@ -8,8 +8,8 @@ endif()
 
 set(scenario ${SOURCE}/examples/python/two_mass_python.yaml)
 file(READ ${scenario} text)
-string(REGEX REPLACE "command: \\[/usr/bin/python3[^]]*\\]"
-       "command: [grainlink-two-mass-node, --side, multibody, --name, \"{name}\", --endpoint, \"{endpoint}\"]"
+set(cpp_mbs "grainlink-two-mass-node, --side, multibody, --name, \"{name}\", --endpoint, \"{endpoint}\"")
+string(REGEX REPLACE "command: \\[/usr/bin/python3[^]]*\\]" "command: [${cpp_mbs}]"
        cpp_text "${text}")
 if(cpp_text STREQUAL text)
     message(FATAL_ERROR "${scenario}: found no Python command to replace with the C++ node")

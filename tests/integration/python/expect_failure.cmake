@@ -1,7 +1,8 @@
 # A Python participant that breaks the protocol makes `grainlink run` fail with the coordinator's
 # one line naming it, and every other participant is told to stop.
 # FAULT: wrong-version (speaks protocol major version 2) | garbage (bytes that are no Envelope in
-# place of window 5's WindowDone). EXPECT: ;-list of regular expressions the output must match.
+# place of window 5's WindowDone) | model-error (the model raises in window 5).
+# EXPECT: ;-list of regular expressions the output must match.
 include(${HERE}/common.cmake)
 if(SKIP)
     return()

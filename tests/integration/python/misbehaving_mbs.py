@@ -1,13 +1,16 @@
 #!/usr/bin/python3
 """The Python example participant made to break the protocol, for the coordinator's fault tests.
 
-    misbehaving_mbs.py --fault wrong-version ...      speaks protocol major version 2
-    misbehaving_mbs.py --fault garbage --at-window N  sends bytes that are no Envelope in place
-                                                      of window N's WindowDone
+    misbehaving_mbs.py --fault wrong-version ...        speaks protocol major version 2
+    misbehaving_mbs.py --fault garbage --at-window N    sends bytes that are no Envelope in place
+                                                        of window N's WindowDone
+    misbehaving_mbs.py --fault model-error --at-window N  the model raises in window N
+                                                          (explicit coupling: one pass a window)
 
 The other arguments go to examples/python/two_mass_multibody.py, which does all the rest.
 """
 import argparse
+import itertools
 import os
 import sys
 
@@ -37,9 +40,21 @@ def garbage_link(at_window):
     return GarbageLink
 
 
+def failing_model(at_window):
+    advance = example.MassOne.advance
+    window = itertools.count()
+
+    def failing_advance(self, window_s, force_N):
+        if next(window) == at_window:
+            raise ValueError("simulated failure of the model")
+        return advance(self, window_s, force_N)
+
+    example.MassOne.advance = failing_advance
+
+
 def main():
     parser = argparse.ArgumentParser()
-    parser.add_argument("--fault", choices=["wrong-version", "garbage"], required=True)
+    parser.add_argument("--fault", choices=["wrong-version", "garbage", "model-error"], required=True)
     parser.add_argument("--at-window", type=int, default=5)
     parser.add_argument("--python-protocol-dir")
     args, rest = parser.parse_known_args()
@@ -47,6 +62,9 @@ def main():
         rest += ["--python-protocol-dir", args.python_protocol_dir]
     if args.fault == "wrong-version":
         return example.main(rest, WrongVersionLink)
+    if args.fault == "model-error":
+        failing_model(args.at_window)
+        return example.main(rest)
     try:
         example.import_protocol(args.python_protocol_dir).Envelope().ParseFromString(GARBAGE)
         sys.exit("misbehaving_mbs: the garbage parses as an Envelope; choose other bytes")
