@@ -11,6 +11,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <random>
@@ -87,6 +88,9 @@ struct Coordinator::Impl {
     Ticks nominal_step_ticks = 0, min_step_ticks = 0, max_step_ticks = 0;
     bool handshake_done = false;
     double cumulative_mismatch_J = 0.0;
+    Ticks hint_ticks = std::numeric_limits<Ticks>::max(); ///< smallest step hint this window
+    std::vector<BodyState> resumed_states;                ///< from the checkpoint, if resuming
+    std::vector<Wrench> resumed_wrenches;
     std::unique_ptr<CouplingSeries> series;
 
     // ---------------------------------------------------------------- failures
@@ -607,8 +611,6 @@ struct Coordinator::Impl {
         }
     }
 
-    Ticks hint_ticks = std::numeric_limits<Ticks>::max();
-
     /// The next window's length: the nominal step, or with adaptive stepping the smallest hint
     /// (growing back to the nominal step when there is none), clamped; never past the end.
     Ticks nextStep() {
@@ -688,9 +690,6 @@ struct Coordinator::Impl {
         resumed_wrenches = codec::fromWire(state.wrenches());
         return directory.string();
     }
-    std::vector<BodyState> resumed_states;
-    std::vector<Wrench> resumed_wrenches;
-
     // ---------------------------------------------------------------- security
 
     void startAuthenticator(const CurveServerKeys &keys) {
