@@ -2,10 +2,37 @@
 
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 
 namespace grainlink::coupling {
+
+namespace {
+
+/// `items` (states or wrenches) rearranged into the scheme's body order: one per body.
+template <typename T>
+std::vector<T> inBodyOrder(const std::vector<T> &items, const std::vector<std::string> &bodies,
+                           const std::string &what) {
+    std::vector<T> out(bodies.size());
+    std::vector<bool> seen(bodies.size(), false);
+    for (const auto &item : items) {
+        const auto b = static_cast<std::size_t>(std::find(bodies.begin(), bodies.end(), item.body) -
+                                                bodies.begin());
+        if (b == bodies.size())
+            throw CouplingError(what + " for unknown body '" + item.body + "'");
+        if (seen[b])
+            throw CouplingError("two " + what + "s for body '" + item.body + "'");
+        seen[b] = true;
+        out[b] = item;
+    }
+    for (std::size_t b = 0; b < bodies.size(); ++b)
+        if (!seen[b])
+            throw CouplingError("no " + what + " for body '" + bodies[b] + "'");
+    return out;
+}
+
+} // namespace
 
 Eigen::VectorXd stack(const std::vector<Wrench> &wrenches) {
     Eigen::VectorXd out(6 * wrenches.size());
@@ -151,43 +178,11 @@ void CouplingScheme::finishIteration(const std::vector<Wrench> &soil_wrenches) {
 }
 
 std::vector<BodyState> CouplingScheme::ordered(const std::vector<BodyState> &states) const {
-    std::vector<BodyState> out(bodies_.size());
-    std::vector<bool> seen(bodies_.size(), false);
-    for (const auto &s : states) {
-        std::size_t b = 0;
-        while (b < bodies_.size() && bodies_[b] != s.body)
-            ++b;
-        if (b == bodies_.size())
-            throw CouplingError("state for unknown body '" + s.body + "'");
-        if (seen[b])
-            throw CouplingError("two states for body '" + s.body + "'");
-        seen[b] = true;
-        out[b] = s;
-    }
-    for (std::size_t b = 0; b < bodies_.size(); ++b)
-        if (!seen[b])
-            throw CouplingError("no state for body '" + bodies_[b] + "'");
-    return out;
+    return inBodyOrder(states, bodies_, "state");
 }
 
 std::vector<Wrench> CouplingScheme::ordered(const std::vector<Wrench> &wrenches) const {
-    std::vector<Wrench> out(bodies_.size());
-    std::vector<bool> seen(bodies_.size(), false);
-    for (const auto &w : wrenches) {
-        std::size_t b = 0;
-        while (b < bodies_.size() && bodies_[b] != w.body)
-            ++b;
-        if (b == bodies_.size())
-            throw CouplingError("wrench on unknown body '" + w.body + "'");
-        if (seen[b])
-            throw CouplingError("two wrenches on body '" + w.body + "'");
-        seen[b] = true;
-        out[b] = w;
-    }
-    for (std::size_t b = 0; b < bodies_.size(); ++b)
-        if (!seen[b])
-            throw CouplingError("no wrench on body '" + bodies_[b] + "'");
-    return out;
+    return inBodyOrder(wrenches, bodies_, "wrench");
 }
 
 std::vector<BodyState> CouplingScheme::extrapolated(double window_s) const {

@@ -1,7 +1,6 @@
 // Coordinator and participants in one test binary, talking over inproc:// and tcp://127.0.0.1:*.
-#include "grainlink/coupling/Coordinator.hpp"
+#include "CouplingFixtures.hpp"
 #include "TwoMassDriver.hpp"
-#include "TwoMassParticipant.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -13,22 +12,10 @@
 #include <unistd.h>
 
 using namespace grainlink::coupling;
-using grainlink::examples::runTwoMassSide;
-using grainlink::examples::twoMassConfig;
+using grainlink::testing::startSide;
+using grainlink::testing::twoMassRun;
 
 namespace {
-
-CoordinatorConfig twoMassRun(SchemeKind kind, const std::string &endpoint, double window_s,
-                             double end_s) {
-    CoordinatorConfig c;
-    c.endpoint = endpoint;
-    c.participants = {{"mbs", Role::Multibody, {}, false}, {"soil", Role::Soil, {}, false}};
-    c.scheme.kind = kind;
-    c.macro_step_s = window_s;
-    c.end_time_s = end_s;
-    c.handshake_timeout_s = 10;
-    return c;
-}
 
 struct Outcome {
     CoordinatorSummary summary;
@@ -39,14 +26,8 @@ struct Outcome {
 Outcome runTwoMassNetworked(const CoordinatorConfig &config) {
     Coordinator coordinator(config);
     const std::string endpoint = coordinator.boundEndpoint();
-    auto side = [endpoint](Role role, const char *name) {
-        return std::async(std::launch::async, [=] {
-            Participant p(twoMassConfig(role, name, endpoint));
-            return runTwoMassSide(p);
-        });
-    };
-    auto mbs = side(Role::Multibody, "mbs");
-    auto soil = side(Role::Soil, "soil");
+    auto mbs = startSide(Role::Multibody, endpoint);
+    auto soil = startSide(Role::Soil, endpoint);
     Outcome out;
     out.summary = coordinator.run();
     out.x1 = mbs.get();
@@ -97,14 +78,8 @@ TEST_CASE("Adaptive stepping follows the smallest hint and lands on the end tick
     Coordinator coordinator(config);
     grainlink::examples::SideHooks hooks;
     hooks.suggest_step_s = [](double t) { return t >= 0.1 - 1e-12 && t < 0.2 ? 0.0025 : 0.0; };
-    auto mbs = std::async(std::launch::async, [&] {
-        Participant p(twoMassConfig(Role::Multibody, "mbs", coordinator.boundEndpoint()));
-        return runTwoMassSide(p);
-    });
-    auto soil = std::async(std::launch::async, [&] {
-        Participant p(twoMassConfig(Role::Soil, "soil", coordinator.boundEndpoint()));
-        return runTwoMassSide(p, {}, hooks);
-    });
+    auto mbs = startSide(Role::Multibody, coordinator.boundEndpoint());
+    auto soil = startSide(Role::Soil, coordinator.boundEndpoint(), hooks);
     const auto summary = coordinator.run();
     mbs.get();
     soil.get();
@@ -140,14 +115,8 @@ TEST_CASE("A failed run resumes from its last checkpoint and ends as if never st
         Coordinator coordinator(config);
         grainlink::examples::SideHooks hooks;
         hooks.fail_at_window = fail_at;
-        auto mbs = std::async(std::launch::async, [&] {
-            Participant p(twoMassConfig(Role::Multibody, "mbs", coordinator.boundEndpoint()));
-            return runTwoMassSide(p);
-        });
-        auto soil = std::async(std::launch::async, [&] {
-            Participant p(twoMassConfig(Role::Soil, "soil", coordinator.boundEndpoint()));
-            return runTwoMassSide(p, {}, hooks);
-        });
+        auto mbs = startSide(Role::Multibody, coordinator.boundEndpoint());
+        auto soil = startSide(Role::Soil, coordinator.boundEndpoint(), hooks);
         std::string failure;
         try {
             coordinator.run();

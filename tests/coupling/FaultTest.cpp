@@ -1,8 +1,7 @@
 // Participants that break the protocol: the coordinator stops the run with one line naming who
 // and why, the well-behaved participants are told, and strangers are answered but do no harm.
+#include "CouplingFixtures.hpp"
 #include "RawPeer.hpp"
-#include "TwoMassParticipant.hpp"
-#include "grainlink/coupling/Coordinator.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -18,25 +17,16 @@ namespace pb = grainlink::v1;
 namespace {
 
 CoordinatorConfig faultRun(double end_s = 0.2) {
-    CoordinatorConfig c;
-    c.endpoint = "tcp://127.0.0.1:*";
-    c.participants = {{"mbs", Role::Multibody, {}, false}, {"soil", Role::Soil, {}, false}};
-    c.macro_step_s = 0.01;
-    c.end_time_s = end_s;
+    auto c = grainlink::testing::twoMassRun(SchemeKind::ExplicitSerial, "tcp://127.0.0.1:*", 0.01,
+                                            end_s);
     c.peer_timeout_s = 3.0;
-    c.handshake_timeout_s = 10.0;
     return c;
 }
 
 /// The multibody side on a thread; its future holds its outcome.
 std::future<double> startMultibody(const std::string &endpoint,
                                    grainlink::examples::SideHooks hooks = {}) {
-    return std::async(std::launch::async, [endpoint, hooks] {
-        auto config = twoMassConfig(Role::Multibody, "mbs", endpoint);
-        config.peer_timeout_s = 3.0;
-        Participant p(config);
-        return runTwoMassSide(p, {}, hooks);
-    });
+    return grainlink::testing::startSide(Role::Multibody, endpoint, hooks, 3.0);
 }
 
 std::string failureOf(Coordinator &coordinator) {
@@ -142,10 +132,7 @@ TEST_CASE("Strangers and a mid-run reconnect get an error; the run goes on", "[c
             running.set_value();
     };
     auto mbs = startMultibody(endpoint, hooks);
-    auto soil = std::async(std::launch::async, [endpoint] {
-        Participant p(twoMassConfig(Role::Soil, "soil", endpoint));
-        return runTwoMassSide(p);
-    });
+    auto soil = grainlink::testing::startSide(Role::Soil, endpoint);
     std::vector<pb::Error::Code> codes;
     std::thread strangers([&] {
         running.get_future().wait();
@@ -174,10 +161,7 @@ TEST_CASE("A participant that reports a failure stops the run at once", "[coupli
     grainlink::examples::SideHooks hooks;
     hooks.fail_at_window = 3;
     auto mbs = startMultibody(coordinator.boundEndpoint(), hooks);
-    auto soil = std::async(std::launch::async, [endpoint = coordinator.boundEndpoint()] {
-        Participant p(twoMassConfig(Role::Soil, "soil", endpoint));
-        return runTwoMassSide(p);
-    });
+    auto soil = grainlink::testing::startSide(Role::Soil, coordinator.boundEndpoint());
     CHECK(failureOf(coordinator) == "participant 'mbs' failed in window 3 (t = 0.03 s): "
                                     "reported: simulated failure of the model");
     CHECK_THAT(failureOf(soil), Catch::Contains("the coordinator stopped the run"));

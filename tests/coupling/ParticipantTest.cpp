@@ -1,7 +1,6 @@
 // The participant lifecycle is enforced with messages that say what to do, and outputs are
 // checked before they leave; CURVE keys admit exactly the participants that hold them.
-#include "TwoMassParticipant.hpp"
-#include "grainlink/coupling/Coordinator.hpp"
+#include "CouplingFixtures.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -16,13 +15,8 @@ using grainlink::examples::twoMassConfig;
 namespace {
 
 CoordinatorConfig smallRun(double end_s = 0.05) {
-    CoordinatorConfig c;
-    c.endpoint = "tcp://127.0.0.1:*";
-    c.participants = {{"mbs", Role::Multibody, {}, false}, {"soil", Role::Soil, {}, false}};
-    c.macro_step_s = 0.01;
-    c.end_time_s = end_s;
-    c.handshake_timeout_s = 10.0;
-    return c;
+    return grainlink::testing::twoMassRun(SchemeKind::ExplicitSerial, "tcp://127.0.0.1:*", 0.01,
+                                          end_s);
 }
 
 /// A fresh directory per test process (ctest runs test cases in parallel processes).
@@ -52,10 +46,7 @@ TEST_CASE("Inside a window: outputs before advance, only for the participant's b
           "[coupling][participant]") {
     Coordinator coordinator(smallRun());
     auto run = std::async(std::launch::async, [&] { return coordinator.run(); });
-    auto mbs = std::async(std::launch::async, [endpoint = coordinator.boundEndpoint()] {
-        Participant p(twoMassConfig(Role::Multibody, "mbs", endpoint));
-        return runTwoMassSide(p);
-    });
+    auto mbs = grainlink::testing::startSide(Role::Multibody, coordinator.boundEndpoint());
     Participant soil(twoMassConfig(Role::Soil, "soil", coordinator.boundEndpoint()));
     const auto &info = soil.initialize();
     CHECK(info.bodies.size() == 1);

@@ -1,0 +1,37 @@
+#pragma once
+// Shared set-up of the networked coupling tests: the two-mass run's coordinator configuration and
+// one side of it started on its own thread.
+#include "TwoMassParticipant.hpp"
+#include "grainlink/coupling/Coordinator.hpp"
+
+#include <future>
+#include <string>
+
+namespace grainlink::testing {
+
+inline coupling::CoordinatorConfig
+twoMassRun(coupling::SchemeKind kind, const std::string &endpoint, double window_s, double end_s) {
+    coupling::CoordinatorConfig c;
+    c.endpoint = endpoint;
+    c.participants = {{"mbs", coupling::Role::Multibody, {}, false},
+                      {"soil", coupling::Role::Soil, {}, false}};
+    c.scheme.kind = kind;
+    c.macro_step_s = window_s;
+    c.end_time_s = end_s;
+    c.handshake_timeout_s = 10;
+    return c;
+}
+
+/// One side ("mbs" multibody or "soil") running on its own thread; the future holds mass x.
+inline std::future<double> startSide(coupling::Role role, const std::string &endpoint,
+                                     examples::SideHooks hooks = {}, double peer_timeout_s = 5.0) {
+    return std::async(std::launch::async, [=] {
+        auto config = examples::twoMassConfig(
+            role, role == coupling::Role::Multibody ? "mbs" : "soil", endpoint);
+        config.peer_timeout_s = peer_timeout_s;
+        coupling::Participant p(config);
+        return examples::runTwoMassSide(p, {}, hooks);
+    });
+}
+
+} // namespace grainlink::testing
