@@ -231,7 +231,7 @@ pb::Envelope decode(const void *data, std::size_t size, const std::string &from)
                             from + " speaks protocol major version " +
                                 std::to_string(envelope.version()) + ", this side speaks " +
                                 std::to_string(kProtocolMajor),
-                            envelope.sender());
+                            envelope.sender(), envelope.version());
     if (envelope.body_case() == pb::Envelope::BODY_NOT_SET)
         throw ProtocolError(pb::Error::CODE_MALFORMED,
                             "message from " + from + " has no body (an unset body is an error)",

@@ -14,10 +14,12 @@ namespace pb = grainlink::v1;
 /// A received message that breaks the protocol; `code` says how.
 class ProtocolError : public CouplingError {
 public:
-    ProtocolError(pb::Error::Code code, const std::string &what, std::string sender = {})
-        : CouplingError(what), code(code), sender(std::move(sender)) {}
+    ProtocolError(pb::Error::Code code, const std::string &what, std::string sender = {},
+                  std::uint32_t version = 0)
+        : CouplingError(what), code(code), sender(std::move(sender)), version(version) {}
     pb::Error::Code code;
-    std::string sender; ///< the envelope's sender when the bytes parsed, else empty
+    std::string sender;        ///< the envelope's sender when the bytes parsed, else empty
+    std::uint32_t version = 0; ///< the envelope's version when the bytes parsed
 };
 
 void toWire(const Vec3 &v, pb::Vec3 *out);

@@ -32,6 +32,7 @@ struct Peer {
     ParticipantSpec spec;
     bool joined = false;
     std::string routing_id;
+    std::string heartbeat_id; ///< routing id of its heartbeat connection
     std::vector<BodyDescription> provides;
     std::vector<BodyState> initial_states;
     std::vector<std::string> consumes;
@@ -92,6 +93,13 @@ struct Coordinator::Impl {
     std::vector<BodyState> resumed_states;                ///< from the checkpoint, if resuming
     std::vector<Wrench> resumed_wrenches;
     std::unique_ptr<CouplingSeries> series;
+    const std::string heartbeat_bytes = [] {
+        pb::Envelope e;
+        e.set_version(kProtocolMajor);
+        e.set_sender("coordinator");
+        e.mutable_heartbeat();
+        return codec::encode(e);
+    }();
 
     // ---------------------------------------------------------------- failures
 
@@ -113,13 +121,20 @@ struct Coordinator::Impl {
 
     void shutdownAll(bool failure, const std::string &reason) {
         for (std::size_t p = 0; p < peers.size(); ++p) {
-            if (!peers[p].joined)
-                continue;
-            pb::Envelope e = envelopeFor(p);
+            pb::Envelope e;
+            if (peers[p].joined) {
+                e = envelopeFor(p);
+            } else { // not joined yet: its heartbeat connection (if any) hears the news
+                e.set_version(kProtocolMajor);
+                e.set_sender("coordinator");
+            }
             e.mutable_shutdown()->set_failure(failure);
             e.mutable_shutdown()->set_reason(reason);
+            const std::string &to = peers[p].joined ? peers[p].routing_id : peers[p].heartbeat_id;
+            if (to.empty())
+                continue;
             try {
-                sendRaw(peers[p].routing_id, codec::encode(e), true);
+                sendRaw(to, codec::encode(e), true);
             } catch (const zmq::error_t &) {
                 // Already gone: nothing to tell it.
             }
@@ -248,8 +263,11 @@ struct Coordinator::Impl {
         } catch (const codec::ProtocolError &error) {
             const auto p = error.sender.empty() ? std::nullopt : peerByName(error.sender);
             if (p && error.code == pb::Error::CODE_VERSION_MISMATCH) {
-                replyError(id, error.code, error.what());
-                fail("participant '" + peers[*p].spec.name + "'", error.what());
+                const std::string why =
+                    "speaks protocol major version " + std::to_string(error.version) +
+                    ", the coordinator speaks " + std::to_string(kProtocolMajor);
+                replyError(id, error.code, why);
+                fail("participant '" + peers[*p].spec.name + "'", why);
             }
             spdlog::warn("coordinator: ignored {} bytes from an unknown connection: {}",
                          payload.size(), error.what());
@@ -258,13 +276,23 @@ struct Coordinator::Impl {
         }
         const auto p = peerByName(e.sender());
         if (e.has_heartbeat()) {
-            if (p) { // answered even before it joined, so it can tell when we are gone
-                if (peers[*p].joined)
-                    peers[*p].last_seen = Clock::now();
-                try {
-                    sendRaw(id, payload.to_string(), true); // the echo tells it we are alive
-                } catch (const zmq::error_t &) {
-                }
+            if (!p)
+                return std::nullopt;
+            // The first connection that beats for a name is its heartbeat connection; beats for
+            // that name from anywhere else do not keep it alive.
+            Peer &peer = peers[*p];
+            if (peer.heartbeat_id.empty())
+                peer.heartbeat_id = id;
+            if (peer.heartbeat_id != id) {
+                spdlog::warn("coordinator: ignored a heartbeat for '{}' from a second connection",
+                             peer.spec.name);
+                return std::nullopt;
+            }
+            if (peer.joined)
+                peer.last_seen = Clock::now();
+            try { // answered even before it joined, so it can tell when we are gone
+                sendRaw(id, heartbeat_bytes, true);
+            } catch (const zmq::error_t &) {
             }
             return std::nullopt;
         }
@@ -305,6 +333,9 @@ struct Coordinator::Impl {
             fail(who, "speaks protocol major version " + std::to_string(h.protocol_major()) +
                           ", the coordinator speaks " + std::to_string(kProtocolMajor));
         }
+        if (h.participant() != e.sender())
+            fail(who, "says Hello as '" + h.participant() + "' in an envelope from '" + e.sender() +
+                          "'");
         if (e.sequence() != 1)
             fail(who,
                  "Hello must be its first message (sequence " + std::to_string(e.sequence()) + ")");
@@ -451,7 +482,8 @@ struct Coordinator::Impl {
     std::string checkpointDirectory(std::uint64_t w) const {
         char name[32];
         std::snprintf(name, sizeof name, "window_%09llu", static_cast<unsigned long long>(w));
-        return (fs::path(config.output_directory) / "checkpoints" / name).string();
+        // Absolute, so a participant started from another folder writes to the same place.
+        return fs::absolute(fs::path(config.output_directory) / "checkpoints" / name).string();
     }
 
     void welcome(const std::optional<std::string> &restore_directory) {
@@ -675,7 +707,7 @@ struct Coordinator::Impl {
         if (!(in >> name))
             throw CouplingError("cannot resume: no complete checkpoint (" + latest.string() +
                                 " is missing)");
-        const fs::path directory = latest.parent_path() / name;
+        const fs::path directory = fs::absolute(latest.parent_path() / name);
         std::ifstream state_file(directory / "coordinator.pb", std::ios::binary);
         pb::CoordinatorCheckpoint state;
         if (!state.ParseFromIstream(&state_file))

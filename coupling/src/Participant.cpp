@@ -7,6 +7,7 @@
 #include <atomic>
 #include <cmath>
 #include <filesystem>
+#include <mutex>
 #include <set>
 #include <sstream>
 #include <thread>
@@ -58,6 +59,9 @@ struct Participant::Impl {
     std::atomic<bool> stop_heartbeat{false};
     std::atomic<Clock::rep> coordinator_seen{0};
     std::atomic<bool> coordinator_heard{false};
+    std::atomic<bool> shutdown_heard{false}; ///< a Shutdown came on the heartbeat connection
+    std::mutex shutdown_mutex;
+    std::string shutdown_reason;
     std::atomic<double> heartbeat_interval_s{0.2};
     double peer_timeout_s = 5.0;
 
@@ -124,6 +128,11 @@ struct Participant::Impl {
                 received_sequence = e.sequence();
                 return e;
             }
+            if (shutdown_heard) {
+                std::lock_guard<std::mutex> lock(shutdown_mutex);
+                throw CouplingError(who() +
+                                    ": the coordinator stopped the run: " + shutdown_reason);
+            }
             // Silence counts only once the coordinator answered: it may start after us.
             if (coordinator_heard && coordinatorSilence() > peer_timeout_s) {
                 std::ostringstream os;
@@ -170,6 +179,14 @@ struct Participant::Impl {
                             zmq::message_t reply;
                             (void)beat.recv(reply, zmq::recv_flags::none);
                             noteCoordinatorAlive();
+                            // A run that fails before we joined is announced here.
+                            pb::Envelope news;
+                            if (news.ParseFromArray(reply.data(), int(reply.size())) &&
+                                news.has_shutdown()) {
+                                std::lock_guard<std::mutex> lock(shutdown_mutex);
+                                shutdown_reason = news.shutdown().reason();
+                                shutdown_heard = true;
+                            }
                         }
                     }
                 }

@@ -148,6 +148,7 @@ class Link:
         self.joined = False  # True once the Welcome came
         self.stop_heartbeats = threading.Event()
         self.heartbeat_thread = None
+        self.shutdown_reason = None  # set by the heartbeat thread
 
     def envelope(self, window, **body):
         return self.pb.Envelope(
@@ -166,6 +167,8 @@ class Link:
         start = time.monotonic()
         while not self.main.poll(50):
             now = time.monotonic()
+            if self.shutdown_reason is not None:
+                raise CouplingError(f"the coordinator stopped the run: {self.shutdown_reason}")
             # Silence counts once the coordinator has answered (it may start after us).
             if self.last_heard is not None and now - self.last_heard > self.peer_timeout_s:
                 raise CouplingError(
@@ -204,7 +207,8 @@ class Link:
 
     def start_heartbeats(self):
         """A thread that sends a Heartbeat every interval on its own connection. The coordinator
-        echoes each one: that echo is how we notice a coordinator that has gone away."""
+        answers each with its own Heartbeat: that is how we notice a coordinator that has gone
+        away."""
 
         def beat():
             socket = self.context.socket(zmq.DEALER)
@@ -221,8 +225,12 @@ class Link:
                 while (not self.stop_heartbeats.is_set()
                        and time.monotonic() - sent < self.heartbeat_interval_s):
                     if socket.poll(min(50, int(self.heartbeat_interval_s * 1000) + 1)):
-                        socket.recv()
+                        reply = self.pb.Envelope()
+                        reply.ParseFromString(socket.recv())
                         self.last_heard = time.monotonic()
+                        # A run that fails before we joined is announced on this connection.
+                        if reply.WhichOneof("body") == "shutdown":
+                            self.shutdown_reason = reply.shutdown.reason
             socket.close()
 
         self.heartbeat_thread = threading.Thread(target=beat, daemon=True)

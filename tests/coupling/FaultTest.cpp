@@ -81,7 +81,7 @@ TEST_CASE("A wrong protocol major version is refused and stops the run", "[coupl
     const std::string failure = failureOf(coordinator);
     soil.join();
     CHECK_THAT(failure, Catch::Matches("participant 'soil' failed during the handshake: .*speaks "
-                                       "protocol major version 2, this side speaks 1"));
+                                       "protocol major version 2, the coordinator speaks 1"));
     REQUIRE(reply);
     CHECK(reply->error().code() == pb::Error::CODE_VERSION_MISMATCH);
     // The multibody side either got the Shutdown or noticed the coordinator vanish.
@@ -184,4 +184,25 @@ TEST_CASE("A participant whose heartbeats stop is declared dead", "[coupling][fa
     soil.join();
     CHECK_THAT(failure, Catch::Matches("participant 'soil' failed in window 0 \\(t = 0 s\\): "
                                        "silent for 1\\.[0-9]* s \\(no heartbeat: .*"));
+}
+
+TEST_CASE("A Hello must name the participant that sends it", "[coupling][fault]") {
+    Coordinator coordinator(faultRun());
+    auto mbs = startMultibody(coordinator.boundEndpoint());
+    std::thread soil([endpoint = coordinator.boundEndpoint()] {
+        RawPeer peer(endpoint, "soil");
+        pb::Envelope e = peer.envelope();
+        auto *h = e.mutable_hello();
+        h->set_protocol_major(grainlink::coupling::kProtocolMajor);
+        h->set_participant("somebody-else");
+        h->set_role(pb::ROLE_SOIL);
+        h->add_consumes("mass1");
+        peer.send(e);
+        peer.receiveUntil(pb::Envelope::kShutdown, 3000);
+    });
+    const std::string failure = failureOf(coordinator);
+    soil.join();
+    CHECK(failure == "participant 'soil' failed during the handshake: says Hello as "
+                     "'somebody-else' in an envelope from 'soil'");
+    CHECK_THAT(failureOf(mbs), Catch::Contains("participant 'mbs'"));
 }
