@@ -153,6 +153,7 @@ void DemSystem::initialise() {
         neighbours_.build(reference_position_, particles_.radius, settings_.skin_m, {}, threads);
         neighbours_.restoreBuildCount(builds);
         updatePlaneMasks();
+        balanceContactWork();
     }
     candidates_stale_ = true;
 }
@@ -460,6 +461,7 @@ void DemSystem::rebuildNeighbours() {
                       settings_.threads);
     reference_position_ = particles_.position;
     updatePlaneMasks();
+    balanceContactWork();
 }
 
 void DemSystem::updatePlaneMasks() {
@@ -486,6 +488,36 @@ void DemSystem::updatePlaneMasks() {
     for (std::size_t i = 0; i < n; ++i)
         for (std::uint64_t mask = plane_mask_[i]; mask != 0; mask &= mask - 1)
             plane_candidates_.push_back({i, std::size_t(__builtin_ctzll(mask))});
+}
+
+void DemSystem::balanceContactWork() {
+    // Splits the particles of the contact pass into thread ranges of about equal work. A contact
+    // costs about 12 times a listed pair that does not touch, and contacts crowd at the floor and
+    // walls of a bed; so the work of a particle is estimated from its listed pairs, those of
+    // them in contact at the rebuild, and its plane candidates. The split depends only on the
+    // lists, so a run stays deterministic for a given thread count.
+    const std::size_t n = particles_.size();
+    const int threads = settings_.threads;
+    const auto &first = neighbours_.first;
+    const auto &state = neighbours_.state;
+    std::vector<std::uint64_t> work(n, 0);
+    for (const PlaneCandidate &c : plane_candidates_)
+        work[c.particle] += 12;
+    std::uint64_t total = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        for (std::size_t k = first[i]; k < first[i + 1]; ++k)
+            work[i] += (state[k] & NeighbourList::kTouching) ? 13 : 1;
+        total += work[i];
+    }
+    contact_split_.assign(std::size_t(threads) + 1, n);
+    contact_split_[0] = 0;
+    std::uint64_t sum = 0;
+    int t = 1;
+    for (std::size_t i = 0; i < n && t < threads; ++i) {
+        sum += work[i];
+        while (t < threads && sum * std::uint64_t(threads) >= total * std::uint64_t(t))
+            contact_split_[std::size_t(t++)] = i + 1;
+    }
 }
 
 void DemSystem::permuteWallHistories(const std::vector<std::size_t> &order) {
@@ -572,7 +604,7 @@ void DemSystem::pairContacts() {
     // Particle-particle, then particle-plane contacts, one parallel pass.
     PhaseTimer::Scope scope(timer_, phase_.contacts);
     const int threads = settings_.threads;
-    const std::size_t n = particles_.size(), np = planes_.size();
+    const std::size_t np = planes_.size();
     const std::size_t nm = materials_.size();
     const double dt = settings_.time_step_s;
     auto &p = particles_;
@@ -586,8 +618,8 @@ void DemSystem::pairContacts() {
             // reaction on a particle of a later thread goes to a side list, added after the
             // barrier in thread order: deterministic and without full-size buffers.
             const int t = omp_get_thread_num();
-            const std::size_t begin = n * std::size_t(t) / std::size_t(threads);
-            const std::size_t end = n * std::size_t(t + 1) / std::size_t(threads);
+            const std::size_t begin = contact_split_[std::size_t(t)];
+            const std::size_t end = contact_split_[std::size_t(t) + 1];
             auto &side = side_[std::size_t(t)];
             side.clear();
             // Raw, non-aliasing pointers: the stores to forces then cannot force reloads of

@@ -126,6 +126,7 @@ private:
     void updateNeighbours();
     void rebuildNeighbours();
     void updatePlaneMasks();
+    void balanceContactWork();
     void rebuildMeshCandidates();
     void computeForces();
     void pairContacts(); ///< and plane contacts
@@ -160,6 +161,7 @@ private:
         std::size_t particle, plane;
     };
     std::vector<PlaneCandidate> plane_candidates_; ///< the masks as a list, in particle order
+    std::vector<std::size_t> contact_split_; ///< thread t owns particles [split[t], split[t+1])
     double max_displacement_sq_ = 0.0, max_mesh_displacement_sq_ = 0.0;
     bool displacement_known_ = false;
     CellGrid mesh_grid_;
