@@ -546,10 +546,10 @@ void printReport(const std::vector<Case> &cases, const std::vector<std::vector<S
 
     std::printf("\nWhere a window's time goes (medians over windows, then over runs) [us]\n\n");
     std::printf("%-9s %-8s %12s %10s %10s %10s %8s %8s %8s %9s %8s\n", "transport", "scheme",
-                "participants", "overhead", "overhead", "csv", "CPU", "CPU", "CPU", "ctx sw",
+                "participants", "coord.", "coord.", "csv", "CPU", "CPU", "CPU", "ctx sw",
                 "one CPU");
-    std::printf("%-9s %-8s %12s %10s %10s %10s %8s %8s %8s %9s %8s\n", "", "", "held", "median",
-                "p99", "wall_s", "coord", "mb", "soil", "/window", "[%]");
+    std::printf("%-9s %-8s %12s %10s %10s %10s %8s %8s %8s %9s %8s\n", "", "", "held", "overhead",
+                "ovh. p99", "wall_s", "coord", "mb", "soil", "/window", "[%]");
     for (std::size_t i = 0; i < cases.size(); ++i) {
         const auto &r = samples[i];
         const Case &c = cases[i];
@@ -582,13 +582,17 @@ void printReport(const std::vector<Case> &cases, const std::vector<std::vector<S
         "participants held: time from waitForCommand() returning to advance() returning, both\n"
         "  participants (union of the two intervals); no physics, so this is the participant\n"
         "  library's writeOutputs() checks, encode and send.\n"
-        "overhead: window wall time - participants held = the coordinator's code plus ZeroMQ\n"
-        "  hops on the critical path (decode in the participants included).\n"
+        "coord. overhead: window wall time - participants held = the critical-path time in\n"
+        "  which no participant holds the window: the coordinator's code plus the ZeroMQ hops\n"
+        "  (decode in the participants included). With more busy threads than CPUs a\n"
+        "  participant's interval also holds what the scheduler ran meanwhile; then read the\n"
+        "  CPU columns and the difference to the * rows instead.\n"
         "csv wall_s: the coordinator's own per-window figure from coupling.csv (window start to\n"
         "  the end of its last WindowDone; it leaves out the CSV append and the next window's\n"
         "  set-up).\n"
         "CPU: user+system CPU per window of each process (all threads, ZeroMQ I/O included),\n"
-        "  whole run / all windows. ctx sw: voluntary+involuntary context switches, all three.\n"
+        "  whole run / all windows; CPU coord = the coordinator's own cost per window.\n"
+        "  ctx sw: voluntary+involuntary context switches, all three.\n"
         "one CPU: share of windows in which both participants opened the window on the same CPU\n"
         "  (the scheduler's placement; wake-ups across CPUs cost far more on a VM).\n");
     if (std::any_of(cases.begin(), cases.end(), [](const Case &c) { return c.floor; }))
