@@ -99,73 +99,75 @@ void NeighbourList::build(const std::vector<Vec3> &positions, const std::vector<
             carried_first[i + 1] += carried_first[i];
     }
 
-    // 2. Bin and search the 27 surrounding cells; each thread fills a contiguous range of i.
+    // 2. Bin, then visit each pair of neighbouring cells once: a cell with itself and with the
+    //    13 of its 26 neighbours that come after it. Half the cells of a full 27-cell search
+    //    per particle, and no candidate is looked at twice.
     double max_radius = 0.0;
     for (double r : radii)
         max_radius = std::max(max_radius, r);
     grid_.bin(positions, 2.0 * max_radius + skin_m);
     const auto &start = grid_.cellStart();
     const auto &members = grid_.cellParticles();
-    const auto &dims = grid_.dims();
-
+    const Eigen::Vector3i dims = grid_.dims();
+    const int cells = dims.x() * dims.y() * dims.z();
+    static constexpr int kForward[13][3] = {
+        {1, 0, 0},  {-1, 1, 0}, {0, 1, 0}, {1, 1, 0},  {-1, -1, 1}, {0, -1, 1}, {1, -1, 1},
+        {-1, 0, 1}, {0, 0, 1},  {1, 0, 1}, {-1, 1, 1}, {0, 1, 1},   {1, 1, 1}};
     threads = std::max(1, threads);
-    chunk_neighbours_.resize(std::size_t(threads));
-    chunk_counts_.resize(std::size_t(threads));
-    std::vector<std::size_t> chunk_begin(threads + 1);
-    for (int t = 0; t <= threads; ++t)
-        chunk_begin[t] = n * std::size_t(t) / std::size_t(threads);
-
+    chunk_pairs_.resize(std::size_t(threads));
 #pragma omp parallel num_threads(threads)
     {
-        const int t = omp_get_thread_num();
-        auto &out = chunk_neighbours_[t];
-        auto &counts = chunk_counts_[t];
+        auto &out = chunk_pairs_[std::size_t(omp_get_thread_num())];
         out.clear();
-        counts.clear();
-        for (std::size_t i = chunk_begin[t]; i < chunk_begin[t + 1]; ++i) {
-            const std::size_t before = out.size();
-            const Eigen::Vector3i c = grid_.cellCoords(positions[i]);
-            for (int dz = -1; dz <= 1; ++dz) {
-                const int z = c.z() + dz;
-                if (z < 0 || z >= dims.z())
+        // Pair (a, b) is listed in the row of the smaller index; the distance is computed as
+        // the row's particle minus the neighbour, as the contact loop does.
+        const auto consider = [&](int a, int b) {
+            const int i = std::min(a, b), j = std::max(a, b);
+            const double reach = radii[std::size_t(i)] + radii[std::size_t(j)] + skin_m;
+            if ((positions[std::size_t(i)] - positions[std::size_t(j)]).squaredNorm() <
+                reach * reach)
+                out.push_back({i, j});
+        };
+#pragma omp for schedule(static)
+        for (int c = 0; c < cells; ++c) {
+            if (start[c] == start[c + 1])
+                continue;
+            const int x = c % dims.x(), y = (c / dims.x()) % dims.y(),
+                      z = c / (dims.x() * dims.y());
+            for (int k = start[c]; k < start[c + 1]; ++k)
+                for (int m = k + 1; m < start[c + 1]; ++m)
+                    consider(members[k], members[m]);
+            for (const auto &o : kForward) {
+                const int nx = x + o[0], ny = y + o[1], nz = z + o[2];
+                if (nx < 0 || nx >= dims.x() || ny < 0 || ny >= dims.y() || nz >= dims.z())
                     continue;
-                for (int dy = -1; dy <= 1; ++dy) {
-                    const int y = c.y() + dy;
-                    if (y < 0 || y >= dims.y())
-                        continue;
-                    for (int dx = -1; dx <= 1; ++dx) {
-                        const int x = c.x() + dx;
-                        if (x < 0 || x >= dims.x())
-                            continue;
-                        const int cell = grid_.cellIndex({x, y, z});
-                        for (int k = start[cell]; k < start[cell + 1]; ++k) {
-                            const int j = members[k];
-                            if (std::size_t(j) <= i)
-                                continue;
-                            const double reach = radii[i] + radii[j] + skin_m;
-                            if ((positions[i] - positions[j]).squaredNorm() < reach * reach)
-                                out.push_back(j);
-                        }
-                    }
-                }
+                const int nc = grid_.cellIndex({nx, ny, nz});
+                for (int k = start[c]; k < start[c + 1]; ++k)
+                    for (int m = start[nc]; m < start[nc + 1]; ++m)
+                        consider(members[k], members[m]);
             }
-            // Sorted neighbours: the force summation order depends only on the pair set.
-            std::sort(out.begin() + before, out.end());
-            counts.push_back(out.size() - before);
         }
     }
 
-    // 3. Concatenate in thread order and attach carried histories.
+    // 3. Rows by counting sort, each sorted by neighbour: the force summation order then
+    //    depends only on the pair set. Then attach carried histories.
     first.assign(n + 1, 0);
-    for (int t = 0; t < threads; ++t)
-        for (std::size_t k = 0; k < chunk_counts_[t].size(); ++k)
-            first[chunk_begin[t] + k + 1] = chunk_counts_[t][k];
+    for (const auto &chunk : chunk_pairs_)
+        for (const auto &pair : chunk)
+            ++first[std::size_t(pair.first) + 1];
     for (std::size_t i = 0; i < n; ++i)
         first[i + 1] += first[i];
-    neighbour.clear();
-    neighbour.reserve(first[n]);
-    for (int t = 0; t < threads; ++t)
-        neighbour.insert(neighbour.end(), chunk_neighbours_[t].begin(), chunk_neighbours_[t].end());
+    neighbour.resize(first[n]);
+    {
+        std::vector<std::size_t> fill(first.begin(), first.end() - 1);
+        for (const auto &chunk : chunk_pairs_)
+            for (const auto &pair : chunk)
+                neighbour[fill[std::size_t(pair.first)]++] = pair.second;
+    }
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (std::size_t i = 0; i < n; ++i)
+        std::sort(neighbour.begin() + std::ptrdiff_t(first[i]),
+                  neighbour.begin() + std::ptrdiff_t(first[i + 1]));
     const std::size_t entries = neighbour.size();
     owner.resize(entries);
 #pragma omp parallel for schedule(static) num_threads(threads)

@@ -6,6 +6,7 @@
 #include "grainlink/dem/Types.hpp"
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace grainlink::dem {
@@ -101,8 +102,7 @@ private:
     std::vector<int> old_neighbour_;
     std::vector<std::uint8_t> old_state_;
     std::vector<Vec3> old_tangential_, old_rolling_;
-    std::vector<std::vector<int>> chunk_neighbours_;
-    std::vector<std::vector<std::size_t>> chunk_counts_;
+    std::vector<std::vector<std::pair<int, int>>> chunk_pairs_; ///< found pairs, per thread
 };
 
 } // namespace grainlink::dem
