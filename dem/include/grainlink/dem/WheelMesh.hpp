@@ -1,0 +1,22 @@
+#pragma once
+// The parametric wheel (seed Fig. 8) as a closed triangle mesh about the body y axis: a rim
+// cylinder plus straight grousers as boxes standing on it. The coupled DEM node and `grainlink`'s
+// STL export build it from the same numbers the multibody side sends in its handshake.
+#include "grainlink/dem/TriangleMesh.hpp"
+
+namespace grainlink::dem {
+
+struct WheelMeshSpec {
+    double diameter_m = 0.25; ///< [m] rim outer diameter (grousers excluded)
+    double width_m = 0.1;     ///< [m]
+    unsigned grouser_count = 0;
+    double grouser_height_m = 0.0;    ///< [m] radially outward from the rim
+    double grouser_thickness_m = 0.0; ///< [m] in the rolling direction
+    bool chevron = false;             ///< chevron grousers are not built yet: an error
+    bool closed_sides = true;         ///< side discs (an open wheel is a rim only)
+    int rim_segments = 0;             ///< facets around; 0: about one per 5 degrees, at least 24
+};
+
+TriangleMesh makeWheel(const WheelMeshSpec &spec);
+
+} // namespace grainlink::dem
