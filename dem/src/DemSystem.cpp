@@ -540,35 +540,46 @@ void DemSystem::rebuildMeshCandidates() {
     mesh_grid_.bin(particles_.position, 2.0 * r_max + skin);
     const auto &start = mesh_grid_.cellStart();
     const auto &members = mesh_grid_.cellParticles();
-    std::vector<std::pair<std::size_t, std::pair<int, int>>> found;
-    for (std::size_t b = 0; b < bodies_.size(); ++b) {
-        const MeshBody &body = bodies_[b];
+    // Triangles are shared out among threads; the sort below makes the result independent of
+    // the thread count.
+    std::vector<std::pair<int, int>> triangles;
+    for (std::size_t b = 0; b < bodies_.size(); ++b)
+        for (std::size_t t = 0; t < bodies_[b].mesh().triangles.size(); ++t)
+            triangles.push_back({int(b), int(t)});
+    const int threads = settings_.threads;
+    using Found = std::vector<std::pair<std::size_t, std::pair<int, int>>>;
+    std::vector<Found> found_by(static_cast<std::size_t>(threads));
+#pragma omp parallel for schedule(static) num_threads(threads)
+    for (std::size_t k = 0; k < triangles.size(); ++k) {
+        auto &found = found_by[std::size_t(omp_get_thread_num())];
+        const auto [b, t] = triangles[k];
+        const MeshBody &body = bodies_[std::size_t(b)];
         const auto &v = body.worldVertices();
-        const auto &tris = body.mesh().triangles;
-        for (std::size_t t = 0; t < tris.size(); ++t) {
-            const Vec3 &a = v[tris[t][0]], &bb = v[tris[t][1]], &c = v[tris[t][2]];
-            const Vec3 pad = Vec3::Constant(r_max + skin);
-            const Eigen::Vector3i lo = mesh_grid_.cellCoords(a.cwiseMin(bb).cwiseMin(c) - pad);
-            const Eigen::Vector3i hi = mesh_grid_.cellCoords(a.cwiseMax(bb).cwiseMax(c) + pad);
-            const Vec3 normal = (bb - a).cross(c - a).normalized();
-            for (int z = lo.z(); z <= hi.z(); ++z)
-                for (int y = lo.y(); y <= hi.y(); ++y)
-                    for (int x = lo.x(); x <= hi.x(); ++x) {
-                        const int cell = mesh_grid_.cellIndex({x, y, z});
-                        for (int k = start[cell]; k < start[cell + 1]; ++k) {
-                            const std::size_t i = std::size_t(members[k]);
-                            const Vec3 &p = particles_.position[i];
-                            const double reach = particles_.radius[i] + skin;
-                            // Cheap plane test first: most cell members are far off the plane.
-                            if (std::abs((p - a).dot(normal)) >= reach)
-                                continue;
-                            if ((closestPointOnTriangle(p, a, bb, c) - p).squaredNorm() <
-                                reach * reach)
-                                found.push_back({i, {int(b), int(t)}});
-                        }
+        const auto &tri = body.mesh().triangles[std::size_t(t)];
+        const Vec3 &a = v[tri[0]], &bb = v[tri[1]], &c = v[tri[2]];
+        const Vec3 pad = Vec3::Constant(r_max + skin);
+        const Eigen::Vector3i lo = mesh_grid_.cellCoords(a.cwiseMin(bb).cwiseMin(c) - pad);
+        const Eigen::Vector3i hi = mesh_grid_.cellCoords(a.cwiseMax(bb).cwiseMax(c) + pad);
+        const Vec3 normal = (bb - a).cross(c - a).normalized();
+        for (int z = lo.z(); z <= hi.z(); ++z)
+            for (int y = lo.y(); y <= hi.y(); ++y)
+                for (int x = lo.x(); x <= hi.x(); ++x) {
+                    const int cell = mesh_grid_.cellIndex({x, y, z});
+                    for (int m = start[cell]; m < start[cell + 1]; ++m) {
+                        const std::size_t i = std::size_t(members[m]);
+                        const Vec3 &p = particles_.position[i];
+                        const double reach = particles_.radius[i] + skin;
+                        // Cheap plane test first: most cell members are far off the plane.
+                        if (std::abs((p - a).dot(normal)) >= reach)
+                            continue;
+                        if ((closestPointOnTriangle(p, a, bb, c) - p).squaredNorm() < reach * reach)
+                            found.push_back({i, {b, t}});
                     }
-        }
+                }
     }
+    Found found;
+    for (const Found &part : found_by)
+        found.insert(found.end(), part.begin(), part.end());
     std::sort(found.begin(), found.end());
     std::vector<std::size_t> first(n + 1, 0);
     mesh_candidates_.clear();

@@ -128,7 +128,9 @@ void NeighbourList::build(const std::vector<Vec3> &positions, const std::vector<
                 reach * reach)
                 out.push_back({i, j});
         };
-#pragma omp for schedule(static)
+        // Cells are unevenly filled (the grid spans the bounding box): dynamic chunks. The rows
+        // are sorted below, so the result does not depend on which thread found a pair.
+#pragma omp for schedule(dynamic, 64)
         for (int c = 0; c < cells; ++c) {
             if (start[c] == start[c + 1])
                 continue;
