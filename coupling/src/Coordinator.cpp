@@ -93,6 +93,12 @@ struct Coordinator::Impl {
     std::vector<BodyState> resumed_states;                ///< from the checkpoint, if resuming
     std::vector<Wrench> resumed_wrenches;
     std::unique_ptr<CouplingSeries> series;
+    struct PendingRow {
+        CouplingSeries::Row row;
+        std::vector<BodyState> states;
+        std::vector<Wrench> wrenches;
+    };
+    std::optional<PendingRow> pending_row; ///< the last window, not yet in coupling.csv
     const std::string heartbeat_bytes = [] {
         pb::Envelope e;
         e.set_version(kProtocolMajor);
@@ -110,10 +116,18 @@ struct Coordinator::Impl {
                " (t = " + formatSeconds(tick * config.tick_s) + " s)";
     }
 
+    void writePendingRow() {
+        if (series && pending_row) {
+            series->append(pending_row->row, pending_row->states, pending_row->wrenches);
+            pending_row.reset();
+        }
+    }
+
     /// Stops every participant, then throws the one line that names who failed and why.
     [[noreturn]] void fail(const std::string &who, const std::string &why) {
         const std::string message = who + " failed " + where() + ": " + why;
         shutdownAll(true, message);
+        writePendingRow();
         if (series)
             series->flush();
         throw CouplingError(message);
@@ -203,13 +217,12 @@ struct Coordinator::Impl {
         return names;
     }
 
-    /// Receives for up to `timeout_ms`; answers heartbeats and strangers itself and returns
+    /// Receives for up to 20 ms; answers heartbeats and strangers itself and returns
     /// the next message of a joined participant, if any. Checks liveness and Ctrl-C each call.
-    std::optional<Incoming> pump(long timeout_ms) {
+    std::optional<Incoming> pump() {
         std::optional<Incoming> result;
-        if (sockets::poll(router, timeout_ms)) {
-            zmq::message_t id, payload;
-            (void)router.recv(id, zmq::recv_flags::none);
+        zmq::message_t id, payload;
+        if (sockets::receive(router, id)) { // waits at most the router's rcvtimeo (20 ms)
             if (!id.more()) {
                 checkHealth();
                 return std::nullopt;
@@ -228,27 +241,27 @@ struct Coordinator::Impl {
     std::optional<Incoming> handle(const std::string &id, const zmq::message_t &payload) {
         if (const auto p = peerByRoutingId(id)) {
             Peer &peer = peers[*p];
-            const std::string who = "participant '" + peer.spec.name + "'";
+            const auto who = [&peer] { return "participant '" + peer.spec.name + "'"; };
             pb::Envelope e;
             try {
-                e = codec::decode(payload.data(), payload.size(), who);
+                e = codec::decode(payload.data(), payload.size(), who());
             } catch (const codec::ProtocolError &error) {
-                fail(who, std::string("sent a bad message: ") + error.what());
+                fail(who(), std::string("sent a bad message: ") + error.what());
             }
             peer.last_seen = Clock::now();
             if (e.sender() != peer.spec.name)
-                fail(who, "sent a message signed '" + e.sender() + "'");
+                fail(who(), "sent a message signed '" + e.sender() + "'");
             if (e.sequence() <= peer.received_sequence)
-                fail(who, "sent message " + std::to_string(e.sequence()) + " again (duplicate; " +
-                              "last was " + std::to_string(peer.received_sequence) + ")");
+                fail(who(), "sent message " + std::to_string(e.sequence()) + " again (duplicate; " +
+                                "last was " + std::to_string(peer.received_sequence) + ")");
             if (e.sequence() != peer.received_sequence + 1)
-                fail(who, "sent message " + std::to_string(e.sequence()) + " after " +
-                              std::to_string(peer.received_sequence) + " (out of order)");
+                fail(who(), "sent message " + std::to_string(e.sequence()) + " after " +
+                                std::to_string(peer.received_sequence) + " (out of order)");
             peer.received_sequence = e.sequence();
             if (e.has_heartbeat())
                 return std::nullopt;
             if (e.has_error())
-                fail(who, "reported: " + e.error().message());
+                fail(who(), "reported: " + e.error().message());
             return Incoming{*p, std::move(e)};
         }
         return handleStranger(id, payload);
@@ -389,7 +402,7 @@ struct Coordinator::Impl {
     void awaitFrom(std::set<std::size_t> pending, const char *what, Accept accept) {
         const auto start = Clock::now();
         while (!pending.empty()) {
-            if (auto in = pump(20)) {
+            if (auto in = pump()) {
                 const std::string who = "participant '" + peers[in->peer].spec.name + "'";
                 if (!pending.count(in->peer) || !accept(in->peer, in->envelope))
                     fail(who, "sent " + codec::bodyName(in->envelope) + " for window " +
@@ -411,7 +424,7 @@ struct Coordinator::Impl {
     void handshake() {
         const auto start = Clock::now();
         while (std::any_of(peers.begin(), peers.end(), [](const Peer &p) { return !p.joined; })) {
-            if (auto in = pump(50))
+            if (auto in = pump())
                 fail("participant '" + peers[in->peer].spec.name + "'",
                      "sent " + codec::bodyName(in->envelope) + " before the run started");
             if (sockets::secondsSince(start) > config.handshake_timeout_s) {
@@ -562,6 +575,7 @@ struct Coordinator::Impl {
                     send(p, e);
                     pending.insert(p);
                 }
+            writePendingRow();
             std::vector<BodyState> states;
             std::vector<Wrench> wrenches;
             double mb_work = 0.0, soil_work = 0.0;
@@ -680,6 +694,7 @@ struct Coordinator::Impl {
         codec::toWire(scheme->states(), tick, state.mutable_states());
         codec::toWire(scheme->wrenches(), tick, tick, state.mutable_wrenches());
         state.set_cumulative_mismatch_j(cumulative_mismatch_J);
+        writePendingRow();
         series->flush();
         writeAtomically((fs::path(directory) / "coordinator.pb").string(),
                         state.SerializeAsString());
@@ -810,6 +825,7 @@ Coordinator::Coordinator(CoordinatorConfig config)
     s.router = zmq::socket_t(s.context, zmq::socket_type::router);
     s.router.set(zmq::sockopt::router_mandatory, 1);
     s.router.set(zmq::sockopt::linger, 1000);
+    s.router.set(zmq::sockopt::rcvtimeo, 20); // liveness is checked between receives
     if (c.curve) {
         if (!curveAvailable())
             throw CouplingError("CURVE keys given, but this libzmq has no CURVE support");
@@ -893,7 +909,9 @@ CoordinatorSummary Coordinator::run() {
             row.work_soil_J = work_soil;
             row.cumulative_mismatch_J = s.cumulative_mismatch_J;
             row.wall_s = sockets::secondsSince(window_started);
-            s.series->append(row, s.scheme->states(), s.scheme->wrenches());
+            // Written once the next window's inputs are out (or at the end, a checkpoint, a
+            // failure): the formatting then overlaps the participants' work.
+            s.pending_row = Impl::PendingRow{row, s.scheme->states(), s.scheme->wrenches()};
         }
         s.tick += step;
         ++s.window;
@@ -916,6 +934,7 @@ CoordinatorSummary Coordinator::run() {
         }
     }
     s.shutdownAll(false, "the run reached its end time");
+    s.writePendingRow();
     if (s.series)
         s.series->flush();
     summary.end_time_s = s.tick * c.tick_s;

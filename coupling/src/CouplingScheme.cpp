@@ -52,8 +52,9 @@ void unstack(const Eigen::VectorXd &values, std::vector<Wrench> &wrenches) {
 }
 
 CouplingScheme::CouplingScheme(const SchemeSettings &settings, std::vector<BodyState> initial)
-    : settings_(settings), acceleration_(makeAcceleration(settings.acceleration)),
-      states_(std::move(initial)) {
+    : settings_(settings), states_(std::move(initial)) {
+    if (settings_.kind == SchemeKind::Implicit) // explicit schemes never iterate
+        acceleration_ = makeAcceleration(settings.acceleration);
     for (const auto &s : states_) {
         bodies_.push_back(s.body);
         wrenches_.push_back(Wrench{s.body, Vec3::Zero(), Vec3::Zero(), {}});
@@ -75,7 +76,8 @@ void CouplingScheme::beginWindow(double window_s) {
     residual_ = 0.0;
     multibody_done_ = soil_done_ = false;
     applied_ = wrenches_;
-    acceleration_->beginWindow();
+    if (acceleration_)
+        acceleration_->beginWindow();
     switch (settings_.kind) {
     case SchemeKind::ExplicitSerial:
     case SchemeKind::Implicit:

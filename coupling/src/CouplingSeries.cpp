@@ -1,5 +1,6 @@
 #include "CouplingSeries.hpp"
 
+#include <charconv>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -58,37 +59,43 @@ CouplingSeries::~CouplingSeries() {
 
 void CouplingSeries::append(const Row &row, const std::vector<BodyState> &states,
                             const std::vector<Wrench> &wrenches) {
-    std::fprintf(file_, "%llu,%.17g,%.17g,%.17g,%u,%.6g,%.17g,%.17g,%.17g,%.17g,%.6g",
-                 static_cast<unsigned long long>(row.window), row.start_s, row.end_s,
-                 row.end_s - row.start_s, row.iterations, row.residual, row.work_multibody_J,
-                 row.work_soil_J, row.work_multibody_J - row.work_soil_J, row.cumulative_mismatch_J,
-                 row.wall_s);
+    // Shortest round-trip text (std::to_chars) into one reused buffer, one fwrite: the row is
+    // written every window, so it must cost microseconds, not tens of them.
+    line_.clear();
+    auto put = [this](auto value) {
+        char text[32];
+        const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+        line_.append(text, end);
+        line_.push_back(',');
+    };
+    put(row.window);
+    put(row.start_s);
+    put(row.end_s);
+    put(row.end_s - row.start_s);
+    put(row.iterations);
+    put(row.residual);
+    put(row.work_multibody_J);
+    put(row.work_soil_J);
+    put(row.work_multibody_J - row.work_soil_J);
+    put(row.cumulative_mismatch_J);
+    put(row.wall_s);
     for (std::size_t b = 0; b < states.size(); ++b) {
         const auto &s = states[b];
         const auto &w = wrenches[b];
-        const double values[] = {s.position_m.x(),
-                                 s.position_m.y(),
-                                 s.position_m.z(),
-                                 s.orientation.w(),
-                                 s.orientation.x(),
-                                 s.orientation.y(),
-                                 s.orientation.z(),
-                                 s.linear_velocity_m_s.x(),
-                                 s.linear_velocity_m_s.y(),
-                                 s.linear_velocity_m_s.z(),
-                                 s.angular_velocity_rad_s.x(),
-                                 s.angular_velocity_rad_s.y(),
-                                 s.angular_velocity_rad_s.z(),
-                                 w.force_N.x(),
-                                 w.force_N.y(),
-                                 w.force_N.z(),
-                                 w.torque_N_m.x(),
-                                 w.torque_N_m.y(),
-                                 w.torque_N_m.z()};
-        for (double v : values)
-            std::fprintf(file_, ",%.17g", v);
+        for (const Vec3 *v : {&s.position_m})
+            for (int k = 0; k < 3; ++k)
+                put((*v)[k]);
+        put(s.orientation.w());
+        put(s.orientation.x());
+        put(s.orientation.y());
+        put(s.orientation.z());
+        for (const Vec3 *v :
+             {&s.linear_velocity_m_s, &s.angular_velocity_rad_s, &w.force_N, &w.torque_N_m})
+            for (int k = 0; k < 3; ++k)
+                put((*v)[k]);
     }
-    std::fputc('\n', file_);
+    line_.back() = '\n';
+    std::fwrite(line_.data(), 1, line_.size(), file_);
     const auto now = std::chrono::steady_clock::now();
     if (now - last_flush_ > std::chrono::milliseconds(500))
         flush();

@@ -38,6 +38,7 @@ public:
 private:
     std::string path_;
     std::FILE *file_ = nullptr;
+    std::string line_; ///< reused row buffer
     std::chrono::steady_clock::time_point last_flush_;
 };
 

@@ -116,9 +116,8 @@ struct Participant::Impl {
     pb::Envelope receive(double timeout_s, const char *waiting_for) {
         const auto start = Clock::now();
         for (;;) {
-            if (sockets::poll(socket, 50)) {
-                zmq::message_t message;
-                (void)socket.recv(message, zmq::recv_flags::none);
+            zmq::message_t message;
+            if (sockets::receive(socket, message)) { // waits at most 50 ms (rcvtimeo)
                 noteCoordinatorAlive();
                 pb::Envelope e = codec::decode(message.data(), message.size(), "the coordinator");
                 if (e.sequence() != received_sequence + 1)

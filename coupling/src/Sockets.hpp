@@ -36,10 +36,24 @@ inline zmq::socket_t connectDealer(zmq::context_t &context, const std::string &e
                                    const std::optional<CurveClientKeys> &curve, int linger_ms) {
     zmq::socket_t socket(context, zmq::socket_type::dealer);
     socket.set(zmq::sockopt::linger, linger_ms);
+    socket.set(zmq::sockopt::rcvtimeo, 50);
     if (curve)
         makeCurveClient(socket, *curve);
     socket.connect(endpoint);
     return socket;
+}
+
+/// Receives one message, waiting at most the socket's receive timeout (`rcvtimeo`, set when the
+/// socket is made); false on timeout or when a signal (Ctrl-C) interrupted the wait. One system
+/// call where poll-then-receive takes two: this is on every window's path.
+inline bool receive(zmq::socket_t &socket, zmq::message_t &message) {
+    try {
+        return socket.recv(message, zmq::recv_flags::none).has_value();
+    } catch (const zmq::error_t &error) {
+        if (error.num() == EINTR)
+            return false;
+        throw;
+    }
 }
 
 inline void send(zmq::socket_t &socket, const codec::pb::Envelope &envelope) {
