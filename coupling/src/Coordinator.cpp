@@ -99,6 +99,7 @@ struct Coordinator::Impl {
         std::vector<Wrench> wrenches;
     };
     std::optional<PendingRow> pending_row; ///< the last window, not yet in coupling.csv
+    std::string completed_by; ///< the participant that declared the experiment complete
     const std::string heartbeat_bytes = [] {
         pb::Envelope e;
         e.set_version(kProtocolMajor);
@@ -608,6 +609,8 @@ struct Coordinator::Impl {
                 for (const auto &w : done.work())
                     work += w.work_j();
                 (peers[p].spec.role == Role::Multibody ? mb_work : soil_work) += work;
+                if (done.run_complete() && completed_by.empty())
+                    completed_by = peers[p].spec.name;
                 if (done.suggested_macro_step_ticks() > 0)
                     hint_ticks = std::min(hint_ticks, Ticks(done.suggested_macro_step_ticks()));
                 return true;
@@ -915,6 +918,11 @@ CoordinatorSummary Coordinator::run() {
         }
         s.tick += step;
         ++s.window;
+        if (!s.completed_by.empty()) {
+            spdlog::info("coordinator: participant '{}' completed its experiment at t = {} s",
+                         s.completed_by, formatSeconds(s.tick * c.tick_s));
+            break;
+        }
         s.macro_step_ticks = s.nextStep();
         if (c.checkpoint_every_windows > 0 && s.window % c.checkpoint_every_windows == 0 &&
             s.tick < s.end_tick)
@@ -933,13 +941,16 @@ CoordinatorSummary Coordinator::run() {
                 double(summary.iterations) / double(summary.windows), s.cumulative_mismatch_J);
         }
     }
-    s.shutdownAll(false, "the run reached its end time");
+    s.shutdownAll(false, s.completed_by.empty()
+                             ? "the run reached its end time"
+                             : "participant '" + s.completed_by + "' completed its experiment");
     s.writePendingRow();
     if (s.series)
         s.series->flush();
     summary.end_time_s = s.tick * c.tick_s;
     summary.wall_s = sockets::secondsSince(started);
     summary.cumulative_mismatch_J = s.cumulative_mismatch_J;
+    summary.completed_by = s.completed_by;
     summary.final_states = s.scheme->states();
     summary.final_wrenches = s.scheme->wrenches();
     return summary;

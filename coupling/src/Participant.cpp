@@ -423,6 +423,7 @@ void Participant::advance() {
     if (s.outputs.suggested_macro_step_s > 0.0)
         done->set_suggested_macro_step_ticks(static_cast<Ticks>(
             std::max(1.0, std::floor(s.outputs.suggested_macro_step_s / s.run.tick_s))));
+    done->set_run_complete(s.outputs.run_complete);
     sockets::send(s.socket, e);
     s.state = State::Ready;
 }

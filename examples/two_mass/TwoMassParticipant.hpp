@@ -14,10 +14,11 @@ namespace grainlink::examples {
 /// Test hooks: misbehave at a given window (the coordinator's fault tests), watch the windows,
 /// or ask for another macro step (adaptive stepping).
 struct SideHooks {
-    long die_at_window = -1;    ///< the process kills itself (SIGKILL) when this window opens
-    long hang_at_window = -1;   ///< the model never returns from this window (heartbeats go on)
-    long freeze_at_window = -1; ///< the whole process stops (SIGSTOP), heartbeats too
-    long fail_at_window = -1;   ///< reports a failure to the coordinator and gives up
+    long die_at_window = -1;      ///< the process kills itself (SIGKILL) when this window opens
+    long hang_at_window = -1;     ///< the model never returns from this window (heartbeats go on)
+    long freeze_at_window = -1;   ///< the whole process stops (SIGSTOP), heartbeats too
+    long fail_at_window = -1;     ///< reports a failure to the coordinator and gives up
+    long complete_at_window = -1; ///< declares the experiment complete (run_complete) here
     std::function<void(std::uint64_t window)> on_window;  ///< called as each window opens
     std::function<double(double start_s)> suggest_step_s; ///< hint sent with each window
 };
@@ -77,6 +78,7 @@ inline double runTwoMassSide(coupling::Participant &participant, const TwoMassPa
                                               std::to_string(window));
             }
             coupling::WindowOutputs out;
+            out.run_complete = window == hooks.complete_at_window;
             if (hooks.suggest_step_s)
                 out.suggested_macro_step_s = hooks.suggest_step_s(in.start_s);
             if (is_one) {

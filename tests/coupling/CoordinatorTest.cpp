@@ -162,3 +162,18 @@ TEST_CASE("A failed run resumes from its last checkpoint and ends as if never st
     CHECK(resumed == straight); // bit-identical: same numbers printed with 17 digits
     std::filesystem::remove_all(base);
 }
+
+TEST_CASE("A participant that declares its experiment complete ends the run normally",
+          "[coupling][coordinator]") {
+    Coordinator coordinator(twoMassRun(SchemeKind::ExplicitSerial, "inproc://complete", 0.01, 1.0));
+    grainlink::examples::SideHooks hooks;
+    hooks.complete_at_window = 7;
+    auto mbs = startSide(Role::Multibody, coordinator.boundEndpoint(), hooks);
+    auto soil = startSide(Role::Soil, coordinator.boundEndpoint());
+    const auto summary = coordinator.run();
+    CHECK(summary.windows == 8);
+    CHECK(summary.end_time_s == Approx(0.08).epsilon(1e-12));
+    CHECK(summary.completed_by == "mbs");
+    CHECK_NOTHROW(mbs.get());
+    CHECK_NOTHROW(soil.get());
+}

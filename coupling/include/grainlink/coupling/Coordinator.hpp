@@ -56,6 +56,7 @@ struct CoordinatorSummary {
     double cumulative_mismatch_J = 0.0; ///< Σ (multibody work - soil work) over all windows
     std::vector<BodyState> final_states;
     std::vector<Wrench> final_wrenches;
+    std::string completed_by; ///< the participant that ended the run early (run_complete), if any
 };
 
 class Coordinator {

@@ -70,6 +70,7 @@ struct WindowOutputs {
     std::vector<Wrench> wrenches;        ///< soil: averaged over the window, one per consumed body
     std::vector<BodyWork> work;          ///< optional: work of the coupling wrench per body
     double suggested_macro_step_s = 0.0; ///< [s] 0: no preference (adaptive stepping hint)
+    bool run_complete = false; ///< the experiment is over (e.g. steady state): end the run
 };
 
 enum class Command { Advance, WriteCheckpoint, Finish };

@@ -20,7 +20,7 @@ using Ticks = std::uint64_t;
 
 /// The protocol this build speaks; a peer with another major version is refused.
 constexpr std::uint32_t kProtocolMajor = 1;
-constexpr std::uint32_t kProtocolMinor = 0;
+constexpr std::uint32_t kProtocolMinor = 1; // 1.1: WindowDone.run_complete
 
 enum class Role {
     Multibody, ///< integrates the bodies: wrenches in, states out
