@@ -15,9 +15,8 @@ namespace grainlink::dem {
 
 namespace fs = std::filesystem;
 
-namespace {
+namespace {} // namespace
 
-/// Height of the settled bed's surface: 98th percentile of grain tops (robust to stray grains).
 double bedSurface(const ParticleStore &p) {
     if (p.empty())
         return 0.0;
@@ -28,6 +27,44 @@ double bedSurface(const ParticleStore &p) {
     std::nth_element(tops.begin(), tops.begin() + std::ptrdiff_t(k), tops.end());
     return tops[k];
 }
+
+std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progress_interval_s,
+                                       bool *from_cache) {
+    auto sys = makeSystem(scenario);
+    const std::string key = packingKey(scenario);
+    const fs::path cache =
+        scenario.packing_cache_directory.empty()
+            ? fs::path()
+            : fs::path(scenario.packing_cache_directory) / ("packing-" + key + ".bin");
+    if (!cache.empty() && fs::exists(cache)) {
+        readCheckpoint(*sys, cache.string());
+        if (from_cache)
+            *from_cache = true;
+        std::fprintf(stderr, "[deposition] reusing cached packing %s (%zu particles)\n",
+                     cache.c_str(), sys->particles().size());
+        return sys;
+    }
+    Progress progress("deposition", progress_interval_s);
+    const auto report = deposit(*sys, scenario.deposition, [&](const DepositionReport &r) {
+        progress.update(
+            sys->time(), std::min(1.0, r.settle_time_s / scenario.deposition.max_settle_time_s),
+            sys->stepCount() * sys->particles().size(),
+            "KE/particle " + std::to_string(r.final_kinetic_energy_per_particle_J) + " J");
+    });
+    std::fprintf(stderr,
+                 "[deposition] %zu particles, settled %s after %.3f s (KE/particle %.3g J)\n",
+                 report.inserted, report.settled ? "" : "NOT (time limit)", report.settle_time_s,
+                 report.final_kinetic_energy_per_particle_J);
+    if (!cache.empty()) {
+        fs::create_directories(cache.parent_path());
+        writeCheckpoint(*sys, cache.string());
+    }
+    if (from_cache)
+        *from_cache = false;
+    return sys;
+}
+
+namespace {
 
 std::string seriesHeader(const DemSystem &sys) {
     std::string h = "time_s,run_time_s,step,kinetic_J,rotational_J,gravitational_J,elastic_J,"
@@ -149,35 +186,7 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
         std::fprintf(stderr, "[resume] from %s at t = %.4f s (step %llu)\n", checkpoint.c_str(),
                      sys->time(), static_cast<unsigned long long>(sys->stepCount()));
     } else {
-        const std::string key = packingKey(scenario);
-        const fs::path cache =
-            scenario.packing_cache_directory.empty()
-                ? fs::path()
-                : fs::path(scenario.packing_cache_directory) / ("packing-" + key + ".bin");
-        if (!cache.empty() && fs::exists(cache)) {
-            readCheckpoint(*sys, cache.string());
-            summary.packing_from_cache = true;
-            std::fprintf(stderr, "[deposition] reusing cached packing %s (%zu particles)\n",
-                         cache.c_str(), sys->particles().size());
-        } else {
-            Progress progress("deposition", options.progress_interval_s);
-            const auto report = deposit(*sys, scenario.deposition, [&](const DepositionReport &r) {
-                progress.update(
-                    sys->time(),
-                    std::min(1.0, r.settle_time_s / scenario.deposition.max_settle_time_s),
-                    sys->stepCount() * sys->particles().size(),
-                    "KE/particle " + std::to_string(r.final_kinetic_energy_per_particle_J) + " J");
-            });
-            std::fprintf(
-                stderr,
-                "[deposition] %zu particles, settled %s after %.3f s (KE/particle %.3g J)\n",
-                report.inserted, report.settled ? "" : "NOT (time limit)", report.settle_time_s,
-                report.final_kinetic_energy_per_particle_J);
-            if (!cache.empty()) {
-                fs::create_directories(cache.parent_path());
-                writeCheckpoint(*sys, cache.string());
-            }
-        }
+        sys = prepareSoil(scenario, options.progress_interval_s, &summary.packing_from_cache);
         run_start_s = sys->time();
         starts = startPoses(*sys, scenario);
         for (std::size_t b = 0; b < scenario.bodies.size(); ++b)

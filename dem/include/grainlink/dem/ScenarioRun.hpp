@@ -22,6 +22,13 @@ struct RunSummary {
     bool packing_from_cache = false;
 };
 
+/// The scenario's system with its settled packing: read from the packing cache when an identical
+/// soil setup was settled before, else deposited, settled and cached. No bodies yet.
+std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progress_interval_s,
+                                       bool *from_cache = nullptr);
+/// Height of a settled bed's surface: 98th percentile of grain tops (robust to stray grains).
+double bedSurface(const ParticleStore &particles);
+
 /// Runs to the end; throws (after saving what is readable) on bad input or a failed step.
 RunSummary runScenario(const DemScenario &scenario, const RunOptions &options);
 
