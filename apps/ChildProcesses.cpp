@@ -35,6 +35,9 @@ ChildProcesses::ChildProcesses(OnExit on_unexpected_exit)
     const std::string folder = ownFolder();
     if (!folder.empty())
         ::setenv("PATH", (folder + ":" + (path ? path : "/usr/bin:/bin")).c_str(), 1);
+    // The participants share the cores with each other and the coordinator, which wake every
+    // window: spinning OpenMP barriers would steal their time (unless the user chose otherwise).
+    ::setenv("OMP_WAIT_POLICY", "PASSIVE", 0);
 }
 
 ChildProcesses::~ChildProcesses() {

@@ -2,6 +2,8 @@
 
 #include "ChildProcesses.hpp"
 #include "grainlink/coupling/Coordinator.hpp"
+#include "grainlink/dem/Scenario.hpp"
+#include "grainlink/mbs/WheelTest.hpp"
 
 #include <csignal>
 #include <cstdio>
@@ -36,7 +38,17 @@ struct StopSignals {
 };
 
 CoordinatorConfig configFor(const CoupledRunOptions &options, const char *default_endpoint) {
-    CoordinatorConfig config = coupling::loadCoordinatorConfig(options.config_path);
+    // The coupling sections, and the participants' own sections checked up front, so a typo
+    // stops the run before any process starts.
+    const auto root = config::ConfigNode::loadFile(options.config_path);
+    CoordinatorConfig config = coupling::coordinatorConfigFrom(root);
+    if (const auto soil = root.optional("soil"))
+        dem::parseScenario(*soil, true);
+    if (const auto rig = root.optional("rig"))
+        mbs::parseSingleWheelRig(*rig);
+    if (const auto test = root.optional("wheel_test"))
+        mbs::parseWheelTest(*test);
+    root.finish();
     if (!options.endpoint.empty())
         config.endpoint = options.endpoint;
     if (config.endpoint.empty())
@@ -111,9 +123,11 @@ int runCoupled(const CoupledRunOptions &options) {
         }
         std::vector<std::string> argv;
         for (const auto &arg : p.command)
-            argv.push_back(substitute(substitute(substitute(arg, "{endpoint}", endpoint), "{out}",
-                                                 config.output_directory),
-                                      "{name}", p.name));
+            argv.push_back(substitute(substitute(substitute(substitute(arg, "{endpoint}", endpoint),
+                                                            "{out}", config.output_directory),
+                                                 "{name}", p.name),
+                                      "{scenario}",
+                                      std::filesystem::absolute(options.config_path).string()));
         children.start(p.name, argv);
     }
     std::fflush(stdout);

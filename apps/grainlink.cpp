@@ -1,5 +1,6 @@
 // The `grainlink` command: one binary, one subcommand per job.
 #include "CouplingCommands.hpp"
+#include "Nodes.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 
 #include <CLI/CLI.hpp>
@@ -48,6 +49,24 @@ int main(int argc, char **argv) {
         ->delimiter(',')
         ->required();
 
+    grainlink::apps::NodeOptions node;
+    auto *mbs_node = app.add_subcommand(
+        "mbs-node", "the Simbody single-wheel rig as a multibody participant (started by run)");
+    auto *dem_node =
+        app.add_subcommand("dem-node", "the DEM soil as a soil participant (started by run)");
+    for (auto *command : {mbs_node, dem_node}) {
+        command->add_option("scenario", node.scenario_path, "coupled scenario YAML")->required();
+        command->add_option("--name", node.name, "participant name")->required();
+        command->add_option("--endpoint", node.endpoint, "the coordinator's endpoint")->required();
+        command->add_option("--out", node.output_directory, "output directory")->required();
+        command->add_option("--keys", node.keys_directory, "CURVE keys directory");
+        command->add_option("--progress-interval", node.progress_interval_s,
+                            "seconds between progress lines");
+    }
+    dem_node->add_option("--bodies", node.bodies, "the coupled bodies it loads (comma separated)")
+        ->delimiter(',')
+        ->required();
+
     CLI11_PARSE(app, argc, argv);
     try {
         if (dem->parsed()) {
@@ -61,6 +80,10 @@ int main(int argc, char **argv) {
             return grainlink::apps::runCoupled(coupled);
         } else if (coordinator->parsed()) {
             return grainlink::apps::runCoordinator(coupled);
+        } else if (mbs_node->parsed()) {
+            return grainlink::apps::runMultibodyNode(node);
+        } else if (dem_node->parsed()) {
+            return grainlink::apps::runSoilNode(node);
         } else if (keygen->parsed()) {
             return grainlink::apps::generateKeys(key_directory, key_names);
         }

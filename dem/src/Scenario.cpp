@@ -268,9 +268,9 @@ DemScenario loadScenario(const std::string &path) {
     return s;
 }
 
-DemScenario parseScenario(const ConfigNode &root) {
+DemScenario parseScenario(const ConfigNode &root, bool coupled) {
     DemScenario s;
-    s.name = root["name"].text();
+    s.name = coupled ? root.text("name", "soil") : root["name"].text();
     // Mesh files are found relative to the scenario file.
     const auto slash = root.file().rfind('/');
     const std::string dir = slash == std::string::npos ? "" : root.file().substr(0, slash + 1);
@@ -306,9 +306,11 @@ DemScenario parseScenario(const ConfigNode &root) {
     if (const auto bodies = root.optional("bodies"))
         for (const ConfigNode &b : bodies->items())
             s.bodies.push_back(parseBody(b, dir));
-    const ConfigNode run = root["run"];
-    s.duration_s = run["duration_s"].positive();
-    run.finish();
+    if (!coupled) { // a coupled soil runs as long as the coordinator says
+        const ConfigNode run = root["run"];
+        s.duration_s = run["duration_s"].positive();
+        run.finish();
+    }
     if (const auto out = root.optional("output")) {
         s.output.series_interval_s = out->number("series_interval_s", 0.01);
         s.output.snapshot_interval_s = out->number("snapshot_interval_s", 0.0);

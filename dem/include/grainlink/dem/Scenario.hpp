@@ -60,7 +60,8 @@ struct DemScenario {
 
 /// Reads and validates a scenario; errors name the file, key and line.
 DemScenario loadScenario(const std::string &path);
-DemScenario parseScenario(const ConfigNode &root);
+/// `coupled`: the soil section of a coupled run (no `run:`; bodies come from the coupling).
+DemScenario parseScenario(const ConfigNode &root, bool coupled = false);
 
 /// The system without mesh bodies (deposition runs without them).
 std::unique_ptr<DemSystem> makeSystem(const DemScenario &scenario);

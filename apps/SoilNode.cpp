@@ -1,0 +1,183 @@
+// The soil participant: the DEM bed (settled once, cached) with the coupled bodies' meshes moved
+// along each window's motion, returning the window-averaged wrench (impulse / window).
+#include "Nodes.hpp"
+#include "grainlink/coupling/Participant.hpp"
+#include "grainlink/dem/Checkpoint.hpp"
+#include "grainlink/dem/Progress.hpp"
+#include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/dem/WheelMesh.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+
+namespace grainlink::apps {
+
+namespace {
+
+dem::TriangleMesh meshOf(const coupling::BodyDescription &body) {
+    if (const auto *w = std::get_if<coupling::WheelGeometry>(&body.geometry)) {
+        dem::WheelMeshSpec spec;
+        spec.diameter_m = w->diameter_m;
+        spec.width_m = w->width_m;
+        spec.grouser_count = w->grouser_count;
+        spec.grouser_height_m = w->grouser_height_m;
+        spec.grouser_thickness_m = w->grouser_thickness_m;
+        spec.chevron = w->grouser_shape == coupling::GrouserShape::Chevron;
+        spec.closed_sides = w->closed_sides;
+        return dem::makeWheel(spec);
+    }
+    if (const auto *m = std::get_if<coupling::MeshGeometry>(&body.geometry)) {
+        dem::TriangleMesh mesh;
+        mesh.vertices_m = m->vertices_m;
+        for (std::size_t t = 0; t + 2 < m->triangles.size(); t += 3)
+            mesh.triangles.push_back(
+                {int(m->triangles[t]), int(m->triangles[t + 1]), int(m->triangles[t + 2])});
+        return mesh;
+    }
+    throw coupling::CouplingError("body '" + body.name + "' has no geometry the soil can touch");
+}
+
+/// Motion of one body inside the current window: cubic Hermite position (and its derivative)
+/// through both end states, orientation by slerp, angular velocity linear.
+struct WindowMotion {
+    double start_dem_s = 0.0, duration_s = 1.0;
+    coupling::BodyState a, b;
+
+    dem::RigidBodyState at(double dem_time_s) const {
+        const double H = duration_s;
+        const double s = std::clamp((dem_time_s - start_dem_s) / H, 0.0, 1.0);
+        const double s2 = s * s, s3 = s2 * s;
+        dem::RigidBodyState r;
+        r.position_m = (2 * s3 - 3 * s2 + 1) * a.position_m +
+                       (s3 - 2 * s2 + s) * H * a.linear_velocity_m_s +
+                       (-2 * s3 + 3 * s2) * b.position_m + (s3 - s2) * H * b.linear_velocity_m_s;
+        r.velocity_m_s =
+            ((6 * s2 - 6 * s) * a.position_m + (3 * s2 - 4 * s + 1) * H * a.linear_velocity_m_s +
+             (-6 * s2 + 6 * s) * b.position_m + (3 * s2 - 2 * s) * H * b.linear_velocity_m_s) /
+            H;
+        r.orientation = a.orientation.slerp(s, b.orientation).normalized();
+        r.angular_velocity_rad_s =
+            (1 - s) * a.angular_velocity_rad_s + s * b.angular_velocity_rad_s;
+        return r;
+    }
+};
+
+} // namespace
+
+int runSoilNode(const NodeOptions &options) {
+    const auto root = config::ConfigNode::loadFile(options.scenario_path);
+    const dem::DemScenario scenario = dem::parseScenario(root["soil"], true);
+    auto sys = dem::prepareSoil(scenario, options.progress_interval_s);
+    const double surface = dem::bedSurface(sys->particles());
+    const double dt = scenario.settings.time_step_s;
+    std::fprintf(stderr, "[%s] %zu particles, bed surface at z = %.4f m\n", options.name.c_str(),
+                 sys->particles().size(), surface);
+
+    coupling::ParticipantConfig config;
+    config.name = options.name;
+    config.role = coupling::Role::Soil;
+    config.endpoint = options.endpoint;
+    config.consumes = options.bodies;
+    config.capabilities.checkpoint = true;
+    if (!options.keys_directory.empty())
+        config.curve = coupling::loadClientKeys(options.keys_directory, options.name);
+    coupling::Participant participant(config);
+    const auto &run = participant.initialize();
+
+    // Every consumed body becomes a mesh body whose motion follows the current window.
+    std::vector<WindowMotion> motion(options.bodies.size());
+    for (std::size_t b = 0; b < options.bodies.size(); ++b) {
+        const auto description = std::find_if(
+            run.bodies.begin(), run.bodies.end(),
+            [&](const coupling::BodyDescription &d) { return d.name == options.bodies[b]; });
+        dem::MeshBody body(options.bodies[b], meshOf(*description), dem::RigidBodyState{});
+        sys->addBody(std::move(body), [&motion, b](double t) { return motion[b].at(t); });
+    }
+    double dem_offset_s = sys->time() - run.start_tick * run.tick_s; // DEM time - coupling time
+    if (run.restore) {
+        const auto extras =
+            dem::readCheckpoint(*sys, run.restore->checkpoint_directory + "/soil.bin");
+        dem_offset_s = extras.at("dem_offset_s");
+    }
+
+    std::filesystem::create_directories(options.output_directory);
+    std::ofstream series(options.output_directory + "/soil.csv",
+                         run.restore ? std::ios::app : std::ios::trunc);
+    if (!run.restore)
+        series << "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts\n";
+    series.precision(10);
+    dem::Progress progress(options.name, options.progress_interval_s);
+    const std::uint64_t first_step = sys->stepCount();
+    const double end_s = run.end_tick * run.tick_s;
+
+    for (;;) {
+        switch (participant.waitForCommand()) {
+        case coupling::Command::WriteCheckpoint:
+            dem::writeCheckpoint(*sys, participant.checkpointDirectory() + "/soil.bin",
+                                 {{"dem_offset_s", dem_offset_s}});
+            series.flush();
+            participant.checkpointWritten();
+            break;
+        case coupling::Command::Advance: {
+            const auto &in = participant.inputs();
+            const double steps_real = in.duration_s / dt;
+            const auto steps = static_cast<std::uint64_t>(std::llround(steps_real));
+            if (steps == 0 || std::abs(steps_real - double(steps)) > 1e-6)
+                throw coupling::CouplingError("participant '" + options.name +
+                                              "': the macro step " + std::to_string(in.duration_s) +
+                                              " s is not a whole number of DEM time steps (" +
+                                              std::to_string(dt) + " s)");
+            for (std::size_t b = 0; b < motion.size(); ++b) {
+                motion[b].start_dem_s = in.start_s + dem_offset_s;
+                motion[b].duration_s = in.duration_s;
+                motion[b].a = in.start_states.at(b);
+                motion[b].b = in.end_states.at(b);
+                sys->body(int(b)).setState(motion[b].at(motion[b].start_dem_s));
+                sys->body(int(b)).resetAccumulatedImpulse();
+            }
+            std::vector<double> work(motion.size(), 0.0);
+            for (std::uint64_t k = 0; k < steps; ++k) {
+                sys->step();
+                for (std::size_t b = 0; b < motion.size(); ++b) {
+                    const auto &body = sys->body(int(b));
+                    work[b] += (body.force_N.dot(body.state().velocity_m_s) +
+                                body.torque_N_m.dot(body.state().angular_velocity_rad_s)) *
+                               dt;
+                }
+            }
+            // The soil's load on the body: the impulse over the window divided by the window.
+            coupling::WindowOutputs out;
+            for (std::size_t b = 0; b < motion.size(); ++b) {
+                const auto &body = sys->body(int(b));
+                coupling::Wrench w;
+                w.body = options.bodies[b];
+                w.force_N = body.impulse_N_s / in.duration_s;
+                w.torque_N_m = body.angular_impulse_N_m_s / in.duration_s;
+                out.wrenches.push_back(w);
+                out.work.push_back({w.body, work[b]});
+                double lowest = 1e300;
+                for (const auto &v : body.worldVertices())
+                    lowest = std::min(lowest, v.z());
+                series << in.end_s << ',' << w.body << ',' << surface - lowest << ','
+                       << w.force_N.x() << ',' << w.force_N.y() << ',' << w.force_N.z() << ','
+                       << w.torque_N_m.x() << ',' << w.torque_N_m.y() << ',' << w.torque_N_m.z()
+                       << ',' << sys->wallContactCount() << '\n';
+            }
+            participant.writeOutputs(std::move(out));
+            participant.advance();
+            progress.update(in.end_s, in.end_s / end_s,
+                            (sys->stepCount() - first_step) * sys->particles().size(), "");
+            break;
+        }
+        case coupling::Command::Finish:
+            participant.finalize();
+            series.flush();
+            return 0;
+        }
+    }
+}
+
+} // namespace grainlink::apps
