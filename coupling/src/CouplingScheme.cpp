@@ -10,26 +10,31 @@ namespace grainlink::coupling {
 
 namespace {
 
-/// `items` (states or wrenches) rearranged into the scheme's body order: one per body.
+/// `items` (states or wrenches) rearranged into the scheme's body order, one per body, into `out`
+/// (its storage is reused; on an error it holds a partial result). `seen` is scratch space.
 template <typename T>
-std::vector<T> inBodyOrder(const std::vector<T> &items, const std::vector<std::string> &bodies,
-                           const std::string &what) {
-    std::vector<T> out(bodies.size());
-    std::vector<bool> seen(bodies.size(), false);
-    for (const auto &item : items) {
-        const auto b = static_cast<std::size_t>(std::find(bodies.begin(), bodies.end(), item.body) -
-                                                bodies.begin());
+void inBodyOrder(const std::vector<T> &items, const std::vector<std::string> &bodies,
+                 const std::string &what, std::vector<T> &out, std::vector<char> &seen) {
+    out.resize(bodies.size());
+    seen.assign(bodies.size(), 0);
+    for (std::size_t i = 0; i < items.size(); ++i) {
+        const auto &item = items[i];
+        // Items usually come in body order already: try that place first.
+        const auto b =
+            i < bodies.size() && bodies[i] == item.body
+                ? i
+                : static_cast<std::size_t>(std::find(bodies.begin(), bodies.end(), item.body) -
+                                           bodies.begin());
         if (b == bodies.size())
             throw CouplingError(what + " for unknown body '" + item.body + "'");
         if (seen[b])
             throw CouplingError("two " + what + "s for body '" + item.body + "'");
-        seen[b] = true;
+        seen[b] = 1;
         out[b] = item;
     }
     for (std::size_t b = 0; b < bodies.size(); ++b)
         if (!seen[b])
             throw CouplingError("no " + what + " for body '" + bodies[b] + "'");
-    return out;
 }
 
 } // namespace
@@ -64,8 +69,12 @@ CouplingScheme::CouplingScheme(const SchemeSettings &settings, std::vector<BodyS
 }
 
 void CouplingScheme::restore(std::vector<BodyState> states, std::vector<Wrench> wrenches) {
-    states_ = ordered(states);
-    wrenches_ = ordered(wrenches);
+    std::vector<BodyState> ordered_states;
+    std::vector<Wrench> ordered_wrenches;
+    order(states, ordered_states);
+    order(wrenches, ordered_wrenches);
+    states_ = std::move(ordered_states);
+    wrenches_ = std::move(ordered_wrenches);
     stage_ = Stage::Accepted;
 }
 
@@ -91,41 +100,44 @@ void CouplingScheme::beginWindow(double window_s) {
 }
 
 std::vector<Task> CouplingScheme::tasks() const {
+    std::vector<Task> out;
+    tasks(out);
+    return out;
+}
+
+void CouplingScheme::tasks(std::vector<Task> &out) const {
     const bool implicit = settings_.kind == SchemeKind::Implicit;
-    Task multibody;
-    multibody.role = Role::Multibody;
-    multibody.iteration = iteration_;
-    multibody.save_state = implicit && iteration_ == 0;
-    multibody.restore_state = implicit && iteration_ > 0;
-    multibody.wrenches = applied_;
-    Task soil = multibody;
-    soil.role = Role::Soil;
-    soil.wrenches.clear();
-    soil.start_states = states_;
-    soil.end_states = soil_inputs_;
-    switch (stage_) {
-    case Stage::Multibody:
-        return {multibody};
-    case Stage::Soil:
-        return {soil};
-    case Stage::Both: {
-        std::vector<Task> out;
-        if (!multibody_done_)
-            out.push_back(multibody);
-        if (!soil_done_)
-            out.push_back(soil);
-        return out;
-    }
-    case Stage::Accepted:
-        break;
-    }
-    return {};
+    const bool multibody =
+        stage_ == Stage::Multibody || (stage_ == Stage::Both && !multibody_done_);
+    const bool soil = stage_ == Stage::Soil || (stage_ == Stage::Both && !soil_done_);
+    out.resize(std::size_t(multibody) + std::size_t(soil));
+    // Assigned field by field, so a reused `out` keeps its vectors' storage.
+    auto set = [&](Task &task, Role role) {
+        task.role = role;
+        task.iteration = iteration_;
+        task.save_state = implicit && iteration_ == 0;
+        task.restore_state = implicit && iteration_ > 0;
+        if (role == Role::Multibody) {
+            task.wrenches = applied_;
+            task.start_states.clear();
+            task.end_states.clear();
+        } else {
+            task.wrenches.clear();
+            task.start_states = states_;
+            task.end_states = soil_inputs_;
+        }
+    };
+    if (multibody)
+        set(out.front(), Role::Multibody);
+    if (soil)
+        set(out.back(), Role::Soil);
 }
 
 void CouplingScheme::completeMultibody(const std::vector<BodyState> &end_states) {
     if (!(stage_ == Stage::Multibody || (stage_ == Stage::Both && !multibody_done_)))
         throw CouplingError("multibody result arrived when none was expected");
-    end_states_ = ordered(end_states);
+    order(end_states, scratch_states_); // end_states_ stays as it was if this throws
+    std::swap(end_states_, scratch_states_);
     if (stage_ == Stage::Multibody) {
         soil_inputs_ = end_states_;
         stage_ = Stage::Soil;
@@ -139,7 +151,8 @@ void CouplingScheme::completeMultibody(const std::vector<BodyState> &end_states)
 void CouplingScheme::completeSoil(const std::vector<Wrench> &wrenches) {
     if (!(stage_ == Stage::Soil || (stage_ == Stage::Both && !soil_done_)))
         throw CouplingError("soil result arrived when none was expected");
-    soil_result_ = ordered(wrenches);
+    order(wrenches, scratch_wrenches_);
+    std::swap(soil_result_, scratch_wrenches_);
     if (stage_ == Stage::Both) {
         soil_done_ = true;
         if (!multibody_done_)
@@ -179,12 +192,12 @@ void CouplingScheme::finishIteration(const std::vector<Wrench> &soil_wrenches) {
     stage_ = Stage::Multibody;
 }
 
-std::vector<BodyState> CouplingScheme::ordered(const std::vector<BodyState> &states) const {
-    return inBodyOrder(states, bodies_, "state");
+void CouplingScheme::order(const std::vector<BodyState> &states, std::vector<BodyState> &out) {
+    inBodyOrder(states, bodies_, "state", out, seen_);
 }
 
-std::vector<Wrench> CouplingScheme::ordered(const std::vector<Wrench> &wrenches) const {
-    return inBodyOrder(wrenches, bodies_, "wrench");
+void CouplingScheme::order(const std::vector<Wrench> &wrenches, std::vector<Wrench> &out) {
+    inBodyOrder(wrenches, bodies_, "wrench", out, seen_);
 }
 
 std::vector<BodyState> CouplingScheme::extrapolated(double window_s) const {

@@ -40,6 +40,8 @@ public:
     void beginWindow(double window_s);
     /// What must run now, all of it concurrently; empty once the window is accepted.
     std::vector<Task> tasks() const;
+    /// The same into `out`, reusing its storage: no allocation per call once warm.
+    void tasks(std::vector<Task> &out) const;
     void completeMultibody(const std::vector<BodyState> &end_states);
     void completeSoil(const std::vector<Wrench> &wrenches);
 
@@ -54,8 +56,9 @@ public:
 
 private:
     enum class Stage { Multibody, Soil, Both, Accepted };
-    std::vector<BodyState> ordered(const std::vector<BodyState> &states) const;
-    std::vector<Wrench> ordered(const std::vector<Wrench> &wrenches) const;
+    /// `states` (or `wrenches`) in body order into `out`; throws on a missing or unknown body.
+    void order(const std::vector<BodyState> &states, std::vector<BodyState> &out);
+    void order(const std::vector<Wrench> &wrenches, std::vector<Wrench> &out);
     std::vector<BodyState> extrapolated(double window_s) const;
     void finishIteration(const std::vector<Wrench> &soil_wrenches);
 
@@ -72,6 +75,9 @@ private:
     std::vector<Wrench> wrenches_;       ///< accepted wrenches of the last window
     std::vector<Wrench> applied_;        ///< what the multibody side applies this iteration
     std::vector<Wrench> soil_result_;
+    std::vector<BodyState> scratch_states_; ///< reused by completeMultibody()
+    std::vector<Wrench> scratch_wrenches_;  ///< reused by completeSoil()
+    std::vector<char> seen_;                ///< scratch of order()
 };
 
 /// Wrenches as one vector (force, torque per body) for the fixed-point iteration.
