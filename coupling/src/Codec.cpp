@@ -128,12 +128,24 @@ void toWire(const std::vector<BodyState> &states, Ticks tick, pb::BodyStates *ou
         toWire(s, out->add_states());
 }
 
+void toWire(const std::vector<BodyState> &states, const std::vector<std::size_t> &which, Ticks tick,
+            pb::BodyStates *out) {
+    out->set_tick(tick);
+    out->mutable_states()->Reserve(static_cast<int>(which.size()));
+    for (const auto b : which)
+        toWire(states[b], out->add_states());
+}
+
 std::vector<BodyState> fromWire(const pb::BodyStates &states) {
     std::vector<BodyState> out;
-    out.reserve(states.states_size());
-    for (const auto &s : states.states())
-        out.push_back(fromWire(s));
+    fromWire(states, out);
     return out;
+}
+
+void fromWire(const pb::BodyStates &states, std::vector<BodyState> &out) {
+    out.resize(static_cast<std::size_t>(states.states_size()));
+    for (int i = 0; i < states.states_size(); ++i)
+        out[static_cast<std::size_t>(i)] = fromWire(states.states(i));
 }
 
 void toWire(const Wrench &wrench, pb::BodyWrench *out) {
@@ -165,12 +177,25 @@ void toWire(const std::vector<Wrench> &wrenches, Ticks start, Ticks end, pb::Bod
         toWire(w, out->add_wrenches());
 }
 
+void toWire(const std::vector<Wrench> &wrenches, const std::vector<std::size_t> &which, Ticks start,
+            Ticks end, pb::BodyWrenches *out) {
+    out->set_start_tick(start);
+    out->set_end_tick(end);
+    out->mutable_wrenches()->Reserve(static_cast<int>(which.size()));
+    for (const auto b : which)
+        toWire(wrenches[b], out->add_wrenches());
+}
+
 std::vector<Wrench> fromWire(const pb::BodyWrenches &wrenches) {
     std::vector<Wrench> out;
-    out.reserve(wrenches.wrenches_size());
-    for (const auto &w : wrenches.wrenches())
-        out.push_back(fromWire(w));
+    fromWire(wrenches, out);
     return out;
+}
+
+void fromWire(const pb::BodyWrenches &wrenches, std::vector<Wrench> &out) {
+    out.resize(static_cast<std::size_t>(wrenches.wrenches_size()));
+    for (int i = 0; i < wrenches.wrenches_size(); ++i)
+        out[static_cast<std::size_t>(i)] = fromWire(wrenches.wrenches(i));
 }
 
 pb::Role toWire(Role role) {
@@ -222,6 +247,11 @@ std::string encode(const pb::Envelope &envelope) {
 
 pb::Envelope decode(const void *data, std::size_t size, const std::string &from) {
     pb::Envelope envelope;
+    decode(data, size, from, envelope);
+    return envelope;
+}
+
+void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &envelope) {
     if (!envelope.ParseFromArray(data, static_cast<int>(size)))
         throw ProtocolError(pb::Error::CODE_MALFORMED,
                             "malformed message from " + from + " (" + std::to_string(size) +
@@ -236,7 +266,14 @@ pb::Envelope decode(const void *data, std::size_t size, const std::string &from)
         throw ProtocolError(pb::Error::CODE_MALFORMED,
                             "message from " + from + " has no body (an unset body is an error)",
                             envelope.sender());
-    return envelope;
+}
+
+ScratchEnvelope::ScratchEnvelope()
+    : block_(std::make_unique<char[]>(kBlockBytes)), arena_(block_.get(), kBlockBytes) {}
+
+pb::Envelope &ScratchEnvelope::fresh() {
+    arena_.Reset();
+    return *google::protobuf::Arena::CreateMessage<pb::Envelope>(&arena_);
 }
 
 std::string bodyName(const pb::Envelope &envelope) {

@@ -4,6 +4,9 @@
 #include "grainlink/coupling/Types.hpp"
 #include "grainlink/v1/coupling.pb.h"
 
+#include <google/protobuf/arena.h>
+
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -31,12 +34,22 @@ BodyDescription fromWire(const pb::BodyDescription &body);
 void toWire(const BodyState &state, pb::BodyState *out);
 BodyState fromWire(const pb::BodyState &state);
 void toWire(const std::vector<BodyState> &states, Ticks tick, pb::BodyStates *out);
+/// Only the states `which` picks (indices into `states`, in that order).
+void toWire(const std::vector<BodyState> &states, const std::vector<std::size_t> &which, Ticks tick,
+            pb::BodyStates *out);
 std::vector<BodyState> fromWire(const pb::BodyStates &states);
+/// The same into `out`, reusing its storage.
+void fromWire(const pb::BodyStates &states, std::vector<BodyState> &out);
 
 void toWire(const Wrench &wrench, pb::BodyWrench *out);
 Wrench fromWire(const pb::BodyWrench &wrench);
 void toWire(const std::vector<Wrench> &wrenches, Ticks start, Ticks end, pb::BodyWrenches *out);
+/// Only the wrenches `which` picks (indices into `wrenches`, in that order).
+void toWire(const std::vector<Wrench> &wrenches, const std::vector<std::size_t> &which, Ticks start,
+            Ticks end, pb::BodyWrenches *out);
 std::vector<Wrench> fromWire(const pb::BodyWrenches &wrenches);
+/// The same into `out`, reusing its storage.
+void fromWire(const pb::BodyWrenches &wrenches, std::vector<Wrench> &out);
 
 pb::Role toWire(Role role);
 Role fromWire(pb::Role role, const std::string &who);
@@ -48,6 +61,27 @@ std::string encode(const pb::Envelope &envelope);
 /// Parses and checks an envelope: well-formed bytes, our major version, a body set.
 /// `from` names the peer in error messages.
 pb::Envelope decode(const void *data, std::size_t size, const std::string &from);
+
+/// The same into `out` (an empty envelope, e.g. ScratchEnvelope::fresh()).
+void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &out);
+
+/// An envelope whose memory is kept from one message to the next: it lives on an arena with a
+/// fixed first block that is reset for each message, so building or parsing the messages of a
+/// window allocates nothing. One per direction and thread.
+class ScratchEnvelope {
+public:
+    ScratchEnvelope();
+    ScratchEnvelope(const ScratchEnvelope &) = delete;
+    ScratchEnvelope &operator=(const ScratchEnvelope &) = delete;
+
+    /// A new, empty envelope; the previous one, and all that pointed into it, is gone.
+    pb::Envelope &fresh();
+
+private:
+    static constexpr std::size_t kBlockBytes = 16 * 1024; ///< holds a window's message (~1 kB)
+    std::unique_ptr<char[]> block_;
+    google::protobuf::Arena arena_;
+};
 
 /// The name of the envelope's body ("hello", "advance_to", ...), for messages.
 std::string bodyName(const pb::Envelope &envelope);

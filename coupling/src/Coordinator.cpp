@@ -30,6 +30,7 @@ namespace {
 /// A participant as the coordinator knows it.
 struct Peer {
     ParticipantSpec spec;
+    std::string who; ///< "participant '<name>'", for messages
     bool joined = false;
     std::string routing_id;
     std::string heartbeat_id; ///< routing id of its heartbeat connection
@@ -37,15 +38,44 @@ struct Peer {
     std::vector<BodyState> initial_states;
     std::vector<std::string> consumes;
     Capabilities capabilities;
+    // Set once the bodies are known (collectBodies), so a window builds no name lists:
+    std::vector<std::size_t> inputs;  ///< the bodies (indices, body order) whose inputs it gets
+    std::vector<std::string> outputs; ///< the bodies it must answer for (what it provides or
+                                      ///< consumes, in that order)
     std::uint64_t sent_sequence = 0;
     std::uint64_t received_sequence = 0;
     Clock::time_point last_seen;
 };
 
+/// Which participants the coordinator waits for; a plain flag per participant, so that waiting
+/// allocates nothing per window.
+class PeerSet {
+public:
+    explicit PeerSet(std::size_t peers) : member_(peers, 0) {}
+    void insert(std::size_t p) {
+        count_ += !member_[p];
+        member_[p] = 1;
+    }
+    void erase(std::size_t p) {
+        count_ -= member_[p];
+        member_[p] = 0;
+    }
+    bool contains(std::size_t p) const { return member_[p] != 0; }
+    bool empty() const { return count_ == 0; }
+    std::size_t first() const {
+        return static_cast<std::size_t>(std::find(member_.begin(), member_.end(), 1) -
+                                        member_.begin());
+    }
+
+private:
+    std::vector<char> member_;
+    std::size_t count_ = 0;
+};
+
 /// A message from a joined participant's main connection.
 struct Incoming {
     std::size_t peer;
-    pb::Envelope envelope;
+    const pb::Envelope &envelope; ///< valid until the next message is received
 };
 
 std::string makeRunId() {
@@ -83,6 +113,13 @@ struct Coordinator::Impl {
     std::vector<BodyDescription> bodies;
     std::string run_id = makeRunId();
     std::unique_ptr<CouplingScheme> scheme;
+    // Reused every window (no allocation once warm):
+    codec::ScratchEnvelope incoming; ///< the last message received from a joined participant
+    codec::ScratchEnvelope outgoing; ///< a window's AdvanceTo
+    std::vector<Task> tasks;
+    PeerSet pending_peers{0};
+    std::vector<BodyState> received_states, got_states;
+    std::vector<Wrench> received_wrenches, got_wrenches;
 
     std::uint64_t window = 0;
     Ticks tick = 0, end_tick = 0, macro_step_ticks = 0;
@@ -98,7 +135,8 @@ struct Coordinator::Impl {
         std::vector<BodyState> states;
         std::vector<Wrench> wrenches;
     };
-    std::optional<PendingRow> pending_row; ///< the last window, not yet in coupling.csv
+    PendingRow pending_row;   ///< the last window, not yet in coupling.csv (storage reused)
+    bool row_pending = false; ///< pending_row holds a row to write
     std::string completed_by; ///< the participant that declared the experiment complete
     const std::string heartbeat_bytes = [] {
         pb::Envelope e;
@@ -118,9 +156,9 @@ struct Coordinator::Impl {
     }
 
     void writePendingRow() {
-        if (series && pending_row) {
-            series->append(pending_row->row, pending_row->states, pending_row->wrenches);
-            pending_row.reset();
+        if (series && row_pending) {
+            series->append(pending_row.row, pending_row.states, pending_row.wrenches);
+            row_pending = false;
         }
     }
 
@@ -160,11 +198,16 @@ struct Coordinator::Impl {
 
     pb::Envelope envelopeFor(std::size_t p) {
         pb::Envelope e;
+        address(p, e);
+        return e;
+    }
+
+    /// Fills in the envelope's header for the next message to participant `p`.
+    void address(std::size_t p, pb::Envelope &e) {
         e.set_version(kProtocolMajor);
         e.set_sender("coordinator");
         e.set_sequence(++peers[p].sent_sequence);
         e.set_window(window);
-        return e;
     }
 
     void sendRaw(const std::string &routing_id, const std::string &bytes, bool dontwait = false) {
@@ -175,7 +218,8 @@ struct Coordinator::Impl {
 
     void send(std::size_t p, const pb::Envelope &e) {
         try {
-            sendRaw(peers[p].routing_id, codec::encode(e));
+            router.send(zmq::buffer(peers[p].routing_id), zmq::send_flags::sndmore);
+            router.send(sockets::encode(e), zmq::send_flags::none);
         } catch (const zmq::error_t &error) {
             fail("participant '" + peers[p].spec.name + "'",
                  std::string("cannot be reached (") + error.what() + "): it disconnected");
@@ -221,20 +265,18 @@ struct Coordinator::Impl {
     /// Receives for up to 20 ms; answers heartbeats and strangers itself and returns
     /// the next message of a joined participant, if any. Checks liveness and Ctrl-C each call.
     std::optional<Incoming> pump() {
-        std::optional<Incoming> result;
         zmq::message_t id, payload;
-        if (sockets::receive(router, id)) { // waits at most the router's rcvtimeo (20 ms)
-            if (!id.more()) {
-                checkHealth();
-                return std::nullopt;
-            }
-            (void)router.recv(payload, zmq::recv_flags::none);
-            while (payload.more()) { // a well-behaved DEALER sends one frame; drop the rest
-                zmq::message_t extra;
-                (void)router.recv(extra, zmq::recv_flags::none);
-            }
-            result = handle(id.to_string(), payload);
+        if (!sockets::receive(router, id) || // waits at most the router's rcvtimeo (20 ms)
+            !id.more()) {
+            checkHealth();
+            return std::nullopt;
         }
+        (void)router.recv(payload, zmq::recv_flags::none);
+        while (payload.more()) { // a well-behaved DEALER sends one frame; drop the rest
+            zmq::message_t extra;
+            (void)router.recv(extra, zmq::recv_flags::none);
+        }
+        auto result = handle(id.to_string(), payload);
         checkHealth();
         return result;
     }
@@ -242,10 +284,10 @@ struct Coordinator::Impl {
     std::optional<Incoming> handle(const std::string &id, const zmq::message_t &payload) {
         if (const auto p = peerByRoutingId(id)) {
             Peer &peer = peers[*p];
-            const auto who = [&peer] { return "participant '" + peer.spec.name + "'"; };
-            pb::Envelope e;
+            const auto who = [&peer]() -> const std::string & { return peer.who; };
+            pb::Envelope &e = incoming.fresh();
             try {
-                e = codec::decode(payload.data(), payload.size(), who());
+                codec::decode(payload.data(), payload.size(), who(), e);
             } catch (const codec::ProtocolError &error) {
                 fail(who(), std::string("sent a bad message: ") + error.what());
             }
@@ -263,7 +305,7 @@ struct Coordinator::Impl {
                 return std::nullopt;
             if (e.has_error())
                 fail(who(), "reported: " + e.error().message());
-            return Incoming{*p, std::move(e)};
+            return Incoming{*p, e};
         }
         return handleStranger(id, payload);
     }
@@ -399,22 +441,21 @@ struct Coordinator::Impl {
     }
 
     /// Waits until each participant in `pending` sent the message `accept` takes.
-    template <typename Accept>
-    void awaitFrom(std::set<std::size_t> pending, const char *what, Accept accept) {
+    template <typename Accept> void awaitFrom(PeerSet &pending, const char *what, Accept accept) {
         const auto start = Clock::now();
         while (!pending.empty()) {
             if (auto in = pump()) {
-                const std::string who = "participant '" + peers[in->peer].spec.name + "'";
-                if (!pending.count(in->peer) || !accept(in->peer, in->envelope))
-                    fail(who, "sent " + codec::bodyName(in->envelope) + " for window " +
-                                  std::to_string(in->envelope.window()) +
-                                  " while the coordinator "
-                                  "waited for " +
-                                  what);
+                if (!pending.contains(in->peer) || !accept(in->peer, in->envelope))
+                    fail(peers[in->peer].who, "sent " + codec::bodyName(in->envelope) +
+                                                  " for window " +
+                                                  std::to_string(in->envelope.window()) +
+                                                  " while the coordinator "
+                                                  "waited for " +
+                                                  what);
                 pending.erase(in->peer);
             }
             if (!pending.empty() && sockets::secondsSince(start) > config.window_timeout_s)
-                fail("participant '" + peers[*pending.begin()].spec.name + "'",
+                fail(peers[pending.first()].who,
                      std::string("did not send ") + what + " within window_timeout_s = " +
                          formatSeconds(config.window_timeout_s) + " s (hung?)");
         }
@@ -490,6 +531,18 @@ struct Coordinator::Impl {
                     fail("participant '" + peer.spec.name + "'",
                          "cannot write checkpoints, but checkpoint_every_windows = " +
                              std::to_string(config.checkpoint_every_windows));
+        for (auto &peer : peers) {
+            if (peer.spec.role == Role::Multibody)
+                for (const auto &b : peer.provides)
+                    peer.outputs.push_back(b.name);
+            else
+                peer.outputs = peer.consumes;
+            for (std::size_t b = 0; b < body_names.size(); ++b)
+                if (std::find(peer.outputs.begin(), peer.outputs.end(), body_names[b]) !=
+                    peer.outputs.end())
+                    peer.inputs.push_back(b);
+        }
+        pending_peers = PeerSet(peers.size());
         scheme = std::make_unique<CouplingScheme>(config.scheme, std::move(initial));
     }
 
@@ -529,63 +582,47 @@ struct Coordinator::Impl {
         handshake_done = true;
     }
 
-    template <typename T, typename Name>
-    static std::vector<T> only(const std::vector<T> &items, const std::vector<std::string> &names,
-                               Name name) {
-        std::vector<T> out;
-        for (const auto &item : items)
-            if (std::find(names.begin(), names.end(), name(item)) != names.end())
-                out.push_back(item);
-        return out;
-    }
-
-    std::vector<std::string> providedBy(const Peer &peer) const {
-        std::vector<std::string> names;
-        for (const auto &b : peer.provides)
-            names.push_back(b.name);
-        return names;
-    }
-
     /// One window: the scheme's tasks until it accepts. Returns the work each side reported.
     std::pair<double, double> runWindow(Ticks start, Ticks end) {
         scheme->beginWindow((end - start) * config.tick_s);
         double work_multibody = 0.0, work_soil = 0.0;
-        for (auto tasks = scheme->tasks(); !tasks.empty(); tasks = scheme->tasks()) {
-            std::set<std::size_t> pending;
+        for (scheme->tasks(tasks); !tasks.empty(); scheme->tasks(tasks)) {
+            PeerSet &pending = pending_peers;
             for (const auto &task : tasks)
                 for (std::size_t p = 0; p < peers.size(); ++p) {
                     if (peers[p].spec.role != task.role)
                         continue;
-                    pb::Envelope e = envelopeFor(p);
+                    pb::Envelope &e = outgoing.fresh();
+                    address(p, e);
                     auto *a = e.mutable_advance_to();
                     a->set_start_tick(start);
                     a->set_end_tick(end);
                     a->set_iteration(task.iteration);
                     a->set_save_state(task.save_state);
                     a->set_restore_state(task.restore_state);
-                    auto name_of = [](const auto &x) { return x.body; };
+                    // The scheme's lists are in body order; `inputs` picks this peer's bodies.
                     if (task.role == Role::Multibody) {
-                        codec::toWire(only(task.wrenches, providedBy(peers[p]), name_of), start,
-                                      end, a->mutable_wrenches());
+                        codec::toWire(task.wrenches, peers[p].inputs, start, end,
+                                      a->mutable_wrenches());
                     } else {
-                        codec::toWire(only(task.start_states, peers[p].consumes, name_of), start,
+                        codec::toWire(task.start_states, peers[p].inputs, start,
                                       a->mutable_start_states());
-                        codec::toWire(only(task.end_states, peers[p].consumes, name_of), end,
+                        codec::toWire(task.end_states, peers[p].inputs, end,
                                       a->mutable_end_states());
                     }
                     send(p, e);
                     pending.insert(p);
                 }
             writePendingRow();
-            std::vector<BodyState> states;
-            std::vector<Wrench> wrenches;
+            received_states.clear();
+            received_wrenches.clear();
             double mb_work = 0.0, soil_work = 0.0;
             const unsigned iteration = tasks.front().iteration;
             awaitFrom(pending, "WindowDone", [&](std::size_t p, const pb::Envelope &e) {
                 if (!e.has_window_done() || e.window() != window)
                     return false;
                 const auto &done = e.window_done();
-                const std::string who = "participant '" + peers[p].spec.name + "'";
+                const std::string &who = peers[p].who;
                 if (done.end_tick() != end)
                     fail(who, "reports end tick " + std::to_string(done.end_tick()) +
                                   " for a window that ends at tick " + std::to_string(end));
@@ -594,13 +631,15 @@ struct Coordinator::Impl {
                                   ", expected " + std::to_string(iteration));
                 try {
                     if (peers[p].spec.role == Role::Multibody) {
-                        auto got = codec::fromWire(done.states());
-                        checkNames(who, "states", got, providedBy(peers[p]));
-                        states.insert(states.end(), got.begin(), got.end());
+                        codec::fromWire(done.states(), got_states);
+                        checkNames(peers[p], "states", got_states);
+                        received_states.insert(received_states.end(), got_states.begin(),
+                                               got_states.end());
                     } else {
-                        auto got = codec::fromWire(done.wrenches());
-                        checkNames(who, "wrenches", got, peers[p].consumes);
-                        wrenches.insert(wrenches.end(), got.begin(), got.end());
+                        codec::fromWire(done.wrenches(), got_wrenches);
+                        checkNames(peers[p], "wrenches", got_wrenches);
+                        received_wrenches.insert(received_wrenches.end(), got_wrenches.begin(),
+                                                 got_wrenches.end());
                     }
                 } catch (const codec::ProtocolError &error) {
                     fail(who, error.what());
@@ -620,11 +659,11 @@ struct Coordinator::Impl {
                 for (const auto &task : tasks)
                     (task.role == Role::Multibody ? has_multibody : has_soil) = true;
                 if (has_multibody) {
-                    scheme->completeMultibody(states);
+                    scheme->completeMultibody(received_states);
                     work_multibody = mb_work;
                 }
                 if (has_soil) {
-                    scheme->completeSoil(wrenches);
+                    scheme->completeSoil(received_wrenches);
                     work_soil = soil_work;
                 }
             } catch (const CouplingError &error) {
@@ -634,12 +673,13 @@ struct Coordinator::Impl {
         return {work_multibody, work_soil};
     }
 
+    /// Fails unless `got` is finite and names exactly the bodies `peer` answers for.
     template <typename T>
-    void checkNames(const std::string &who, const char *what, const std::vector<T> &got,
-                    std::vector<std::string> expected) {
-        std::vector<std::string> names;
-        for (const auto &x : got) {
-            names.push_back(x.body);
+    void checkNames(const Peer &peer, const char *what, const std::vector<T> &got) {
+        const std::string &who = peer.who;
+        bool in_order = got.size() == peer.outputs.size();
+        for (std::size_t i = 0; i < got.size(); ++i) {
+            const auto &x = got[i];
             if constexpr (std::is_same_v<T, BodyState>) {
                 if (!x.position_m.allFinite() || !x.linear_velocity_m_s.allFinite() ||
                     !x.angular_velocity_rad_s.allFinite())
@@ -648,7 +688,13 @@ struct Coordinator::Impl {
                 if (!x.force_N.allFinite() || !x.torque_N_m.allFinite())
                     fail(who, "sent a non-finite wrench on body '" + x.body + "'");
             }
+            in_order = in_order && x.body == peer.outputs[i];
         }
+        if (in_order) // the usual case: the same names in the same order
+            return;
+        std::vector<std::string> names, expected = peer.outputs;
+        for (const auto &x : got)
+            names.push_back(x.body);
         std::sort(names.begin(), names.end());
         std::sort(expected.begin(), expected.end());
         if (names != expected) {
@@ -676,7 +722,7 @@ struct Coordinator::Impl {
     void writeCheckpoint() {
         const std::string directory = checkpointDirectory(window);
         fs::create_directories(directory);
-        std::set<std::size_t> all;
+        PeerSet all(peers.size());
         for (std::size_t p = 0; p < peers.size(); ++p) {
             pb::Envelope e = envelopeFor(p);
             auto *c = e.mutable_checkpoint();
@@ -800,6 +846,7 @@ Coordinator::Coordinator(CoordinatorConfig config)
         (p.role == Role::Multibody ? has_multibody : has_soil) = true;
         Peer peer;
         peer.spec = p;
+        peer.who = "participant '" + p.name + "'";
         s.peers.push_back(std::move(peer));
     }
     if (!has_multibody || !has_soil)
@@ -914,7 +961,10 @@ CoordinatorSummary Coordinator::run() {
             row.wall_s = sockets::secondsSince(window_started);
             // Written once the next window's inputs are out (or at the end, a checkpoint, a
             // failure): the formatting then overlaps the participants' work.
-            s.pending_row = Impl::PendingRow{row, s.scheme->states(), s.scheme->wrenches()};
+            s.pending_row.row = row;
+            s.pending_row.states = s.scheme->states(); // assigned: keeps the vectors' storage
+            s.pending_row.wrenches = s.scheme->wrenches();
+            s.row_pending = true;
         }
         s.tick += step;
         ++s.window;

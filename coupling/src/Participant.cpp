@@ -38,9 +38,20 @@ const char *stateName(Participant::State state) {
 }
 
 struct Participant::Impl {
-    explicit Impl(ParticipantConfig c) : config(std::move(c)) {}
+    explicit Impl(ParticipantConfig c)
+        : config(std::move(c)), who_text("participant '" + config.name + "'") {
+        if (config.role == Role::Multibody)
+            for (const auto &b : config.provides)
+                expected_bodies.push_back(b.name);
+        else
+            expected_bodies = config.consumes;
+    }
 
     ParticipantConfig config;
+    const std::string who_text;               ///< "participant '<name>'", for messages
+    std::vector<std::string> expected_bodies; ///< what writeOutputs() must answer for, in order
+    codec::ScratchEnvelope incoming;          ///< the last message from the coordinator
+    codec::ScratchEnvelope outgoing; ///< WindowDone, built anew each window in the same memory
     zmq::context_t &context = sockets::processContext();
     zmq::socket_t socket; ///< main connection, used by the calling thread only
     State state = State::Created;
@@ -65,15 +76,20 @@ struct Participant::Impl {
     std::atomic<double> heartbeat_interval_s{0.2};
     double peer_timeout_s = 5.0;
 
-    std::string who() const { return "participant '" + config.name + "'"; }
+    const std::string &who() const { return who_text; }
 
     pb::Envelope envelope(std::uint64_t window) {
         pb::Envelope e;
+        address(window, e);
+        return e;
+    }
+
+    /// Fills in the envelope's header for the next message to the coordinator.
+    void address(std::uint64_t window, pb::Envelope &e) {
         e.set_version(kProtocolMajor);
         e.set_sender(config.name);
         e.set_sequence(++sent_sequence);
         e.set_window(window);
-        return e;
     }
 
     void noteCoordinatorAlive() {
@@ -112,14 +128,16 @@ struct Participant::Impl {
         return "";
     }
 
-    /// Receives the next message from the coordinator, checking order and liveness.
-    pb::Envelope receive(double timeout_s, const char *waiting_for) {
+    /// Receives the next message from the coordinator, checking order and liveness. The envelope
+    /// stays valid until the next call.
+    const pb::Envelope &receive(double timeout_s, const char *waiting_for) {
         const auto start = Clock::now();
         for (;;) {
             zmq::message_t message;
             if (sockets::receive(socket, message)) { // waits at most 50 ms (rcvtimeo)
                 noteCoordinatorAlive();
-                pb::Envelope e = codec::decode(message.data(), message.size(), "the coordinator");
+                pb::Envelope &e = incoming.fresh();
+                codec::decode(message.data(), message.size(), "the coordinator", e);
                 if (e.sequence() != received_sequence + 1)
                     throw CouplingError(who() + ": message " + std::to_string(e.sequence()) +
                                         " from the coordinator arrived after " +
@@ -246,7 +264,7 @@ const RunInfo &Participant::initialize() {
         codec::toWire(s.config.initial_states, 0, h->mutable_initial_states());
     sockets::send(s.socket, hello);
 
-    const pb::Envelope reply = s.receive(s.config.handshake_timeout_s, "Welcome");
+    const pb::Envelope &reply = s.receive(s.config.handshake_timeout_s, "Welcome");
     if (!reply.has_welcome())
         s.stopped(reply);
     const auto &w = reply.welcome();
@@ -279,7 +297,7 @@ Command Participant::waitForCommand() {
         throw LifecycleError(s.who() + ": waitForCommand() called in state '" + stateName(s.state) +
                              "'; " + s.whatToDoNow());
     // No bound: a window of the other side may take long; liveness is the heartbeats' job.
-    const pb::Envelope e = s.receive(1e300, "the next command");
+    const pb::Envelope &e = s.receive(1e300, "the next command");
     if (e.has_advance_to()) {
         const auto &a = e.advance_to();
         if (e.window() != s.expected_window &&
@@ -287,7 +305,7 @@ Command Participant::waitForCommand() {
             throw CouplingError(s.who() + ": AdvanceTo for window " + std::to_string(e.window()) +
                                 " while window " + std::to_string(s.expected_window) +
                                 " was expected");
-        WindowInputs in;
+        WindowInputs &in = s.inputs; // filled in place: its vectors keep their storage
         in.window = e.window();
         in.start_tick = a.start_tick();
         in.end_tick = a.end_tick();
@@ -297,10 +315,9 @@ Command Participant::waitForCommand() {
         in.iteration = a.iteration();
         in.save_state = a.save_state();
         in.restore_state = a.restore_state();
-        in.wrenches = codec::fromWire(a.wrenches());
-        in.start_states = codec::fromWire(a.start_states());
-        in.end_states = codec::fromWire(a.end_states());
-        s.inputs = std::move(in);
+        codec::fromWire(a.wrenches(), in.wrenches);
+        codec::fromWire(a.start_states(), in.start_states);
+        codec::fromWire(a.end_states(), in.end_states);
         s.outputs = WindowOutputs{};
         s.expected_window = e.window() + 1;
         s.state = State::WindowOpen;
@@ -350,19 +367,28 @@ bool finite(const Vec3 &v) {
     return v.allFinite();
 }
 
-/// The names in `names`, checked against the expected set: each exactly once.
-void checkBodies(const std::string &who, const char *what, std::vector<std::string> names,
-                 std::vector<std::string> expected) {
+/// The bodies of `items`, checked against `expected`: each exactly once.
+template <typename T>
+void checkBodies(const std::string &who, const char *what, const std::vector<T> &items,
+                 const std::vector<std::string> &expected) {
+    bool in_order = items.size() == expected.size();
+    for (std::size_t i = 0; in_order && i < items.size(); ++i)
+        in_order = items[i].body == expected[i];
+    if (in_order) // the usual case: the same names in the same order
+        return;
+    std::vector<std::string> names, sorted_expected = expected;
+    for (const auto &x : items)
+        names.push_back(x.body);
     std::sort(names.begin(), names.end());
-    std::sort(expected.begin(), expected.end());
-    if (names == expected)
+    std::sort(sorted_expected.begin(), sorted_expected.end());
+    if (names == sorted_expected)
         return;
     std::ostringstream os;
     os << who << ": writeOutputs() got " << what << " for {";
     for (const auto &n : names)
         os << ' ' << n;
     os << " } but must give exactly one for each of {";
-    for (const auto &n : expected)
+    for (const auto &n : sorted_expected)
         os << ' ' << n;
     os << " }";
     throw CouplingError(os.str());
@@ -376,26 +402,20 @@ void Participant::writeOutputs(WindowOutputs outputs) {
         throw LifecycleError(s.who() + ": writeOutputs() called in state '" + stateName(s.state) +
                              "'; " + s.whatToDoNow());
     if (s.config.role == Role::Multibody) {
-        std::vector<std::string> names, expected;
         for (const auto &st : outputs.states) {
-            names.push_back(st.body);
             if (!finite(st.position_m) || !finite(st.linear_velocity_m_s) ||
                 !finite(st.angular_velocity_rad_s) || !std::isfinite(st.orientation.norm()))
                 throw CouplingError(s.who() + ": non-finite state of body '" + st.body +
                                     "' in window " + std::to_string(s.inputs.window));
         }
-        for (const auto &b : s.config.provides)
-            expected.push_back(b.name);
-        checkBodies(s.who(), "states", names, expected);
+        checkBodies(s.who(), "states", outputs.states, s.expected_bodies);
     } else {
-        std::vector<std::string> names;
         for (const auto &w : outputs.wrenches) {
-            names.push_back(w.body);
             if (!finite(w.force_N) || !finite(w.torque_N_m))
                 throw CouplingError(s.who() + ": non-finite wrench on body '" + w.body +
                                     "' in window " + std::to_string(s.inputs.window));
         }
-        checkBodies(s.who(), "wrenches", names, s.config.consumes);
+        checkBodies(s.who(), "wrenches", outputs.wrenches, s.expected_bodies);
     }
     s.outputs = std::move(outputs);
     s.state = State::OutputsWritten;
@@ -406,7 +426,8 @@ void Participant::advance() {
     if (s.state != State::OutputsWritten)
         throw LifecycleError(s.who() + ": advance() called in state '" + stateName(s.state) +
                              "'; " + s.whatToDoNow());
-    pb::Envelope e = s.envelope(s.inputs.window);
+    pb::Envelope &e = s.outgoing.fresh();
+    s.address(s.inputs.window, e);
     auto *done = e.mutable_window_done();
     done->set_end_tick(s.inputs.end_tick);
     done->set_iteration(s.inputs.iteration);

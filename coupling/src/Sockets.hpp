@@ -7,6 +7,7 @@
 
 #include <cerrno>
 #include <chrono>
+#include <cstdint>
 #include <optional>
 #include <string>
 
@@ -56,9 +57,15 @@ inline bool receive(zmq::socket_t &socket, zmq::message_t &message) {
     }
 }
 
+/// The envelope's bytes, serialized straight into a ZeroMQ message (no string, no copy).
+inline zmq::message_t encode(const codec::pb::Envelope &envelope) {
+    zmq::message_t message(envelope.ByteSizeLong());
+    envelope.SerializeWithCachedSizesToArray(static_cast<std::uint8_t *>(message.data()));
+    return message;
+}
+
 inline void send(zmq::socket_t &socket, const codec::pb::Envelope &envelope) {
-    const std::string bytes = codec::encode(envelope);
-    socket.send(zmq::buffer(bytes), zmq::send_flags::none);
+    socket.send(encode(envelope), zmq::send_flags::none);
 }
 
 /// Waits up to `timeout_ms` for a message; false on timeout or when a signal (Ctrl-C)
