@@ -137,6 +137,17 @@ int runSoilNode(const NodeOptions &options) {
                 motion[b].b = in.end_states.at(b);
                 sys->body(int(b)).setState(motion[b].at(motion[b].start_dem_s));
                 sys->body(int(b)).resetAccumulatedImpulse();
+                if (in.window == 0 && !run.restore) { // a body must not start buried in the bed
+                    double lowest = 1e300;
+                    for (const auto &v : sys->body(int(b)).worldVertices())
+                        lowest = std::min(lowest, v.z());
+                    if (lowest < surface)
+                        throw coupling::CouplingError(
+                            "participant '" + options.name + "': body '" + options.bodies[b] +
+                            "' starts " + std::to_string(1000.0 * (surface - lowest)) +
+                            " mm inside the settled bed (surface at z = " +
+                            std::to_string(surface) + " m): start it higher");
+                }
             }
             std::vector<double> work(motion.size(), 0.0);
             for (std::uint64_t k = 0; k < steps; ++k) {
