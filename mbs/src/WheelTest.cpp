@@ -75,7 +75,11 @@ bool WheelTest::afterWindow(SingleWheelRig &rig, const Wrench &soil) {
     const auto slip = [](const WheelSample &w) { return w.slip; };
     const MeanStd older = meanStd(drive_samples_, 0, middle, slip);
     const MeanStd newer = meanStd(drive_samples_, middle, drive_samples_.size(), slip);
-    if (std::abs(newer.mean - older.mean) >= settings_.steady_slip_tolerance)
+    const auto height = [](const WheelSample &w) { return w.wheel_z_m; };
+    const double sinking = meanStd(drive_samples_, middle, drive_samples_.size(), height).mean -
+                           meanStd(drive_samples_, 0, middle, height).mean;
+    if (std::abs(newer.mean - older.mean) >= settings_.steady_slip_tolerance ||
+        std::abs(sinking) >= settings_.steady_height_tolerance_m)
         return false;
     phase_ = Phase::Steady;
     steady_.reached = true;
@@ -128,6 +132,8 @@ WheelTestSettings parseWheelTest(const config::ConfigNode &node) {
     s.drive_min_s = node.number("drive_min_s", s.drive_min_s);
     s.steady_window_s = node.number("steady_window_s", s.steady_window_s);
     s.steady_slip_tolerance = node.number("steady_slip_tolerance", s.steady_slip_tolerance);
+    s.steady_height_tolerance_m =
+        node.number("steady_height_tolerance_m", s.steady_height_tolerance_m);
     node.finish();
     return s;
 }

@@ -16,7 +16,8 @@ struct WheelTestSettings {
     double drop_settle_time_s = 0.1;       ///< [s] than this vertically over this long
     double drive_min_s = 0.5;              ///< [s] shortest drive phase before steady is judged
     double steady_window_s = 0.5;          ///< [s] slip means over two such spans are compared
-    double steady_slip_tolerance = 0.02;   ///< steady when the two means differ by less
+    double steady_slip_tolerance = 0.02;   ///< steady when the two means differ by less ...
+    double steady_height_tolerance_m = 0.002; ///< [m] ... and the mean wheel heights too
 };
 
 /// One row of the rig's time series and the steady-state report.
