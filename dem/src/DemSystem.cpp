@@ -655,6 +655,92 @@ void DemSystem::pairContacts() {
             constexpr std::size_t kBatch = 128;
             std::size_t overlapping[kBatch], lost[kBatch];
             const std::size_t k_end = neighbours_.first[end];
+            // Plane contacts of this thread's particles, in the same pass: candidates (within
+            // reach at the last rebuild) are in particle order, and a particle's are handled
+            // once its row of pairs is done, while its data are still in cache. Its force then
+            // sums pairs, then planes, as before.
+            auto &plane_force = thread_plane_force_[std::size_t(t)];
+            std::fill(plane_force.begin(), plane_force.end(), Vec3::Zero());
+            const auto by_particle = [](const PlaneCandidate &c, std::size_t i) {
+                return c.particle < i;
+            };
+            const auto c_begin = std::lower_bound(plane_candidates_.begin(),
+                                                  plane_candidates_.end(), begin, by_particle);
+            const auto c_end = std::lower_bound(c_begin, plane_candidates_.end(), end, by_particle);
+            // As for pairs: first which candidates touch (no branch on it), then the contacts,
+            // so that consecutive contacts overlap in the processor instead of waiting on a
+            // mispredicted branch each.
+            const PlaneCandidate *candidate = plane_candidates_.data();
+            const std::size_t p_begin = std::size_t(c_begin - plane_candidates_.begin());
+            const std::size_t p_end = std::size_t(c_end - plane_candidates_.begin());
+            const auto plane_distance = [&](const PlaneCandidate &c) {
+                const PlaneWall &wall = planes_[c.plane];
+                return (position[c.particle] - wall.point_m).dot(wall.normal);
+            };
+            std::size_t next_candidate = p_begin;
+            const auto planeContactsBefore = [&](std::size_t limit) {
+                std::size_t stop = next_candidate;
+                while (stop < p_end && candidate[stop].particle < limit)
+                    ++stop;
+                for (std::size_t c0 = next_candidate; c0 < stop; c0 += kBatch) {
+                    const std::size_t c1 = std::min(c0 + kBatch, stop);
+                    std::size_t count = 0, apart_count = 0;
+                    for (std::size_t c = c0; c < c1; ++c) {
+                        // Histories of the few particles at walls are scattered over a large
+                        // array: fetch them now, for the contacts below.
+                        const ContactHistory *h =
+                            &plane_history_[candidate[c].particle * np + candidate[c].plane];
+                        __builtin_prefetch(h, 1);
+                        __builtin_prefetch(reinterpret_cast<const char *>(h + 1) - 1, 1);
+                        const unsigned touches =
+                            plane_distance(candidate[c]) < radius[candidate[c].particle];
+                        overlapping[count] = c;
+                        count += touches;
+                        lost[apart_count] = c;
+                        apart_count += touches ^ 1u;
+                    }
+                    // Candidates apart from their plane: an active history lapses.
+                    for (std::size_t k = 0; k < apart_count; ++k) {
+                        const PlaneCandidate &c = candidate[lost[k]];
+                        ContactHistory &h = plane_history_[c.particle * np + c.plane];
+                        if (h.active())
+                            h = ContactHistory{};
+                    }
+                    for (std::size_t k = 0; k < count; ++k) {
+                        const std::size_t i = candidate[overlapping[k]].particle;
+                        const std::size_t w = candidate[overlapping[k]].plane;
+                        const PlaneWall &wall = planes_[w];
+                        ContactHistory &h = plane_history_[i * np + w];
+                        const double ri = radius[i];
+                        const double dist = plane_distance(candidate[overlapping[k]]);
+                        ContactGeometry g;
+                        g.normal = wall.normal;
+                        g.overlap_m = ri - dist;
+                        g.radius_eff_m = ri;
+                        g.mass_eff_kg = p.mass[i];
+                        g.arm_i_m = dist;
+                        g.arm_j_m = 0.0;
+                        g.contact_velocity_m_s = velocity[i] - dist * spin[i].cross(g.normal);
+                        g.relative_spin_rad_s = spin[i];
+                        const Vec3 contact_point = position[i] - dist * wall.normal;
+                        std::size_t slot = std::size_t(material[i]);
+                        if (wall.track && wall.track->contains(contact_point))
+                            slot += nm;
+                        ContactResult r;
+                        evaluateContact<Normal>(damping, tangential, rolling, cohesion,
+                                                plane_props_[w][slot], g, dt, h, r);
+                        force[i] += r.force_on_i_N;
+                        torque[i] += r.torque_on_i_N_m;
+                        plane_force[w] -= r.force_on_i_N;
+                        if (g.overlap_m > max_ratio * ri) {
+                            max_ratio = g.overlap_m / ri;
+                            max_pair = {p.id[i], p.id[i]};
+                        }
+                    }
+                }
+                next_candidate = stop;
+            };
+
             for (std::size_t k0 = neighbours_.first[begin]; k0 < k_end; k0 += kBatch) {
                 const std::size_t k1 = std::min(k0 + kBatch, k_end);
                 // 1. Which listed pairs overlap, and which contacts were just lost, without a
@@ -727,77 +813,11 @@ void DemSystem::pairContacts() {
                         max_pair = {p.id[i], p.id[j]};
                     }
                 }
+                // Rows before the one the next batch starts in are complete.
+                if (k1 < k_end)
+                    planeContactsBefore(std::size_t(owner[k1]));
             }
-            // Plane contacts of this thread's particles, in the same pass: candidates (within
-            // reach at the last rebuild) are in particle order.
-            auto &plane_force = thread_plane_force_[std::size_t(t)];
-            std::fill(plane_force.begin(), plane_force.end(), Vec3::Zero());
-            const auto by_particle = [](const PlaneCandidate &c, std::size_t i) {
-                return c.particle < i;
-            };
-            const auto c_begin = std::lower_bound(plane_candidates_.begin(),
-                                                  plane_candidates_.end(), begin, by_particle);
-            const auto c_end = std::lower_bound(c_begin, plane_candidates_.end(), end, by_particle);
-            // As for pairs: first which candidates touch (no branch on it), then the contacts,
-            // so that consecutive contacts overlap in the processor instead of waiting on a
-            // mispredicted branch each.
-            const PlaneCandidate *candidate = plane_candidates_.data();
-            const std::size_t p_begin = std::size_t(c_begin - plane_candidates_.begin());
-            const std::size_t p_end = std::size_t(c_end - plane_candidates_.begin());
-            const auto plane_distance = [&](const PlaneCandidate &c) {
-                const PlaneWall &wall = planes_[c.plane];
-                return (position[c.particle] - wall.point_m).dot(wall.normal);
-            };
-            for (std::size_t c0 = p_begin; c0 < p_end; c0 += kBatch) {
-                const std::size_t c1 = std::min(c0 + kBatch, p_end);
-                std::size_t count = 0, apart_count = 0;
-                for (std::size_t c = c0; c < c1; ++c) {
-                    const unsigned touches =
-                        plane_distance(candidate[c]) < radius[candidate[c].particle];
-                    overlapping[count] = c;
-                    count += touches;
-                    lost[apart_count] = c;
-                    apart_count += touches ^ 1u;
-                }
-                // Candidates apart from their plane: an active history lapses.
-                for (std::size_t k = 0; k < apart_count; ++k) {
-                    const PlaneCandidate &c = candidate[lost[k]];
-                    ContactHistory &h = plane_history_[c.particle * np + c.plane];
-                    if (h.active())
-                        h = ContactHistory{};
-                }
-                for (std::size_t k = 0; k < count; ++k) {
-                    const std::size_t i = candidate[overlapping[k]].particle;
-                    const std::size_t w = candidate[overlapping[k]].plane;
-                    const PlaneWall &wall = planes_[w];
-                    ContactHistory &h = plane_history_[i * np + w];
-                    const double ri = radius[i];
-                    const double dist = plane_distance(candidate[overlapping[k]]);
-                    ContactGeometry g;
-                    g.normal = wall.normal;
-                    g.overlap_m = ri - dist;
-                    g.radius_eff_m = ri;
-                    g.mass_eff_kg = p.mass[i];
-                    g.arm_i_m = dist;
-                    g.arm_j_m = 0.0;
-                    g.contact_velocity_m_s = velocity[i] - dist * spin[i].cross(g.normal);
-                    g.relative_spin_rad_s = spin[i];
-                    const Vec3 contact_point = position[i] - dist * wall.normal;
-                    std::size_t slot = std::size_t(material[i]);
-                    if (wall.track && wall.track->contains(contact_point))
-                        slot += nm;
-                    ContactResult r;
-                    evaluateContact<Normal>(damping, tangential, rolling, cohesion,
-                                            plane_props_[w][slot], g, dt, h, r);
-                    force[i] += r.force_on_i_N;
-                    torque[i] += r.torque_on_i_N_m;
-                    plane_force[w] -= r.force_on_i_N;
-                    if (g.overlap_m > max_ratio * ri) {
-                        max_ratio = g.overlap_m / ri;
-                        max_pair = {p.id[i], p.id[i]};
-                    }
-                }
-            }
+            planeContactsBefore(end);
             thread_max_overlap_[std::size_t(t)] = max_ratio;
             thread_max_overlap_pair_[std::size_t(t)] = max_pair;
             if (threads > 1) {
