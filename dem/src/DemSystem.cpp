@@ -692,6 +692,7 @@ void DemSystem::pairContacts() {
                             &plane_history_[candidate[c].particle * np + candidate[c].plane];
                         __builtin_prefetch(h, 1);
                         __builtin_prefetch(reinterpret_cast<const char *>(h + 1) - 1, 1);
+                        __builtin_prefetch(&p.mass[candidate[c].particle]);
                         const unsigned touches =
                             plane_distance(candidate[c]) < radius[candidate[c].particle];
                         overlapping[count] = c;
