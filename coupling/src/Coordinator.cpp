@@ -97,7 +97,8 @@ struct Coordinator::Impl {
     explicit Impl(CoordinatorConfig c) : config(std::move(c)) {}
 
     CoordinatorConfig config;
-    zmq::context_t &context = sockets::processContext();
+    sockets::ContextFor own_context{config.endpoint};
+    zmq::context_t &context = own_context.get();
     zmq::socket_t router;
     std::string bound_endpoint;
     std::thread zap_thread;

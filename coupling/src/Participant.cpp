@@ -52,7 +52,8 @@ struct Participant::Impl {
     std::vector<std::string> expected_bodies; ///< what writeOutputs() must answer for, in order
     codec::ScratchEnvelope incoming;          ///< the last message from the coordinator
     codec::ScratchEnvelope outgoing; ///< WindowDone, built anew each window in the same memory
-    zmq::context_t &context = sockets::processContext();
+    sockets::ContextFor own_context{config.endpoint};
+    zmq::context_t &context = own_context.get();
     zmq::socket_t socket; ///< main connection, used by the calling thread only
     State state = State::Created;
     RunInfo run;

@@ -8,6 +8,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 
@@ -21,6 +22,22 @@ inline zmq::context_t &processContext() {
     static auto *context = new zmq::context_t(1);
     return *context;
 }
+
+/// The ZeroMQ context of one coordinator or participant. inproc:// endpoints connect only within
+/// one context, so they share the process-wide one (tests); any other endpoint gets its own, which
+/// its destructor terminates: queued messages (a final Shutdown or Error) then leave before the
+/// process exits, waiting at most each socket's linger. Declare it before the sockets.
+class ContextFor {
+public:
+    explicit ContextFor(const std::string &endpoint) {
+        if (endpoint.rfind("inproc://", 0) != 0)
+            own_ = std::make_unique<zmq::context_t>(1);
+    }
+    zmq::context_t &get() { return own_ ? *own_ : processContext(); }
+
+private:
+    std::unique_ptr<zmq::context_t> own_;
+};
 
 inline double secondsSince(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();

@@ -29,6 +29,9 @@ inline std::future<double> startSide(coupling::Role role, const std::string &end
         auto config = examples::twoMassConfig(
             role, role == coupling::Role::Multibody ? "mbs" : "soil", endpoint);
         config.peer_timeout_s = peer_timeout_s;
+        // A coordinator that fails its handshake before this side joined cannot tell it: the
+        // side then gives up after this long.
+        config.handshake_timeout_s = 10.0;
         coupling::Participant p(config);
         return examples::runTwoMassSide(p, {}, hooks);
     });
