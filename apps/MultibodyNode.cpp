@@ -17,6 +17,15 @@ coupling::BodyDescription describe(const mbs::CoupledBody &body) {
     d.name = body.name;
     d.mass.mass_kg = body.mass_kg;
     d.mass.inertia_diagonal_kg_m2 = body.inertia_diagonal_kg_m2;
+    if (body.mesh) {
+        coupling::MeshGeometry m;
+        m.vertices_m = body.mesh->vertices_m;
+        for (const auto &t : body.mesh->triangles)
+            m.triangles.insert(m.triangles.end(), {std::uint32_t(t[0]), std::uint32_t(t[1]),
+                                                   std::uint32_t(t[2])});
+        d.geometry = m;
+        return d;
+    }
     coupling::WheelGeometry w;
     w.diameter_m = body.wheel.diameter_m;
     w.width_m = body.wheel.width_m;
@@ -24,6 +33,9 @@ coupling::BodyDescription describe(const mbs::CoupledBody &body) {
     w.grouser_count = body.wheel.grouser_count;
     w.grouser_height_m = body.wheel.grouser_height_m;
     w.grouser_thickness_m = body.wheel.grouser_thickness_m;
+    w.grouser_shape =
+        body.wheel.chevron ? coupling::GrouserShape::Chevron : coupling::GrouserShape::Straight;
+    w.chevron_angle_deg = body.wheel.chevron_angle_deg;
     w.closed_sides = body.wheel.closed_sides;
     d.geometry = w;
     return d;

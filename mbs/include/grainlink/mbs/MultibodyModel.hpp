@@ -5,7 +5,9 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include <array>
 #include <map>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -33,13 +35,21 @@ struct WheelShape {
     bool closed_sides = true;
 };
 
+/// A closed triangle mesh in the body frame (outward normals by the right-hand rule), for
+/// coupled bodies that are not wheels (the mole's hull, a user's mesh).
+struct MeshShape {
+    std::vector<Vec3> vertices_m;              ///< [m] body frame
+    std::vector<std::array<int, 3>> triangles; ///< vertex indices, counter-clockwise from outside
+};
+
 /// A body that touches the soil.
 struct CoupledBody {
     std::string name;
     double mass_kg = 0.0;                       ///< [kg]
     Vec3 center_of_mass_m = Vec3::Zero();       ///< [m] body frame
     Vec3 inertia_diagonal_kg_m2 = Vec3::Zero(); ///< [kg m^2] about the centre of mass
-    WheelShape wheel;                           ///< its geometry
+    WheelShape wheel;                           ///< its geometry, unless `mesh` is set
+    std::optional<MeshShape> mesh;              ///< replaces `wheel` when set
 };
 
 /// Pose and velocity of a body origin, world frame.
