@@ -21,5 +21,7 @@ struct NodeOptions {
 int runMultibodyNode(const NodeOptions &options);
 /// `grainlink dem-node`: the DEM soil (section `soil:`) as the soil participant.
 int runSoilNode(const NodeOptions &options);
+/// `grainlink wheel-stl`: the scenario's parametric wheel (`rig.wheel` or `rover.wheel`) as STL.
+int exportWheelStl(const std::string &scenario_path, const std::string &stl_path, bool binary);
 
 } // namespace grainlink::apps

@@ -26,6 +26,7 @@ dem::TriangleMesh meshOf(const coupling::BodyDescription &body) {
         spec.grouser_height_m = w->grouser_height_m;
         spec.grouser_thickness_m = w->grouser_thickness_m;
         spec.chevron = w->grouser_shape == coupling::GrouserShape::Chevron;
+        spec.chevron_angle_deg = w->chevron_angle_deg;
         spec.closed_sides = w->closed_sides;
         return dem::makeWheel(spec);
     }

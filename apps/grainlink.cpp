@@ -49,6 +49,15 @@ int main(int argc, char **argv) {
         ->delimiter(',')
         ->required();
 
+    auto *wheel_stl = app.add_subcommand(
+        "wheel-stl", "write a scenario's parametric wheel as STL (the mesh the grains touch)");
+    std::string stl_path;
+    bool stl_binary = false;
+    wheel_stl->add_option("scenario", scenario_path, "scenario YAML with a rig.wheel block")
+        ->required();
+    wheel_stl->add_option("stl", stl_path, "STL file to write")->required();
+    wheel_stl->add_flag("--binary", stl_binary, "binary STL (default ASCII)");
+
     grainlink::apps::NodeOptions node;
     auto *mbs_node = app.add_subcommand(
         "mbs-node", "the Simbody single-wheel rig as a multibody participant (started by run)");
@@ -84,6 +93,8 @@ int main(int argc, char **argv) {
             return grainlink::apps::runMultibodyNode(node);
         } else if (dem_node->parsed()) {
             return grainlink::apps::runSoilNode(node);
+        } else if (wheel_stl->parsed()) {
+            return grainlink::apps::exportWheelStl(scenario_path, stl_path, stl_binary);
         } else if (keygen->parsed()) {
             return grainlink::apps::generateKeys(key_directory, key_names);
         }

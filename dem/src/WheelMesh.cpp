@@ -30,15 +30,38 @@ void appendBox(TriangleMesh &mesh, const Vec3 &centre, const Vec3 &a, const Vec3
         }
 }
 
+/// Appends one straight piece of grouser: a box on the rim whose centre line runs from
+/// (angle0, y0) to (angle1, y1) on the rim surface, from radius `inner` to r + height, lengthened
+/// by `extend0` / `extend1` past its ends (so that the pieces of a chevron arm overlap at their
+/// joints). The piece is sunk by the sagitta of its chord so that it stays closed onto the rim.
+void appendGrouserPiece(TriangleMesh &mesh, double r, double inner, double height, double thickness,
+                        double angle0, double angle1, double y0, double y1, double extend0 = 0.0,
+                        double extend1 = 0.0) {
+    const double mid = 0.5 * (angle0 + angle1);
+    const Vec3 radial(std::cos(mid), 0.0, std::sin(mid));
+    const Vec3 tangential(-std::sin(mid), 0.0, std::cos(mid));
+    const Vec3 run = tangential * (r * (angle1 - angle0)) + Vec3(0.0, y1 - y0, 0.0);
+    const Vec3 along = run.normalized();
+    const Vec3 across = radial.cross(along); // in the rim's tangent plane
+    const double sagitta = r * (1.0 - std::cos(0.5 * (angle1 - angle0)));
+    const double bottom = inner - sagitta;
+    const double half_height = 0.5 * (r + height - bottom);
+    appendBox(mesh,
+              radial * (bottom + half_height) + Vec3(0.0, 0.5 * (y0 + y1), 0.0) +
+                  along * (0.5 * (extend1 - extend0)),
+              radial * half_height, across * (0.5 * thickness),
+              along * (0.5 * (run.norm() + extend0 + extend1)));
+}
+
 } // namespace
 
 TriangleMesh makeWheel(const WheelMeshSpec &spec) {
     const double r = 0.5 * spec.diameter_m;
     if (!(r > 0.0) || !(spec.width_m > 0.0))
         throw std::invalid_argument("wheel: diameter_m and width_m must be positive");
-    if (spec.chevron)
-        throw std::invalid_argument("wheel: chevron grousers are not implemented yet; use "
-                                    "straight grousers");
+    if (spec.chevron && !(std::abs(spec.chevron_angle_deg) < 80.0 && spec.chevron_segments > 0))
+        throw std::invalid_argument("wheel: chevron_angle_deg must lie in (-80, 80) degrees and "
+                                    "chevron_segments be positive");
     if (spec.grouser_count > 0 &&
         (!(spec.grouser_height_m > 0.0) || !(spec.grouser_thickness_m > 0.0)))
         throw std::invalid_argument("wheel: grousers need a positive height and thickness");
@@ -58,12 +81,24 @@ TriangleMesh makeWheel(const WheelMeshSpec &spec) {
     const double inner = r * std::cos(M_PI / segments) - 1e-6;
     for (unsigned g = 0; g < spec.grouser_count; ++g) {
         const double angle = 2.0 * M_PI * g / spec.grouser_count;
-        const Vec3 radial(std::cos(angle), 0.0, std::sin(angle));
-        const Vec3 tangential(-std::sin(angle), 0.0, std::cos(angle));
-        const double half_height = 0.5 * (r + spec.grouser_height_m - inner);
-        appendBox(mesh, radial * (inner + half_height), radial * half_height,
-                  tangential * (0.5 * spec.grouser_thickness_m),
-                  Vec3(0.0, 0.5 * spec.width_m, 0.0));
+        if (!spec.chevron) {
+            appendGrouserPiece(mesh, r, inner, spec.grouser_height_m, spec.grouser_thickness_m,
+                               angle, angle, -0.5 * spec.width_m, 0.5 * spec.width_m);
+            continue;
+        }
+        // Each arm runs from the apex (y = 0) to a side, its angle growing as |y| tan(sweep)/r:
+        // a straight line on the unrolled rim.
+        const double sweep = std::tan(spec.chevron_angle_deg * M_PI / 180.0) / r;
+        const int n = spec.chevron_segments;
+        for (const double side : {-1.0, 1.0})
+            for (int k = 0; k < n; ++k) {
+                const double y0 = side * 0.5 * spec.width_m * k / n;
+                const double y1 = side * 0.5 * spec.width_m * (k + 1) / n;
+                const double overlap = 0.5 * spec.grouser_thickness_m; // closes the joints
+                appendGrouserPiece(mesh, r, inner, spec.grouser_height_m, spec.grouser_thickness_m,
+                                   angle + std::abs(y0) * sweep, angle + std::abs(y1) * sweep, y0,
+                                   y1, overlap, k + 1 < n ? overlap : 0.0);
+            }
     }
     mesh.validate("wheel");
     return mesh;

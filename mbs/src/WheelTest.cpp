@@ -138,19 +138,27 @@ WheelTestSettings parseWheelTest(const config::ConfigNode &node) {
     return s;
 }
 
+WheelShape parseWheelShape(const config::ConfigNode &w) {
+    WheelShape shape;
+    shape.diameter_m = w["diameter_m"].positive();
+    shape.width_m = w["width_m"].positive();
+    shape.rim_thickness_m = w.number("rim_thickness_m", 0.005);
+    shape.grouser_count =
+        static_cast<unsigned>(w.has("grouser_count") ? w["grouser_count"].integer() : 0);
+    shape.grouser_height_m = w.number("grouser_height_m", 0.0);
+    shape.grouser_thickness_m = w.number("grouser_thickness_m", 0.0);
+    if (w.has("grouser_shape"))
+        shape.chevron = w["grouser_shape"].choice({"straight", "chevron"}) == "chevron";
+    shape.chevron_angle_deg = w.number("chevron_angle_deg", shape.chevron ? 30.0 : 0.0);
+    shape.closed_sides = w.boolean("closed_sides", true);
+    w.finish();
+    return shape;
+}
+
 SingleWheelRigSettings parseSingleWheelRig(const config::ConfigNode &node) {
     SingleWheelRigSettings s;
     s.wheel_name = node.text("wheel_name", s.wheel_name);
-    const auto w = node["wheel"];
-    s.wheel.diameter_m = w["diameter_m"].positive();
-    s.wheel.width_m = w["width_m"].positive();
-    s.wheel.rim_thickness_m = w.number("rim_thickness_m", 0.005);
-    s.wheel.grouser_count =
-        static_cast<unsigned>(w.has("grouser_count") ? w["grouser_count"].integer() : 0);
-    s.wheel.grouser_height_m = w.number("grouser_height_m", 0.0);
-    s.wheel.grouser_thickness_m = w.number("grouser_thickness_m", 0.0);
-    s.wheel.closed_sides = w.boolean("closed_sides", true);
-    w.finish();
+    s.wheel = parseWheelShape(node["wheel"]);
     s.wheel_mass_kg = node["wheel_mass_kg"].positive();
     s.normal_load_kg = node["normal_load_kg"].positive();
     s.horizontal_mass_kg = node.number("horizontal_mass_kg", s.normal_load_kg);

@@ -40,13 +40,52 @@ TEST_CASE("Wheel mesh: rim and grousers enclose their volumes, wound outward", "
           Approx(std::hypot(std::hypot(r + 0.015, 0.002), 0.05)).epsilon(1e-12));
 }
 
-TEST_CASE("Wheel mesh: open sides, and what is not built yet is refused", "[dem][wheel]") {
+TEST_CASE("Wheel mesh: chevron grousers sweep back symmetrically from the mid-plane",
+          "[dem][wheel]") {
+    WheelMeshSpec spec;
+    spec.diameter_m = 0.25;
+    spec.width_m = 0.1;
+    spec.grouser_count = 12;
+    spec.grouser_height_m = 0.015;
+    spec.grouser_thickness_m = 0.004;
+    spec.rim_segments = 72;
+    spec.chevron = true;
+    spec.chevron_angle_deg = 30.0;
+    const TriangleMesh mesh = makeWheel(spec); // validate() inside: indices, no degenerate faces
+    CHECK(mesh.triangleCount() == std::size_t(4 * 72 + 12 * 2 * spec.chevron_segments * 12));
+    CHECK(signedVolume(mesh) > 0.0); // every box wound outward
+
+    // Mirror symmetric about y = 0: every vertex has its mirror image (to round-off).
+    for (const auto &v : mesh.vertices_m) {
+        const Vec3 mirror(v.x(), -v.y(), v.z());
+        double nearest = 1e9;
+        for (const auto &w : mesh.vertices_m)
+            nearest = std::min(nearest, (w - mirror).norm());
+        REQUIRE(nearest < 1e-12);
+    }
+    // The tip of grouser 0 follows angle = |y| tan(30 deg) / r on the rim, within the half
+    // thickness (plus the joint overlap) measured along the rim; and reaches the sides.
+    const double r = 0.125, sweep = std::tan(M_PI / 6) / r;
+    const double band = (0.002 + 0.002) / r / std::cos(M_PI / 6) + 1e-9;
+    double widest = 0.0;
+    for (const auto &v : mesh.vertices_m) {
+        const double angle = std::atan2(v.z(), v.x());
+        if (std::hypot(v.x(), v.z()) < r + 0.0075 || std::abs(angle) > M_PI / 12)
+            continue; // not a tip vertex of grouser 0
+        CHECK(std::abs(angle - std::abs(v.y()) * sweep) <= band);
+        widest = std::max(widest, angle);
+    }
+    CHECK(widest >= 0.05 * sweep - 0.002 / r);
+}
+
+TEST_CASE("Wheel mesh: open sides, and what is refused", "[dem][wheel]") {
     WheelMeshSpec spec;
     spec.closed_sides = false;
     spec.rim_segments = 36;
     CHECK(makeWheel(spec).triangleCount() == 2 * 36);
     spec.chevron = true;
-    CHECK_THROWS_WITH(makeWheel(spec), Catch::Contains("chevron grousers are not implemented"));
+    spec.chevron_angle_deg = 85.0;
+    CHECK_THROWS_WITH(makeWheel(spec), Catch::Contains("chevron_angle_deg"));
     spec.chevron = false;
     spec.grouser_count = 4;
     CHECK_THROWS_WITH(makeWheel(spec), Catch::Contains("positive height and thickness"));

@@ -1,6 +1,8 @@
 #pragma once
 // The parametric wheel (seed Fig. 8) as a closed triangle mesh about the body y axis: a rim
-// cylinder plus straight grousers as boxes standing on it. The coupled DEM node and `grainlink`'s
+// cylinder plus grousers standing on it: straight ones as one box across the width, chevron
+// ones as two swept-back arms meeting at the mid-plane, each arm a chain of short boxes that
+// follows the rim's curvature. The coupled DEM node and `grainlink`'s
 // STL export build it from the same numbers the multibody side sends in its handshake.
 #include "grainlink/dem/TriangleMesh.hpp"
 
@@ -12,7 +14,9 @@ struct WheelMeshSpec {
     unsigned grouser_count = 0;
     double grouser_height_m = 0.0;    ///< [m] radially outward from the rim
     double grouser_thickness_m = 0.0; ///< [m] in the rolling direction
-    bool chevron = false;             ///< chevron grousers are not built yet: an error
+    bool chevron = false;             ///< V-shaped grousers, apex at y = 0
+    double chevron_angle_deg = 30.0;  ///< [deg] sweep of each arm from the axial direction
+    int chevron_segments = 4;         ///< boxes per arm
     bool closed_sides = true;         ///< side discs (an open wheel is a rim only)
     int rim_segments = 0;             ///< facets around; 0: about one per 5 degrees, at least 24
 };
