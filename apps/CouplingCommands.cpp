@@ -2,6 +2,7 @@
 
 #include "ChildProcesses.hpp"
 #include "grainlink/coupling/Coordinator.hpp"
+#include "grainlink/dem/RigidFloor.hpp"
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
 
@@ -44,6 +45,8 @@ CoordinatorConfig configFor(const CoupledRunOptions &options, const char *defaul
     CoordinatorConfig config = coupling::coordinatorConfigFrom(root);
     if (const auto soil = root.optional("soil"))
         dem::parseScenario(*soil, true);
+    if (const auto floor = root.optional("floor"))
+        dem::parseRigidFloor(*floor);
     if (const auto rig = root.optional("rig"))
         mbs::parseSingleWheelRig(*rig);
     if (const auto test = root.optional("wheel_test"))

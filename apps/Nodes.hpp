@@ -1,6 +1,11 @@
 #pragma once
-// The participant processes of a coupled wheel run: the Simbody rig and the DEM soil, each a
-// `grainlink` subcommand that `grainlink run` starts from the scenario's participant commands.
+// The participant processes of a coupled run: the Simbody models, the DEM soil and the rigid
+// floor, each a `grainlink` subcommand that `grainlink run` starts from the scenario's
+// participant commands.
+#include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/mbs/MultibodyModel.hpp"
+
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -16,11 +21,17 @@ struct NodeOptions {
     double progress_interval_s = 10.0;
 };
 
-/// `grainlink mbs-node`: the single-wheel rig (section `rig:`) and its test procedure
-/// (`wheel_test:`) as the multibody participant.
+/// `grainlink mbs-node`: the multibody participant: the single-wheel rig (section `rig:`) with
+/// its test procedure (`wheel_test:`), or the model `makeModel` finds in the scenario.
 int runMultibodyNode(const NodeOptions &options);
+/// The multibody model a scenario names (apps/Models.cpp); every section is checked strictly.
+std::unique_ptr<mbs::MultibodyModel> makeModel(const config::ConfigNode &root,
+                                               const std::string &scenario_path);
 /// `grainlink dem-node`: the DEM soil (section `soil:`) as the soil participant.
 int runSoilNode(const NodeOptions &options);
+/// `grainlink floor-node`: a rigid flat floor (section `floor:`) as the soil participant, for
+/// verifying the coupled stack against exact answers.
+int runFloorNode(const NodeOptions &options);
 /// `grainlink wheel-stl`: the scenario's parametric wheel (`rig.wheel` or `rover.wheel`) as STL.
 int exportWheelStl(const std::string &scenario_path, const std::string &stl_path, bool binary);
 

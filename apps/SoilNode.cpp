@@ -1,6 +1,7 @@
 // The soil participant: the DEM bed (settled once, cached) with the coupled bodies' meshes moved
 // along each window's motion, returning the window-averaged wrench (impulse / window).
 #include "Nodes.hpp"
+#include "SoilSide.hpp"
 #include "grainlink/coupling/Participant.hpp"
 #include "grainlink/dem/Checkpoint.hpp"
 #include "grainlink/dem/Progress.hpp"
@@ -14,59 +15,6 @@
 #include <fstream>
 
 namespace grainlink::apps {
-
-namespace {
-
-dem::TriangleMesh meshOf(const coupling::BodyDescription &body) {
-    if (const auto *w = std::get_if<coupling::WheelGeometry>(&body.geometry)) {
-        dem::WheelMeshSpec spec;
-        spec.diameter_m = w->diameter_m;
-        spec.width_m = w->width_m;
-        spec.grouser_count = w->grouser_count;
-        spec.grouser_height_m = w->grouser_height_m;
-        spec.grouser_thickness_m = w->grouser_thickness_m;
-        spec.chevron = w->grouser_shape == coupling::GrouserShape::Chevron;
-        spec.chevron_angle_deg = w->chevron_angle_deg;
-        spec.closed_sides = w->closed_sides;
-        return dem::makeWheel(spec);
-    }
-    if (const auto *m = std::get_if<coupling::MeshGeometry>(&body.geometry)) {
-        dem::TriangleMesh mesh;
-        mesh.vertices_m = m->vertices_m;
-        for (std::size_t t = 0; t + 2 < m->triangles.size(); t += 3)
-            mesh.triangles.push_back(
-                {int(m->triangles[t]), int(m->triangles[t + 1]), int(m->triangles[t + 2])});
-        return mesh;
-    }
-    throw coupling::CouplingError("body '" + body.name + "' has no geometry the soil can touch");
-}
-
-/// Motion of one body inside the current window: cubic Hermite position (and its derivative)
-/// through both end states, orientation by slerp, angular velocity linear.
-struct WindowMotion {
-    double start_dem_s = 0.0, duration_s = 1.0;
-    coupling::BodyState a, b;
-
-    dem::RigidBodyState at(double dem_time_s) const {
-        const double H = duration_s;
-        const double s = std::clamp((dem_time_s - start_dem_s) / H, 0.0, 1.0);
-        const double s2 = s * s, s3 = s2 * s;
-        dem::RigidBodyState r;
-        r.position_m = (2 * s3 - 3 * s2 + 1) * a.position_m +
-                       (s3 - 2 * s2 + s) * H * a.linear_velocity_m_s +
-                       (-2 * s3 + 3 * s2) * b.position_m + (s3 - s2) * H * b.linear_velocity_m_s;
-        r.velocity_m_s =
-            ((6 * s2 - 6 * s) * a.position_m + (3 * s2 - 4 * s + 1) * H * a.linear_velocity_m_s +
-             (-6 * s2 + 6 * s) * b.position_m + (3 * s2 - 2 * s) * H * b.linear_velocity_m_s) /
-            H;
-        r.orientation = a.orientation.slerp(s, b.orientation).normalized();
-        r.angular_velocity_rad_s =
-            (1 - s) * a.angular_velocity_rad_s + s * b.angular_velocity_rad_s;
-        return r;
-    }
-};
-
-} // namespace
 
 int runSoilNode(const NodeOptions &options) {
     const auto root = config::ConfigNode::loadFile(options.scenario_path);

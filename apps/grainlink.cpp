@@ -63,7 +63,9 @@ int main(int argc, char **argv) {
         "mbs-node", "the Simbody single-wheel rig as a multibody participant (started by run)");
     auto *dem_node =
         app.add_subcommand("dem-node", "the DEM soil as a soil participant (started by run)");
-    for (auto *command : {mbs_node, dem_node}) {
+    auto *floor_node = app.add_subcommand(
+        "floor-node", "a rigid flat floor as the soil participant (verification; started by run)");
+    for (auto *command : {mbs_node, dem_node, floor_node}) {
         command->add_option("scenario", node.scenario_path, "coupled scenario YAML")->required();
         command->add_option("--name", node.name, "participant name")->required();
         command->add_option("--endpoint", node.endpoint, "the coordinator's endpoint")->required();
@@ -72,9 +74,10 @@ int main(int argc, char **argv) {
         command->add_option("--progress-interval", node.progress_interval_s,
                             "seconds between progress lines");
     }
-    dem_node->add_option("--bodies", node.bodies, "the coupled bodies it loads (comma separated)")
-        ->delimiter(',')
-        ->required();
+    for (auto *command : {dem_node, floor_node})
+        command->add_option("--bodies", node.bodies, "the coupled bodies it loads (comma separated)")
+            ->delimiter(',')
+            ->required();
 
     CLI11_PARSE(app, argc, argv);
     try {
@@ -93,6 +96,8 @@ int main(int argc, char **argv) {
             return grainlink::apps::runMultibodyNode(node);
         } else if (dem_node->parsed()) {
             return grainlink::apps::runSoilNode(node);
+        } else if (floor_node->parsed()) {
+            return grainlink::apps::runFloorNode(node);
         } else if (wheel_stl->parsed()) {
             return grainlink::apps::exportWheelStl(scenario_path, stl_path, stl_binary);
         } else if (keygen->parsed()) {

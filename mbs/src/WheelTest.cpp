@@ -165,6 +165,8 @@ SingleWheelRigSettings parseSingleWheelRig(const config::ConfigNode &node) {
     s.start_position_m = node["start_position_m"].vec3();
     s.angular_velocity_rad_s = node.number("angular_velocity_rad_s", s.angular_velocity_rad_s);
     s.drawbar_force_N = node.number("drawbar_force_N", 0.0);
+    if (node.has("drive_torque_N_m"))
+        s.drive_torque_N_m = node["drive_torque_N_m"].number();
     if (node.has("slip"))
         s.slip = node["slip"].number();
     s.rotation_locked = true; // the procedure starts with the drop phase

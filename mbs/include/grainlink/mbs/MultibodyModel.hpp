@@ -79,6 +79,9 @@ public:
     virtual std::vector<RigidState> bodyStates() const = 0;
     /// Named quantities for the time series (slip, sinkage, motor torque, ...).
     virtual std::map<std::string, double> observables() const = 0;
+    /// The macro step this model would like next [s]; 0: no preference. The coordinator's
+    /// adaptive stepping takes it as a hint (e.g. small steps around the mole's impacts).
+    virtual double suggestedMacroStep_s() const { return 0.0; }
 
     virtual void saveState() = 0;
     virtual void restoreState() = 0;

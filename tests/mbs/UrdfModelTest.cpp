@@ -1,0 +1,287 @@
+// Models from URDF + YAML (mbs/UrdfModel.cpp): the single-wheel rig read from files against the
+// built-in one, joint springs and a compound pendulum against analytic motion, a floating root
+// with an STL mesh, and the errors a user sees for malformed files (tolerances stated per check).
+#include "grainlink/mbs/UrdfModel.hpp"
+#include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/mbs/SingleWheelRig.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <string>
+
+using namespace grainlink::mbs;
+using grainlink::config::ConfigError;
+
+namespace {
+
+const std::string kData = GRAINLINK_MBS_TEST_DATA;
+const std::string kModels = GRAINLINK_MODELS_DIR;
+
+/// The built-in rig with the settings of scenarios/models/single_wheel_rig.{urdf,yaml}.
+SingleWheelRigSettings builtInRig() {
+    SingleWheelRigSettings s;
+    s.wheel.diameter_m = 0.25;
+    s.wheel.width_m = 0.1;
+    s.wheel_mass_kg = 2.0;
+    s.normal_load_kg = 8.33;
+    s.horizontal_mass_kg = 8.33;
+    s.start_position_m = Vec3(0.1, 0.05, 0.5);
+    s.angular_velocity_rad_s = 3.0;
+    return s;
+}
+
+/// Largest difference between two body states: positions [m], rotation angle [rad], linear
+/// [m/s] and angular [rad/s] velocities, each reported separately.
+struct StateDiff {
+    double position = 0, angle = 0, velocity = 0, angular_velocity = 0;
+    void add(const RigidState &a, const RigidState &b) {
+        position = std::max(position, (a.position_m - b.position_m).norm());
+        angle = std::max(angle, a.orientation.angularDistance(b.orientation));
+        velocity = std::max(velocity, (a.linear_velocity_m_s - b.linear_velocity_m_s).norm());
+        angular_velocity = std::max(angular_velocity,
+                                    (a.angular_velocity_rad_s - b.angular_velocity_rad_s).norm());
+    }
+};
+
+/// The error message of `f`, which must throw E.
+template <class E, class F> std::string messageOf(F &&f) {
+    try {
+        f();
+    } catch (const E &e) {
+        return e.what();
+    }
+    FAIL("expected an exception");
+    return "";
+}
+
+} // namespace
+
+TEST_CASE("URDF rig moves like the built-in single-wheel rig", "[mbs][urdf]") {
+    // Both are Ground -> slider x -> slider z -> pin about y with the same masses, integrated by
+    // the same error-controlled Runge-Kutta-Merson (accuracy 1e-8). Only the mobilizer frames
+    // differ (any rotation taking the slider's x onto z will do), so the two runs differ by
+    // round-off in the same equations (measured: below 1e-15): states must agree to 1e-12 (m,
+    // rad, m/s, rad/s, N m), far below the integrator's own error (1e-8 relative), which a
+    // wrong mass, inertia, frame or drive would exceed by orders of magnitude.
+    const double tolerance = 1e-12;
+    const UrdfModelSettings settings = parseUrdfModel(kModels + "/single_wheel_rig.yaml");
+    StateDiff diff;
+    double torque_diff = 0.0;
+
+    auto compare = [&](SingleWheelRig &rig, UrdfModel &urdf, double from_s, double to_s) {
+        for (double t = from_s + 1e-3; t <= to_s + 1e-12; t += 1e-3) {
+            rig.advanceTo(t);
+            urdf.advanceTo(t);
+            diff.add(rig.bodyStates()[0], urdf.bodyStates()[0]);
+            const auto o_rig = rig.observables(), o_urdf = urdf.observables();
+            torque_diff = std::max(torque_diff, std::abs(o_rig.at("motor_torque_N_m") -
+                                                         o_urdf.at("wheel_drive_torque_N_m")));
+            CHECK(o_urdf.at("carriage_x_position_m") ==
+                  Approx(o_rig.at("carriage_x_m")).margin(tolerance));
+            CHECK(o_urdf.at("carriage_z_speed_m_s") ==
+                  Approx(o_rig.at("carriage_vz_m_s")).margin(tolerance));
+        }
+    };
+
+    SECTION("locked free fall, then soil forces with the wheel speed-driven") {
+        auto rig_settings = builtInRig();
+        rig_settings.rotation_locked = true;
+        SingleWheelRig rig(rig_settings);
+        UrdfModel urdf(settings);
+        urdf.setDrive("wheel", {JointDrive::Mode::Locked, 0.0});
+
+        const auto rb = rig.coupledBodies()[0], ub = urdf.coupledBodies()[0];
+        CHECK(ub.name == "wheel");
+        CHECK(ub.mass_kg == rb.mass_kg);
+        CHECK((ub.inertia_diagonal_kg_m2 - rb.inertia_diagonal_kg_m2).norm() < 1e-15);
+        CHECK(ub.wheel.diameter_m == rb.wheel.diameter_m);
+        diff.add(rig.bodyStates()[0], urdf.bodyStates()[0]);
+
+        rig.applyWrenches({Wrench{}});
+        urdf.applyWrenches({Wrench{}});
+        compare(rig, urdf, 0.0, 0.2); // free fall, rotation locked
+        Wrench soil;
+        soil.force_N = Vec3(-5.0, 1.0, 60.0); // y is carried by the rig's guides
+        soil.torque_N_m = Vec3(0.3, -2.0, 0.1);
+        rig.applyWrenches({soil});
+        urdf.applyWrenches({soil});
+        rig.setRotationLocked(false);
+        urdf.setDrive("wheel", {JointDrive::Mode::Speed, 3.0});
+        compare(rig, urdf, 0.2, 0.5);
+        // The motion really happened: 0.2 s free fall then 0.3 s at a = (60 - 81.7) / 8.33.
+        CHECK(urdf.bodyStates()[0].position_m.z() < 0.5 - 0.19);
+        CHECK(urdf.observables().at("wheel_drive_torque_N_m") == Approx(2.0).margin(1e-9));
+    }
+    SECTION("torque drive: the wheel's inertia and the drawbar force") {
+        auto rig_settings = builtInRig();
+        rig_settings.drive_torque_N_m = 1.5;
+        rig_settings.drawbar_force_N = 4.0;
+        SingleWheelRig rig(rig_settings); // the wheel starts at rest under a torque drive
+        // The same change a user makes in the YAML: drive: {mode: effort, torque_N_m: 1.5}
+        // on the wheel, and the drawbar F_R as an effort drive on the horizontal slider.
+        UrdfModelSettings torque_settings = settings;
+        for (auto &j : torque_settings.joints) {
+            if (j.joint == "wheel")
+                j.drive = {JointDrive::Mode::Effort, 1.5};
+            if (j.joint == "carriage_x")
+                j.drive = {JointDrive::Mode::Effort, -4.0};
+        }
+        UrdfModel urdf(torque_settings);
+        Wrench soil;
+        soil.force_N = Vec3(2.0, 0.0, 50.0);
+        soil.torque_N_m = Vec3(0.0, -0.5, 0.0);
+        rig.applyWrenches({soil});
+        urdf.applyWrenches({soil});
+        compare(rig, urdf, 0.0, 0.4);
+        // α = (1.5 - 0.5) / Iyy = 1 / 0.03125 = 32 rad/s²: ω(0.4 s) = 12.8 rad/s (to 1e-9).
+        CHECK(urdf.bodyStates()[0].angular_velocity_rad_s.y() == Approx(12.8).margin(1e-9));
+        CHECK(urdf.observables().at("wheel_drive_torque_N_m") == 1.5);
+    }
+    INFO("max differences: position "
+         << diff.position << " m, angle " << diff.angle << " rad, velocity " << diff.velocity
+         << " m/s, angular velocity " << diff.angular_velocity << " rad/s, drive torque "
+         << torque_diff << " N m");
+    WARN("URDF vs built-in rig, max differences: position "
+         << diff.position << " m, angle " << diff.angle << " rad, velocity " << diff.velocity
+         << " m/s, angular velocity " << diff.angular_velocity << " rad/s, drive torque "
+         << torque_diff << " N m");
+    CHECK(diff.position < tolerance);
+    CHECK(diff.angle < tolerance);
+    CHECK(diff.velocity < tolerance);
+    CHECK(diff.angular_velocity < tolerance);
+    CHECK(torque_diff < tolerance);
+}
+
+TEST_CASE("URDF model: save/restore and checkpoints keep the drives", "[mbs][urdf]") {
+    UrdfModel a(parseUrdfModel(kModels + "/single_wheel_rig.yaml"));
+    a.applyWrenches({Wrench{}});
+    a.advanceTo(0.05);
+    a.setDrive("wheel", {JointDrive::Mode::Effort, 0.7});
+    const std::string path = "urdf_model_checkpoint.txt";
+    a.writeCheckpoint(path);
+    UrdfModel b(parseUrdfModel(kModels + "/single_wheel_rig.yaml"));
+    b.readCheckpoint(path);
+    CHECK(b.drive("wheel").mode == JointDrive::Mode::Effort);
+    a.advanceTo(0.1);
+    b.advanceTo(0.1);
+    // Same State, same forces, same integrator: bit-identical.
+    CHECK(a.bodyStates()[0].position_m == b.bodyStates()[0].position_m);
+    CHECK(a.bodyStates()[0].angular_velocity_rad_s == b.bodyStates()[0].angular_velocity_rad_s);
+    std::remove(path.c_str());
+}
+
+TEST_CASE("URDF joint springs and a compound pendulum swing at the analytic frequencies",
+          "[mbs][urdf]") {
+    UrdfModel m(parseUrdfModel(kData + "/oscillators.yaml"));
+    // slide: m = 2 kg, k = 50 N/m, x0 = 0.1 m, x(0) = 0.3 m: x = 0.1 + 0.2 cos 5t.
+    // twist: I = 0.5 kg m², k = 8 N m/rad, c = 0.4 N m s/rad: γ = c / 2I = 0.4 /s,
+    //        ω_d = √(k/I - γ²); θ = 0.3 e^(-γt) (cos ω_d t + γ/ω_d sin ω_d t).
+    // swing: I_O = 0.03 + 1.5 · 0.4² = 0.27 kg m², ω0 = √(1.5 · 9.81 · 0.4 / 0.27); at the
+    //        amplitude θ0 = 1e-3 rad the pendulum swings at ω0 (1 - θ0²/16) (the first
+    //        correction of the large-amplitude period), θ = θ0 cos ωt; left out: the third
+    //        harmonic, amplitude θ0³/192 = 5e-12 rad, and O(θ0⁵).
+    const double gamma = 0.4, wd = std::sqrt(8.0 / 0.5 - gamma * gamma);
+    const double theta0 = 1e-3;
+    const double w_pendulum = std::sqrt(1.5 * 9.81 * 0.4 / 0.27) * (1.0 - theta0 * theta0 / 16);
+    double err_slide = 0, err_twist = 0, err_swing = 0;
+    for (int k = 1; k <= 300; ++k) { // 3 s: 2.4 slider periods, 1.9 pendulum periods
+        const double t = 0.01 * k;
+        m.advanceTo(t);
+        const auto o = m.observables();
+        err_slide = std::max(err_slide,
+                             std::abs(o.at("slide_position_m") - (0.1 + 0.2 * std::cos(5.0 * t))));
+        const double twist =
+            0.3 * std::exp(-gamma * t) * (std::cos(wd * t) + gamma / wd * std::sin(wd * t));
+        err_twist = std::max(err_twist, std::abs(o.at("twist_position_rad") - twist));
+        err_swing = std::max(
+            err_swing, std::abs(o.at("swing_position_rad") - theta0 * std::cos(w_pendulum * t)));
+    }
+    WARN("oscillators, max |error| over 3 s: slide " << err_slide << " m, twist " << err_twist
+                                                     << " rad, swing " << err_swing << " rad");
+    // Runge-Kutta-Merson at relative accuracy 1e-8 per step; measured over 3 s: 2.5e-12 m,
+    // 4e-13 rad and 8e-12 rad (pendulum: mostly the third harmonic left out above). Tolerances
+    // 1e-9 m and 1e-9 rad (5e-9 and 3e-9 of the amplitudes) and 5e-11 rad (5e-8 of θ0): a 1 %
+    // error in a stiffness, damping,
+    // mass or inertia, or the inertial frame's rotation ignored (0.02 kg m² instead of 0.03
+    // about the axis: ω off by 2 %), misses by orders of magnitude more.
+    CHECK(err_slide < 1e-9);
+    CHECK(err_twist < 1e-9);
+    CHECK(err_swing < 5e-11);
+}
+
+TEST_CASE("URDF floating root with an STL mesh falls under gravity and the soil force",
+          "[mbs][urdf]") {
+    UrdfModel m(parseUrdfModel(kData + "/free_body.yaml"));
+    const auto bodies = m.coupledBodies();
+    REQUIRE(bodies.size() == 1);
+    CHECK(bodies[0].name == "box");
+    REQUIRE(bodies[0].mesh);
+    CHECK(bodies[0].mesh->triangles.size() == 12);
+    double extent = 0.0;
+    for (const auto &v : bodies[0].mesh->vertices_m)
+        extent = std::max(extent, v.cwiseAbs().maxCoeff());
+    CHECK(extent == Approx(0.05).margin(1e-12)); // 50 mm scaled by mesh_scale 0.001
+    Wrench soil;
+    soil.force_N = Vec3(4.0, 0.0, 19.62); // a = (1, 0, -9.81 + 4.905) m/s²
+    m.applyWrenches({soil});
+    m.advanceTo(0.5);
+    const auto s = m.bodyStates()[0];
+    // Constant acceleration: exact to the integrator's accuracy (1e-8 relative): 1e-9 m.
+    CHECK(s.position_m.x() == Approx(0.2 + 0.5 * 1.0 * 0.25).margin(1e-9));
+    CHECK(s.position_m.y() == Approx(0.1).margin(1e-12));
+    CHECK(s.position_m.z() == Approx(2.0 - 0.5 * 4.905 * 0.25).margin(1e-9));
+    CHECK(m.observables().at("root_vz_m_s") == Approx(-4.905 * 0.5).margin(1e-9));
+}
+
+TEST_CASE("URDF and YAML errors name the file, the key and the line", "[mbs][urdf]") {
+    SECTION("a URDF that is not valid XML") {
+        UrdfModelSettings s;
+        s.urdf_path = kData + "/bad_xml.urdf";
+        const std::string msg = messageOf<ModelError>([&] { UrdfModel m(s); });
+        CHECK_THAT(msg, Catch::Contains("bad_xml.urdf") && Catch::Contains("not a valid URDF"));
+        const std::string yaml =
+            messageOf<ConfigError>([&] { parseUrdfModel(kData + "/bad_xml.yaml"); });
+        CHECK_THAT(yaml, Catch::Contains("bad_xml.yaml:2: key 'urdf'") &&
+                             Catch::Contains("bad_xml.urdf"));
+    }
+    SECTION("a joint naming a link that does not exist") {
+        UrdfModelSettings s;
+        s.urdf_path = kData + "/missing_link.urdf";
+        const std::string msg = messageOf<ModelError>([&] { UrdfModel m(s); });
+        CHECK_THAT(msg, Catch::Contains("missing_link.urdf") && Catch::Contains("hub"));
+    }
+    SECTION("a YAML naming a link the URDF lacks") {
+        const std::string msg =
+            messageOf<ConfigError>([&] { parseUrdfModel(kData + "/missing_coupled_link.yaml"); });
+        CHECK_THAT(msg, Catch::Contains("missing_coupled_link.yaml:5: key 'coupled[0].link'") &&
+                            Catch::Contains("no link 'tyre'"));
+    }
+    SECTION("a YAML naming a joint the URDF lacks") {
+        const std::string msg =
+            messageOf<ConfigError>([&] { parseUrdfModel(kData + "/missing_joint.yaml"); });
+        CHECK_THAT(msg, Catch::Contains("missing_joint.yaml:8: key 'joints[1].joint'") &&
+                            Catch::Contains("no joint 'axle'"));
+    }
+    SECTION("a revolute joint's position in metres") {
+        const std::string msg =
+            messageOf<ConfigError>([&] { parseUrdfModel(kData + "/wrong_unit.yaml"); });
+        CHECK_THAT(msg, Catch::Contains("wrong_unit.yaml:5: unknown key 'joints[0].position_m'"));
+    }
+    SECTION("a massless link at the end of a moving joint") {
+        UrdfModelSettings s;
+        s.urdf_path = kData + "/massless_terminal.urdf";
+        const std::string msg = messageOf<ModelError>([&] { UrdfModel m(s); });
+        CHECK_THAT(msg, Catch::Contains("massless_terminal.urdf") &&
+                            Catch::Contains("link 'probe'") && Catch::Contains("no mass"));
+    }
+    SECTION("settings built in code naming a missing joint") {
+        UrdfModelSettings s;
+        s.urdf_path = kModels + "/single_wheel_rig.urdf";
+        UrdfJointSettings j;
+        j.joint = "axle";
+        s.joints.push_back(j);
+        const std::string msg = messageOf<ModelError>([&] { UrdfModel m(s); });
+        CHECK_THAT(msg, Catch::Contains("joint 'axle'"));
+    }
+}
