@@ -1,6 +1,7 @@
 #include "CouplingCommands.hpp"
 
 #include "ChildProcesses.hpp"
+#include "SoilSide.hpp"
 #include "grainlink/coupling/Coordinator.hpp"
 #include "grainlink/dem/RigidFloor.hpp"
 #include "grainlink/dem/Scenario.hpp"
@@ -45,6 +46,7 @@ CoordinatorConfig configFor(const CoupledRunOptions &options, const char *defaul
     CoordinatorConfig config = coupling::coordinatorConfigFrom(root);
     if (const auto soil = root.optional("soil"))
         dem::parseScenario(*soil, true);
+    MirrorSymmetry::parse(root);
     if (const auto floor = root.optional("floor"))
         dem::parseRigidFloor(*floor);
     if (const auto rig = root.optional("rig"))

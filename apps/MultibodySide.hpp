@@ -1,6 +1,7 @@
 #pragma once
 // What the multibody-side participants share: a model's coupled bodies as handshake
-// descriptions, its states on the wire, and a time series that survives a resume.
+// descriptions and its states on the wire.
+#include "Series.hpp"
 #include "grainlink/coupling/Types.hpp"
 #include "grainlink/mbs/MultibodyModel.hpp"
 
@@ -48,27 +49,6 @@ inline coupling::BodyState toCoupling(const std::string &name, const mbs::RigidS
     out.linear_velocity_m_s = s.linear_velocity_m_s;
     out.angular_velocity_rad_s = s.angular_velocity_rad_s;
     return out;
-}
-
-/// Opens a time series CSV. Fresh: the header. Resumed at `restart_s`: the rows up to that
-/// time are kept, those after it (computed after the checkpoint, lost with the crash) dropped.
-inline std::ofstream openSeries(const std::string &path, const std::string &header,
-                                std::optional<double> restart_s) {
-    std::vector<std::string> kept;
-    if (restart_s) {
-        std::ifstream in(path);
-        std::string line;
-        std::getline(in, line);
-        while (std::getline(in, line))
-            if (std::stod(line.substr(0, line.find(','))) <= *restart_s + 1e-12)
-                kept.push_back(line);
-    }
-    std::ofstream series(path, std::ios::trunc);
-    series << header << '\n';
-    for (const auto &line : kept)
-        series << line << '\n';
-    series.precision(10);
-    return series;
 }
 
 } // namespace grainlink::apps

@@ -1,6 +1,7 @@
 // The soil participant: the DEM bed (settled once, cached) with the coupled bodies' meshes moved
 // along each window's motion, returning the window-averaged wrench (impulse / window).
 #include "Nodes.hpp"
+#include "Series.hpp"
 #include "SoilSide.hpp"
 #include "grainlink/coupling/Participant.hpp"
 #include "grainlink/dem/Checkpoint.hpp"
@@ -35,6 +36,7 @@ int runSoilNode(const NodeOptions &options) {
         config.curve = coupling::loadClientKeys(options.keys_directory, options.name);
     coupling::Participant participant(config);
     const auto &run = participant.initialize();
+    const auto mirror = MirrorSymmetry::parse(root);
 
     // Every consumed body becomes a mesh body whose motion follows the current window.
     std::vector<WindowMotion> motion(options.bodies.size());
@@ -42,7 +44,8 @@ int runSoilNode(const NodeOptions &options) {
         const auto description = std::find_if(
             run.bodies.begin(), run.bodies.end(),
             [&](const coupling::BodyDescription &d) { return d.name == options.bodies[b]; });
-        dem::MeshBody body(options.bodies[b], meshOf(*description), dem::RigidBodyState{});
+        dem::MeshBody body(options.bodies[b], meshOf(*description, mirror.has_value()),
+                           dem::RigidBodyState{});
         sys->addBody(std::move(body), [&motion, b](double t) { return motion[b].at(t); });
     }
     double dem_offset_s = sys->time() - run.start_tick * run.tick_s; // DEM time - coupling time
@@ -53,11 +56,11 @@ int runSoilNode(const NodeOptions &options) {
     }
 
     std::filesystem::create_directories(options.output_directory);
-    std::ofstream series(options.output_directory + "/soil.csv",
-                         run.restore ? std::ios::app : std::ios::trunc);
-    if (!run.restore)
-        series << "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts\n";
-    series.precision(10);
+    std::ofstream series =
+        openSeries(options.output_directory + "/soil.csv",
+                   "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts",
+                   run.restore ? std::optional<double>(double(run.restore->tick) * run.tick_s)
+                               : std::nullopt);
     dem::Progress progress(options.name, options.progress_interval_s);
     const std::uint64_t first_step = sys->stepCount();
     const double end_s = run.end_tick * run.tick_s;
@@ -116,6 +119,11 @@ int runSoilNode(const NodeOptions &options) {
                 w.body = options.bodies[b];
                 w.force_N = body.impulse_N_s / in.duration_s;
                 w.torque_N_m = body.angular_impulse_N_m_s / in.duration_s;
+                if (mirror) {
+                    mirror->check(in.end_states.at(b));
+                    MirrorSymmetry::complete(w.force_N, w.torque_N_m);
+                    work[b] *= 2.0;
+                }
                 out.wrenches.push_back(w);
                 out.work.push_back({w.body, work[b]});
                 double lowest = 1e300;

@@ -6,12 +6,16 @@
 #include "grainlink/dem/Walls.hpp"
 #include "grainlink/dem/WheelMesh.hpp"
 
+#include "grainlink/config/ConfigNode.hpp"
+
 #include <algorithm>
+#include <cmath>
+#include <optional>
 
 namespace grainlink::apps {
 
 /// The triangle mesh of a body as its provider described it (parametric wheel or mesh).
-inline dem::TriangleMesh meshOf(const coupling::BodyDescription &body) {
+inline dem::TriangleMesh meshOf(const coupling::BodyDescription &body, bool half = false) {
     if (const auto *w = std::get_if<coupling::WheelGeometry>(&body.geometry)) {
         dem::WheelMeshSpec spec;
         spec.diameter_m = w->diameter_m;
@@ -22,8 +26,12 @@ inline dem::TriangleMesh meshOf(const coupling::BodyDescription &body) {
         spec.chevron = w->grouser_shape == coupling::GrouserShape::Chevron;
         spec.chevron_angle_deg = w->chevron_angle_deg;
         spec.closed_sides = w->closed_sides;
+        spec.half = half;
         return dem::makeWheel(spec);
     }
+    if (half)
+        throw coupling::CouplingError("body '" + body.name + "': a mirror-symmetric half model "
+                                      "needs parametric wheels, not a mesh");
     if (const auto *m = std::get_if<coupling::MeshGeometry>(&body.geometry)) {
         dem::TriangleMesh mesh;
         mesh.vertices_m = m->vertices_m;
@@ -57,6 +65,37 @@ struct WindowMotion {
         r.angular_velocity_rad_s =
             (1 - s) * a.angular_velocity_rad_s + s * b.angular_velocity_rad_s;
         return r;
+    }
+};
+
+/// Mirror symmetry (DIGEST §5): the soil simulates only the half of the bin at y >= plane, with
+/// a frictionless wall on the plane, and each wheel's y >= 0 half; the other half is the mirror
+/// image. The image's wrench about a body origin on the plane is (Fx, -Fy, Fz), (-Tx, Ty, -Tz),
+/// so the full wheel's wrench is twice the half's x and z force and y torque, the rest zero.
+struct MirrorSymmetry {
+    double plane_y_m = 0.0;
+
+    static std::optional<MirrorSymmetry> parse(const config::ConfigNode &root) {
+        const auto node = root.optional("mirror");
+        if (!node)
+            return std::nullopt;
+        MirrorSymmetry m;
+        m.plane_y_m = (*node)["plane_y_m"].number();
+        node->finish();
+        return m;
+    }
+    /// A wheel must roll in the plane: centre on it, axis across it.
+    void check(const coupling::BodyState &s) const {
+        const coupling::Vec3 axis = s.orientation * coupling::Vec3::UnitY();
+        if (std::abs(s.position_m.y() - plane_y_m) > 1e-9 || std::abs(axis.y()) < 1.0 - 1e-9)
+            throw coupling::CouplingError(
+                "body '" + s.body + "' is not on the mirror plane y = " + std::to_string(plane_y_m) +
+                " m with its axis across it (centre at y = " + std::to_string(s.position_m.y()) +
+                " m): start it there or remove `mirror:`");
+    }
+    static void complete(coupling::Vec3 &force, coupling::Vec3 &torque) {
+        force = coupling::Vec3(2.0 * force.x(), 0.0, 2.0 * force.z());
+        torque = coupling::Vec3(0.0, 2.0 * torque.y(), 0.0);
     }
 };
 

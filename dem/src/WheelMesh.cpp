@@ -68,37 +68,52 @@ TriangleMesh makeWheel(const WheelMeshSpec &spec) {
     const int segments = spec.rim_segments > 0
                              ? spec.rim_segments
                              : std::max(24, static_cast<int>(std::lround(360.0 / 5.0)));
-    TriangleMesh mesh = makeCylinder(r, spec.width_m, segments);
-    if (!spec.closed_sides) { // keep the rim: drop the cap triangles (they touch a centre)
-        const int centre_minus = 2 * segments, centre_plus = centre_minus + 1;
-        std::vector<std::array<int, 3>> rim;
-        for (const auto &t : mesh.triangles)
-            if (t[0] != centre_minus && t[0] != centre_plus)
-                rim.push_back(t);
-        mesh.triangles = rim;
-    }
+    // The rim from y = -w/2 (or 0 for the half wheel) to w/2.
+    const double y_from = spec.half ? 0.0 : -0.5 * spec.width_m, y_to = 0.5 * spec.width_m;
+    TriangleMesh mesh = makeCylinder(r, y_to - y_from, segments);
+    for (auto &v : mesh.vertices_m)
+        v.y() += 0.5 * (y_from + y_to);
+    // Drop the cap triangles (they touch a cap centre) that are not wanted: both for an open
+    // wheel, the one on the symmetry plane for a half wheel.
+    const int centre_minus = 2 * segments, centre_plus = centre_minus + 1;
+    std::vector<std::array<int, 3>> kept;
+    for (const auto &t : mesh.triangles)
+        if (!(t[0] == centre_minus && (spec.half || !spec.closed_sides)) &&
+            !(t[0] == centre_plus && !spec.closed_sides))
+            kept.push_back(t);
+    mesh.triangles = kept;
     // Grousers stand on the rim: from just inside the facetted rim to r + height.
     const double inner = r * std::cos(M_PI / segments) - 1e-6;
     for (unsigned g = 0; g < spec.grouser_count; ++g) {
         const double angle = 2.0 * M_PI * g / spec.grouser_count;
         if (!spec.chevron) {
             appendGrouserPiece(mesh, r, inner, spec.grouser_height_m, spec.grouser_thickness_m,
-                               angle, angle, -0.5 * spec.width_m, 0.5 * spec.width_m);
+                               angle, angle, y_from, y_to);
             continue;
         }
         // Each arm runs from the apex (y = 0) to a side, its angle growing as |y| tan(sweep)/r:
         // a straight line on the unrolled rim.
         const double sweep = std::tan(spec.chevron_angle_deg * M_PI / 180.0) / r;
         const int n = spec.chevron_segments;
-        for (const double side : {-1.0, 1.0})
+        for (const double side : {-1.0, 1.0}) {
+            if (spec.half && side < 0.0)
+                continue;
             for (int k = 0; k < n; ++k) {
                 const double y0 = side * 0.5 * spec.width_m * k / n;
                 const double y1 = side * 0.5 * spec.width_m * (k + 1) / n;
                 const double overlap = 0.5 * spec.grouser_thickness_m; // closes the joints
+                // A half wheel's arm stops where its slanted end face touches the symmetry
+                // plane (its image continues it), leaving a notch smaller than the thickness.
+                const double start =
+                    k > 0 || !spec.half
+                        ? overlap
+                        : -0.5 * spec.grouser_thickness_m *
+                              std::abs(std::tan(spec.chevron_angle_deg * M_PI / 180.0));
                 appendGrouserPiece(mesh, r, inner, spec.grouser_height_m, spec.grouser_thickness_m,
                                    angle + std::abs(y0) * sweep, angle + std::abs(y1) * sweep, y0,
-                                   y1, overlap, k + 1 < n ? overlap : 0.0);
+                                   y1, start, k + 1 < n ? overlap : 0.0);
             }
+        }
     }
     mesh.validate("wheel");
     return mesh;

@@ -90,3 +90,25 @@ TEST_CASE("Wheel mesh: open sides, and what is refused", "[dem][wheel]") {
     spec.grouser_count = 4;
     CHECK_THROWS_WITH(makeWheel(spec), Catch::Contains("positive height and thickness"));
 }
+
+TEST_CASE("Wheel mesh: the half wheel of a mirror-symmetric model is the y >= 0 half",
+          "[dem][wheel]") {
+    WheelMeshSpec spec;
+    spec.grouser_count = 12;
+    spec.grouser_height_m = 0.015;
+    spec.grouser_thickness_m = 0.004;
+    spec.rim_segments = 72;
+    const TriangleMesh full = makeWheel(spec);
+    spec.half = true;
+    const TriangleMesh half = makeWheel(spec);
+    // The rim loses one cap, each grouser half its length: the volume halves, to round-off
+    // (the open side is the plane y = 0, which adds nothing to the divergence-theorem sum).
+    CHECK(signedVolume(half) == Approx(0.5 * signedVolume(full)).epsilon(1e-12));
+    for (const auto &v : half.vertices_m)
+        REQUIRE(v.y() >= -1e-15);
+    CHECK(half.triangleCount() == std::size_t(3 * 72 + 12 * 12));
+
+    spec.chevron = true; // one arm per grouser, stopping at the plane
+    for (const auto &v : makeWheel(spec).vertices_m)
+        REQUIRE(v.y() >= -1e-15);
+}

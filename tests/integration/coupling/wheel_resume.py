@@ -2,7 +2,7 @@
 """A coupled wheel run (wheel_resume.yaml: Simbody rig, DEM soil, coordinator) whose soil process
 is killed with SIGKILL after its first checkpoint, then resumed with --resume: the results
 written before the crash stay readable, and the resumed run ends bit-identically to an
-uninterrupted one (coupling.csv without its wall-time column, and rig.csv, row for row).
+uninterrupted one (coupling.csv without its wall-time column, rig.csv and soil.csv, row for row).
 Usage: wheel_resume.py GRAINLINK CONFIG WORK"""
 import csv
 import os
@@ -71,7 +71,7 @@ print(f"after the crash: rig.csv readable with {len(written) - 1} rows; checkpoi
 again = run(resumed, "--resume")
 if again.returncode != 0:
     fail("the resumed run failed:\n" + again.stdout + again.stderr)
-for name, drop in (("coupling.csv", ("wall_s",)), ("rig.csv", ())):
+for name, drop in (("coupling.csv", ("wall_s",)), ("rig.csv", ()), ("soil.csv", ())):
     a = rows(os.path.join(straight, name), drop)
     b = rows(os.path.join(resumed, name), drop)
     if len(a) != len(b):

@@ -19,6 +19,9 @@ struct WheelMeshSpec {
     int chevron_segments = 4;         ///< boxes per arm
     bool closed_sides = true;         ///< side discs (an open wheel is a rim only)
     int rim_segments = 0;             ///< facets around; 0: about one per 5 degrees, at least 24
+    /// Only the half at y >= 0, open on the plane y = 0: the wheel of a mirror-symmetric half
+    /// model, whose other half is the image in a frictionless symmetry plane.
+    bool half = false;
 };
 
 TriangleMesh makeWheel(const WheelMeshSpec &spec);
