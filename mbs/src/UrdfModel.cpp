@@ -91,12 +91,13 @@ std::string typeName(const urdf::Joint &joint) {
 
 /// Key suffixes of a one-dof joint's quantities (docs/user-models.md).
 struct Units {
-    const char *position, *velocity, *speed, *effort, *stiffness, *damping, *rest;
+    const char *position, *velocity, *speed, *effort, *stiffness, *damping, *rest, *dissipation;
 };
-const Units kRotational{"position_rad",      "velocity_rad_s",    "speed_rad_s",      "torque_N_m",
-                        "stiffness_N_m_rad", "damping_N_m_s_rad", "rest_position_rad"};
-const Units kTranslational{"position_m",    "velocity_m_s",  "speed_m_s",      "force_N",
-                           "stiffness_N_m", "damping_N_s_m", "rest_position_m"};
+const Units kRotational{"position_rad",      "velocity_rad_s",    "speed_rad_s",
+                        "torque_N_m",        "stiffness_N_m_rad", "damping_N_m_s_rad",
+                        "rest_position_rad", "dissipation_s_rad"};
+const Units kTranslational{"position_m",    "velocity_m_s",  "speed_m_s",       "force_N",
+                           "stiffness_N_m", "damping_N_s_m", "rest_position_m", "dissipation_s_m"};
 
 SimTK::Vec3 toSimTK(const urdf::Vector3 &v) {
     return SimTK::Vec3(v.x, v.y, v.z);
@@ -181,6 +182,10 @@ SimTK::Rotation axisFrame(const urdf::Joint &joint, SimTK::CoordinateAxis axis,
     if (!(d.norm() > 1e-12) || !d.isFinite())
         throw ModelError(urdf_path + ": joint '" + joint.name + "' has a zero axis");
     return SimTK::Rotation(SimTK::UnitVec3(d), axis);
+}
+
+std::string where(const UrdfModelSettings &s) {
+    return s.yaml_path.empty() ? s.urdf_path : s.yaml_path;
 }
 
 /// A name in the settings that the URDF lacks (parseUrdfModel reports these with the line;
@@ -315,6 +320,18 @@ UrdfModelSettings parseUrdfModel(const std::string &yaml_path) {
                     (*sp)[u.damping].fail("must be >= 0");
                 sp->finish();
                 j.spring = spring;
+            }
+            if (auto st = item.optional("stop")) {
+                if (joint->type == urdf::Joint::CONTINUOUS || !joint->limits)
+                    st->fail("joint '" + j.joint +
+                             "' has no position limits in the URDF to stop at");
+                JointStop stop;
+                stop.stiffness = (*st)[u.stiffness].positive();
+                stop.dissipation = st->number(u.dissipation, 0.0);
+                if (stop.dissipation < 0.0)
+                    (*st)[u.dissipation].fail("must be >= 0");
+                st->finish();
+                j.stop = stop;
             }
             item.finish();
             s.joints.push_back(std::move(j));
@@ -475,10 +492,24 @@ UrdfModel::UrdfModel(const UrdfModelSettings &settings)
         }
     }
 
-    // Springs (docs/physics.md §11): f = -k (q - q0) - c u on the joint coordinate.
+    // Drives, stops and springs (docs/physics.md §11); spring: f = -k (q - q0) - c u.
     for (const auto &js : settings_.joints) {
         Joint &j = jointNamed(js.joint);
         j.drive = js.drive;
+        if (js.stop) {
+            // Compliant stop at the URDF limits (docs/physics.md §11).
+            const auto joint = model->getJoint(js.joint);
+            if (joint->type == urdf::Joint::CONTINUOUS || !joint->limits ||
+                !(joint->limits->lower <= joint->limits->upper))
+                throw ModelError(path + ": joint '" + js.joint +
+                                 "' has no position limits (lower <= upper) to stop at");
+            if (!(js.stop->stiffness > 0.0) || !(js.stop->dissipation >= 0.0))
+                throw ModelError(where(settings_) + ": joint '" + js.joint +
+                                 "': a stop needs stiffness > 0 and dissipation >= 0");
+            SimTK::Force::MobilityLinearStop(forces_, j.mobod, SimTK::MobilizerQIndex(0),
+                                             js.stop->stiffness, js.stop->dissipation,
+                                             joint->limits->lower, joint->limits->upper);
+        }
         if (!js.spring)
             continue;
         if (js.spring->stiffness != 0.0)

@@ -208,6 +208,14 @@ TEST_CASE("URDF joint springs and a compound pendulum swing at the analytic freq
     CHECK(err_slide < 1e-9);
     CHECK(err_twist < 1e-9);
     CHECK(err_swing < 5e-11);
+    // drop: 1 kg falls 0.1 m onto the stop at the URDF's lower limit (k = 1e4 N/m, Hunt-Crossley
+    // d = 10 s/m: about 0.5 critical damping at rest) and after 3 s rests where k δ = m g.
+    // Measured: 4e-17 m off, settled. Tolerance 1e-9 m (1e-6 of δ = 0.981 mm): a 1 % error in
+    // the stiffness or a stop at the wrong limit misses by 1e-5 m or more.
+    const auto o = m.observables();
+    WARN("stop: rests " << o.at("drop_position_m") - (-0.1 - 9.81 / 1e4)
+                        << " m from -0.1 - m g / k, speed " << o.at("drop_speed_m_s") << " m/s");
+    CHECK(o.at("drop_position_m") == Approx(-0.1 - 9.81 / 1e4).margin(1e-9));
 }
 
 TEST_CASE("URDF floating root with an STL mesh falls under gravity and the soil force",

@@ -27,6 +27,13 @@ struct JointSpring {
     double rest_position = 0.0; ///< [rad | m] where the spring force is zero
 };
 
+/// A compliant stop at the URDF's position limits (<limit lower upper>) of a revolute or
+/// prismatic joint; without one the limits are not enforced (docs/physics.md §11).
+struct JointStop {
+    double stiffness = 0.0;   ///< [N m/rad | N/m] per unit of limit violation
+    double dissipation = 0.0; ///< [s/rad | s/m] Hunt-Crossley coefficient
+};
+
 /// What the YAML says about one joint of the URDF.
 struct UrdfJointSettings {
     std::string joint;
@@ -34,6 +41,7 @@ struct UrdfJointSettings {
     std::optional<double> velocity; ///< [rad/s | m/s] initial speed
     JointDrive drive;
     std::optional<JointSpring> spring;
+    std::optional<JointStop> stop;
 };
 
 /// A link that touches the soil, with its geometry in the link frame.
