@@ -1,6 +1,7 @@
 #include "CouplingCommands.hpp"
 
 #include "ChildProcesses.hpp"
+#include "Nodes.hpp"
 #include "SoilSide.hpp"
 #include "grainlink/coupling/Coordinator.hpp"
 #include "grainlink/dem/RigidFloor.hpp"
@@ -39,6 +40,15 @@ struct StopSignals {
     }
 };
 
+/// Whether a participant of the scenario runs `grainlink mbs-node`.
+bool hasSimbodyParticipant(const config::ConfigNode &root) {
+    for (const auto &p : root["participants"].items())
+        for (const auto &word : p.has("command") ? p["command"].items() : std::vector<config::ConfigNode>{})
+            if (word.text() == "mbs-node")
+                return true;
+    return false;
+}
+
 CoordinatorConfig configFor(const CoupledRunOptions &options, const char *default_endpoint) {
     // The coupling sections, and the participants' own sections checked up front, so a typo
     // stops the run before any process starts.
@@ -51,6 +61,8 @@ CoordinatorConfig configFor(const CoupledRunOptions &options, const char *defaul
         dem::parseRigidFloor(*floor);
     if (const auto rig = root.optional("rig"))
         mbs::parseSingleWheelRig(*rig);
+    else if (hasSimbodyParticipant(root))
+        makeModel(root, options.config_path); // builds it once: every model error shows now
     if (const auto test = root.optional("wheel_test"))
         mbs::parseWheelTest(*test);
     root.finish();
