@@ -1,5 +1,6 @@
 // The `grainlink` command: one binary, one subcommand per job.
 #include "CouplingCommands.hpp"
+#include "LabCommands.hpp"
 #include "Nodes.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 
@@ -58,6 +59,24 @@ int main(int argc, char **argv) {
     wheel_stl->add_option("stl", stl_path, "STL file to write")->required();
     wheel_stl->add_flag("--binary", stl_binary, "binary STL (default ASCII)");
 
+    grainlink::apps::ParamsOptions params_options;
+    auto *params = app.add_subcommand(
+        "params", "derive DEM parameters from a soil and test description (docs/lab.md)");
+    params->add_option("description", params_options.input_path, "soil and test YAML")
+        ->required();
+    params->add_option("--out", params_options.output_path,
+                       "matrix file, .yaml or .csv (default out/params/<name>.yaml)");
+
+    grainlink::apps::LabOptions lab_options;
+    auto *lab = app.add_subcommand("lab", "virtual soil laboratory test (docs/lab.md)");
+    lab->add_option("test", lab_options.test, "the test: bevameter")
+        ->required()
+        ->check(CLI::IsMember({"bevameter"}));
+    lab->add_option("scenario", lab_options.scenario_path, "lab scenario YAML")->required();
+    lab->add_option("--out", lab_options.output_directory, "output directory (default out/<name>)");
+    lab->add_option("--progress-interval", lab_options.progress_interval_s,
+                    "seconds between progress lines");
+
     grainlink::apps::NodeOptions node;
     auto *mbs_node = app.add_subcommand(
         "mbs-node", "the Simbody single-wheel rig as a multibody participant (started by run)");
@@ -100,6 +119,10 @@ int main(int argc, char **argv) {
             return grainlink::apps::runFloorNode(node);
         } else if (wheel_stl->parsed()) {
             return grainlink::apps::exportWheelStl(scenario_path, stl_path, stl_binary);
+        } else if (params->parsed()) {
+            return grainlink::apps::runParams(params_options);
+        } else if (lab->parsed()) {
+            return grainlink::apps::runLab(lab_options);
         } else if (keygen->parsed()) {
             return grainlink::apps::generateKeys(key_directory, key_names);
         }

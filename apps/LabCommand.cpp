@@ -1,0 +1,28 @@
+// `grainlink lab TEST SCENARIO.yaml --out DIR`: the virtual soil laboratory (docs/lab.md).
+#include "LabCommands.hpp"
+
+#include "grainlink/lab/Bevameter.hpp"
+
+#include <cstdio>
+#include <stdexcept>
+
+namespace grainlink::apps {
+
+int runLab(const LabOptions &options) {
+    if (options.test != "bevameter")
+        throw std::invalid_argument("lab test '" + options.test +
+                                    "' is not implemented; available: bevameter");
+    const auto scenario = lab::loadBevameter(options.scenario_path);
+    lab::BevameterOptions run;
+    run.output_directory =
+        options.output_directory.empty() ? "out/" + scenario.name : options.output_directory;
+    run.progress_interval_s = options.progress_interval_s;
+    const auto result = lab::runBevameter(scenario, run);
+    std::printf("%s", result.report().c_str());
+    std::printf("written: %s/{pressure_sinkage.csv,bekker_fit.csv,report.txt}; plot with "
+                "tools/plot_lab.py %s\n",
+                run.output_directory.c_str(), run.output_directory.c_str());
+    return 0;
+}
+
+} // namespace grainlink::apps

@@ -1,0 +1,263 @@
+#include "grainlink/lab/Bevameter.hpp"
+
+#include "grainlink/dem/Progress.hpp"
+#include "grainlink/dem/ScenarioRun.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+#include <stdexcept>
+
+namespace grainlink::lab {
+
+namespace fs = std::filesystem;
+using dem::Vec3;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+double seconds(std::chrono::steady_clock::time_point since) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
+}
+
+/// Flat closed disc of radius R and thickness t, axis z, bottom face at z = 0.
+dem::TriangleMesh plateMesh(double radius_m, double thickness_m, int segments) {
+    dem::TriangleMesh mesh = dem::makeCylinder(radius_m, thickness_m, segments);
+    for (Vec3 &v : mesh.vertices_m)
+        v = Vec3(v.x(), -v.z(), v.y() + 0.5 * thickness_m); // cylinder axis y -> z
+    return mesh;
+}
+
+std::string mm(double m) {
+    std::ostringstream out;
+    out << std::setprecision(4) << m * 1e3 << " mm";
+    return out.str();
+}
+
+} // namespace
+
+BevameterScenario parseBevameter(const config::ConfigNode &root) {
+    BevameterScenario s;
+    s.name = root["name"].text();
+    s.soil = dem::parseScenario(root["soil"], true);
+    const auto b = root["bevameter"];
+    BevameterSpec &t = s.test;
+    const auto radii = b["plate_radii_m"];
+    t.plate_radii_m = radii.numbers();
+    if (t.plate_radii_m.empty())
+        radii.fail("give at least one plate radius");
+    for (double r : t.plate_radii_m)
+        if (!(r > 0.0))
+            radii.fail("every plate radius must be > 0");
+    if (b.has("plate_thickness_m"))
+        t.plate_thickness_m = b["plate_thickness_m"].positive();
+    if (b.has("plate_segments")) {
+        t.plate_segments = int(b["plate_segments"].integer());
+        if (t.plate_segments < 8)
+            b["plate_segments"].fail("must be >= 8");
+    }
+    if (b.has("plate_friction_coefficient")) {
+        t.plate_friction_coefficient = b["plate_friction_coefficient"].number();
+        if (*t.plate_friction_coefficient < 0.0)
+            b["plate_friction_coefficient"].fail("must be >= 0");
+    }
+    t.speed_m_s = b["speed_m_s"].positive();
+    t.max_sinkage_m = b["max_sinkage_m"].positive();
+    if (b.has("start_clearance_m")) {
+        t.start_clearance_m = b["start_clearance_m"].number();
+        if (t.start_clearance_m < 0.0)
+            b["start_clearance_m"].fail("must be >= 0");
+    }
+    if (b.has("sample_interval_s"))
+        t.sample_interval_s = b["sample_interval_s"].positive();
+    if (b.has("min_resolution"))
+        t.min_resolution = b["min_resolution"].positive();
+    if (auto c = b.optional("centre_m")) {
+        const auto xy = c->numbers();
+        if (xy.size() != 2)
+            c->fail("expected [x, y]");
+        t.centre_m = Eigen::Vector2d(xy[0], xy[1]);
+    }
+    if (b.has("fit_min_sinkage_m"))
+        t.fit_min_sinkage_m = b["fit_min_sinkage_m"].number();
+    b.finish();
+    if (!s.soil.bodies.empty())
+        root["soil"]["bodies"].fail("the bevameter adds its own plate; remove soil.bodies");
+
+    // Resolution, seed eq. 11 with L_min = 2 R: Gamma = R / r_max.
+    const double r_max = s.soil.deposition.radius.largest();
+    for (double r : t.plate_radii_m)
+        if (r / r_max < t.min_resolution - 1e-12) {
+            std::ostringstream msg;
+            msg << "plate radius " << r << " m over the largest grain radius " << r_max
+                << " m is Gamma = " << r / r_max << " < min_resolution " << t.min_resolution
+                << " (seed: Gamma >= 10 for bevameter tests); use larger plates or finer grains";
+            b["plate_radii_m"].fail(msg.str());
+        }
+    root.finish();
+    return s;
+}
+
+BevameterScenario loadBevameter(const std::string &path) {
+    return parseBevameter(config::ConfigNode::loadFile(path));
+}
+
+PressureSinkageCurve PlateRun::curve() const {
+    PressureSinkageCurve c;
+    c.plate_radius_m = plate_radius_m;
+    for (const auto &s : samples) {
+        c.sinkage_m.push_back(s.sinkage_m);
+        c.pressure_Pa.push_back(s.pressure_Pa);
+    }
+    return c;
+}
+
+BevameterResult runBevameter(const BevameterScenario &scenario, const BevameterOptions &options) {
+    const auto start = std::chrono::steady_clock::now();
+    const BevameterSpec &t = scenario.test;
+    BevameterResult result;
+    auto base =
+        dem::prepareSoil(scenario.soil, options.progress_interval_s, &result.packing_from_cache);
+    result.preparation_wall_s = seconds(start);
+    result.particles = base->particles().size();
+    result.largest_radius_m = scenario.soil.deposition.radius.largest();
+    result.time_step_s = base->settings().time_step_s;
+    const double surface = dem::bedSurface(base->particles());
+    const Vec3 lower = scenario.soil.deposition.region_lower_m;
+    const Vec3 upper = scenario.soil.deposition.region_upper_m;
+    const Eigen::Vector2d centre = t.centre_m.value_or(
+        Eigen::Vector2d(0.5 * (lower.x() + upper.x()), 0.5 * (lower.y() + upper.y())));
+    const double dt = base->settings().time_step_s;
+
+    for (double radius : t.plate_radii_m) {
+        const auto plate_start = std::chrono::steady_clock::now();
+        dem::DemSystem sys = *base; // every plate presses into the same settled bed
+        PlateRun run;
+        run.plate_radius_m = radius;
+        run.resolution = radius / result.largest_radius_m;
+        run.surface_m = surface;
+        run.wall_gap_m =
+            std::min({centre.x() - radius - lower.x(), upper.x() - centre.x() - radius,
+                      centre.y() - radius - lower.y(), upper.y() - centre.y() - radius});
+        run.depth_below_m = surface - t.max_sinkage_m - lower.z();
+
+        const double thickness = t.plate_thickness_m > 0.0 ? t.plate_thickness_m : 0.2 * radius;
+        dem::RigidBodyState initial;
+        initial.position_m = Vec3(centre.x(), centre.y(), surface + t.start_clearance_m);
+        initial.velocity_m_s = Vec3(0.0, 0.0, -t.speed_m_s);
+        dem::MeshBody plate("plate", plateMesh(radius, thickness, t.plate_segments), initial);
+        plate.friction_coefficient = t.plate_friction_coefficient;
+        const double t0 = sys.time();
+        const double z0 = initial.position_m.z(), v = t.speed_m_s;
+        sys.addBody(std::move(plate), [initial, t0, z0, v](double time_s) {
+            dem::RigidBodyState s = initial;
+            s.position_m.z() = z0 - v * (time_s - t0); // constant speed down
+            return s;
+        });
+        sys.prepare();
+
+        const auto total_steps =
+            std::uint64_t(std::ceil((t.start_clearance_m + t.max_sinkage_m) / (t.speed_m_s * dt)));
+        const auto steps_per_sample =
+            std::max<std::uint64_t>(1, std::llround(t.sample_interval_s / dt));
+        const double area = kPi * radius * radius;
+        dem::Progress progress("bevameter R=" + mm(radius), options.progress_interval_s);
+        sys.body(0).resetAccumulatedImpulse();
+        std::uint64_t done = 0;
+        while (done < total_steps) {
+            const std::uint64_t n = std::min(steps_per_sample, total_steps - done);
+            sys.run(n);
+            done += n;
+            dem::MeshBody &body = sys.body(0);
+            BevameterSample s;
+            s.time_s = (double(done) - 0.5 * double(n)) * dt;
+            s.sinkage_m = surface - (z0 - v * s.time_s);
+            s.force_N = body.impulse_N_s.z() / body.accumulated_time_s;
+            s.pressure_Pa = s.force_N / area;
+            body.resetAccumulatedImpulse();
+            run.samples.push_back(s);
+            progress.update(
+                sys.time(), double(done) / double(total_steps), done * sys.particles().size(),
+                "sinkage " + mm(s.sinkage_m) + ", p " + std::to_string(s.pressure_Pa) + " Pa");
+        }
+        run.steps = done;
+        run.wall_s = seconds(plate_start);
+        std::fprintf(stderr, "[bevameter] R = %s: %llu steps in %.1f s, p(%s) = %.4g Pa\n",
+                     mm(radius).c_str(), static_cast<unsigned long long>(done), run.wall_s,
+                     mm(run.samples.back().sinkage_m).c_str(), run.samples.back().pressure_Pa);
+        result.plates.push_back(std::move(run));
+    }
+
+    std::vector<PressureSinkageCurve> curves;
+    for (const auto &p : result.plates)
+        curves.push_back(p.curve());
+    try {
+        result.fit = fitBekker(curves, t.fit_min_sinkage_m);
+    } catch (const std::invalid_argument &e) {
+        result.fit_note = e.what();
+    }
+    result.wall_s = seconds(start);
+    if (!options.output_directory.empty())
+        writeBevameterOutputs(result, options.output_directory);
+    return result;
+}
+
+std::string BevameterResult::report() const {
+    std::ostringstream out;
+    out << std::setprecision(5);
+    out << "Virtual bevameter (pressure-sinkage)\n";
+    out << "  bed: " << particles << " grains, largest radius " << mm(largest_radius_m)
+        << ", time step " << time_step_s << " s, packing "
+        << (packing_from_cache ? "from the cache" : "deposited") << " in " << preparation_wall_s
+        << " s\n";
+    for (const auto &p : plates) {
+        out << "  plate R = " << mm(p.plate_radius_m) << ": Gamma = R/r_max = " << p.resolution
+            << ", rim to region side " << mm(p.wall_gap_m) << " ("
+            << p.wall_gap_m / (2 * p.plate_radius_m)
+            << " diameters), bed under the plate at the end " << mm(p.depth_below_m) << "; "
+            << p.steps << " steps, " << p.wall_s
+            << " s wall; final p = " << p.samples.back().pressure_Pa
+            << " Pa at z = " << mm(p.samples.back().sinkage_m) << "\n";
+    }
+    if (fit)
+        out << fit->describe();
+    else
+        out << "  no Bekker fit: " << fit_note << "\n";
+    out << "  total wall time " << wall_s << " s\n";
+    return out.str();
+}
+
+void writeBevameterOutputs(const BevameterResult &result, const std::string &directory) {
+    fs::create_directories(directory);
+    const fs::path dir(directory);
+    {
+        std::ofstream csv(dir / "pressure_sinkage.csv");
+        csv << "plate_radius_m,time_s,sinkage_m,force_N,pressure_Pa\n" << std::setprecision(10);
+        for (const auto &p : result.plates)
+            for (const auto &s : p.samples)
+                csv << p.plate_radius_m << ',' << s.time_s << ',' << s.sinkage_m << ',' << s.force_N
+                    << ',' << s.pressure_Pa << '\n';
+    }
+    {
+        std::ofstream csv(dir / "bekker_fit.csv");
+        csv << "parameter,value,standard_error,half_width_95,unit\n" << std::setprecision(10);
+        if (result.fit) {
+            const auto &f = *result.fit;
+            csv << "k_c," << f.parameters.k_c << ',' << f.standard_error[0] << ','
+                << f.half_width_95[0] << ",N/m^(n+1)\n";
+            csv << "k_phi," << f.parameters.k_phi << ',' << f.standard_error[1] << ','
+                << f.half_width_95[1] << ",N/m^(n+2)\n";
+            csv << "n," << f.parameters.n << ',' << f.standard_error[2] << ',' << f.half_width_95[2]
+                << ",-\n";
+        }
+    }
+    std::ofstream(dir / "report.txt") << result.report();
+}
+
+} // namespace grainlink::lab
