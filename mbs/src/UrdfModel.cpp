@@ -135,11 +135,13 @@ LinkMass massOf(const urdf::Link &link, const std::string &urdf_path) {
         Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(inertia).eigenvalues(); // ascending
     const double scale = std::max(1e-300, moments.cwiseAbs().maxCoeff());
     // A physical inertia has non-negative principal moments obeying the triangle inequality.
-    if (moments[0] < -1e-12 * scale || moments[0] + moments[1] < moments[2] * (1.0 - 1e-9))
-        throw ModelError(where + "the inertia tensor is not physical (principal moments " +
-                         std::to_string(moments[0]) + ", " + std::to_string(moments[1]) + ", " +
-                         std::to_string(moments[2]) +
-                         " kg m²: each must be >= 0 and none larger than the other two together)");
+    if (moments[0] < -1e-12 * scale || moments[0] + moments[1] < moments[2] * (1.0 - 1e-9)) {
+        std::ostringstream os;
+        os << where << "the inertia tensor is not physical (principal moments " << moments[0]
+           << ", " << moments[1] << ", " << moments[2]
+           << " kg m²: each must be >= 0 and none larger than the other two together)";
+        throw ModelError(os.str());
+    }
     if (in.mass == 0.0) {
         if (moments[2] > 0.0)
             throw ModelError(where + "zero mass with a nonzero inertia");

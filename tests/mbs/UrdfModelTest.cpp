@@ -242,6 +242,26 @@ TEST_CASE("URDF floating root with an STL mesh falls under gravity and the soil 
     CHECK(m.observables().at("root_vz_m_s") == Approx(-4.905 * 0.5).margin(1e-9));
 }
 
+TEST_CASE("URDF planar joint moves in its plane only; a massless fixed link is allowed",
+          "[mbs][urdf]") {
+    UrdfModel m(parseUrdfModel(kData + "/planar.yaml"));
+    Wrench soil;
+    soil.force_N = Vec3(3.0, 5.0, 0.0);    // y is normal to the plane: carried by the joint
+    soil.torque_N_m = Vec3(0.2, 0.1, 0.3); // only the y component turns the puck
+    m.applyWrenches({soil});
+    m.advanceTo(0.4);
+    const auto s = m.bodyStates()[0];
+    // Constant accelerations a_x = 3 / 2, a_z = -9.81, α_y = 0.1 / 0.05 (Iyy): exact to the
+    // integrator's accuracy (1e-8 relative): 1e-9.
+    CHECK(s.position_m.x() == Approx(0.5 * 1.5 * 0.16).margin(1e-9));
+    CHECK(s.position_m.y() == Approx(0.0).margin(1e-12));
+    CHECK(s.position_m.z() == Approx(1.0 - 0.5 * 9.81 * 0.16).margin(1e-9));
+    CHECK(s.angular_velocity_rad_s.y() == Approx(2.0 * 0.4).margin(1e-9));
+    CHECK(s.angular_velocity_rad_s.x() == Approx(0.0).margin(1e-12));
+    CHECK(s.angular_velocity_rad_s.z() == Approx(0.0).margin(1e-12));
+    CHECK(m.observables().at("sled_angle_rad") == Approx(0.5 * 2.0 * 0.16).margin(1e-9));
+}
+
 TEST_CASE("URDF and YAML errors name the file, the key and the line", "[mbs][urdf]") {
     SECTION("a URDF that is not valid XML") {
         UrdfModelSettings s;
@@ -282,6 +302,19 @@ TEST_CASE("URDF and YAML errors name the file, the key and the line", "[mbs][urd
         const std::string msg = messageOf<ModelError>([&] { UrdfModel m(s); });
         CHECK_THAT(msg, Catch::Contains("massless_terminal.urdf") &&
                             Catch::Contains("link 'probe'") && Catch::Contains("no mass"));
+    }
+    SECTION("an inertia tensor that no body has") {
+        UrdfModelSettings s;
+        s.urdf_path = kData + "/bad_inertia.urdf";
+        const std::string msg = messageOf<ModelError>([&] { UrdfModel m(s); });
+        CHECK_THAT(msg, Catch::Contains("bad_inertia.urdf: link 'disc'") &&
+                            Catch::Contains("not physical"));
+    }
+    SECTION("a stop on a joint without limits") {
+        const std::string msg =
+            messageOf<ConfigError>([&] { parseUrdfModel(kData + "/stop_without_limits.yaml"); });
+        CHECK_THAT(msg, Catch::Contains("stop_without_limits.yaml:5: key 'joints[0].stop'") &&
+                            Catch::Contains("no position limits"));
     }
     SECTION("settings built in code naming a missing joint") {
         UrdfModelSettings s;
