@@ -7,6 +7,7 @@
 #include "grainlink/dem/Checkpoint.hpp"
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/dem/VtkWriter.hpp"
 #include "grainlink/dem/WheelMesh.hpp"
 
 #include <algorithm>
@@ -49,10 +50,18 @@ int runSoilNode(const NodeOptions &options) {
         sys->addBody(std::move(body), [&motion, b](double t) { return motion[b].at(t); });
     }
     double dem_offset_s = sys->time() - run.start_tick * run.tick_s; // DEM time - coupling time
+    // Particle and wheel snapshots for ParaView (soil.output.snapshot_interval_s), at the first
+    // window end past each multiple of the interval; their times are kept in the checkpoint.
+    const double snapshot_interval_s = scenario.output.snapshot_interval_s;
+    dem::VtkWriter vtk(options.output_directory + "/snapshots");
     if (run.restore) {
         const auto extras =
             dem::readCheckpoint(*sys, run.restore->checkpoint_directory + "/soil.bin");
         dem_offset_s = extras.at("dem_offset_s");
+        std::vector<double> times;
+        for (int k = 0; k < int(extras.at("snapshots")); ++k)
+            times.push_back(extras.at("snapshot" + std::to_string(k) + "_s"));
+        vtk.resumeAt(int(times.size()), times);
     }
 
     std::filesystem::create_directories(options.output_directory);
@@ -68,11 +77,16 @@ int runSoilNode(const NodeOptions &options) {
     for (;;) {
         switch (participant.waitForCommand()) {
         case coupling::Command::WriteCheckpoint:
-            dem::writeCheckpoint(*sys, participant.checkpointDirectory() + "/soil.bin",
-                                 {{"dem_offset_s", dem_offset_s}});
+        {
+            dem::CheckpointExtras extras{{"dem_offset_s", dem_offset_s},
+                                         {"snapshots", double(vtk.count())}};
+            for (int k = 0; k < vtk.count(); ++k)
+                extras["snapshot" + std::to_string(k) + "_s"] = vtk.times()[std::size_t(k)];
+            dem::writeCheckpoint(*sys, participant.checkpointDirectory() + "/soil.bin", extras);
             series.flush();
             participant.checkpointWritten();
             break;
+        }
         case coupling::Command::Advance: {
             const auto &in = participant.inputs();
             const double steps_real = in.duration_s / dt;
@@ -133,6 +147,11 @@ int runSoilNode(const NodeOptions &options) {
                        << w.force_N.x() << ',' << w.force_N.y() << ',' << w.force_N.z() << ','
                        << w.torque_N_m.x() << ',' << w.torque_N_m.y() << ',' << w.torque_N_m.z()
                        << ',' << sys->wallContactCount() << '\n';
+            }
+            if (snapshot_interval_s > 0.0 &&
+                in.end_s >= snapshot_interval_s * double(vtk.count()) - 1e-12) {
+                std::filesystem::create_directories(options.output_directory + "/snapshots");
+                vtk.write(*sys, in.end_s);
             }
             participant.writeOutputs(std::move(out));
             participant.advance();

@@ -2,7 +2,8 @@
 """A coupled wheel run (wheel_resume.yaml: Simbody rig, DEM soil, coordinator) whose soil process
 is killed with SIGKILL after its first checkpoint, then resumed with --resume: the results
 written before the crash stay readable, and the resumed run ends bit-identically to an
-uninterrupted one (coupling.csv without its wall-time column, rig.csv and soil.csv, row for row).
+uninterrupted one (coupling.csv without its wall-time column, rig.csv and soil.csv row for row, and the
+ParaView snapshots).
 Usage: wheel_resume.py GRAINLINK CONFIG WORK"""
 import csv
 import os
@@ -80,3 +81,9 @@ for name, drop in (("coupling.csv", ("wall_s",)), ("rig.csv", ()), ("soil.csv", 
         if ra != rb:
             fail(f"{name}: resumed row\n{rb}\ndiffers from the uninterrupted\n{ra}")
     print(f"{name}: {len(a) - 1} rows, identical to the uninterrupted run")
+# The ParaView snapshots: the same collection, the last snapshot byte for byte.
+for name in ("snapshots/particles.pvd", "snapshots/particles_000003.vtu"):
+    if open(os.path.join(straight, name), "rb").read() != open(os.path.join(resumed, name),
+                                                               "rb").read():
+        fail(f"{name} differs after resuming")
+print("snapshots: particles.pvd and the last snapshot identical to the uninterrupted run")
