@@ -148,8 +148,18 @@ BevameterResult runBevameter(const BevameterScenario &scenario, const BevameterO
         run.depth_below_m = surface - t.max_sinkage_m - lower.z();
 
         const double thickness = t.plate_thickness_m > 0.0 ? t.plate_thickness_m : 0.2 * radius;
+        // Start above every grain under the plate (the surface is a percentile: a few grains
+        // stick out of it), so the plate never appears inside a grain.
+        double highest = surface;
+        const auto &grains = sys.particles();
+        for (std::size_t i = 0; i < grains.size(); ++i) {
+            const Vec3 &x = grains.position[i];
+            const double reach = radius + grains.radius[i];
+            if (std::hypot(x.x() - centre.x(), x.y() - centre.y()) < reach)
+                highest = std::max(highest, x.z() + grains.radius[i]);
+        }
         dem::RigidBodyState initial;
-        initial.position_m = Vec3(centre.x(), centre.y(), surface + t.start_clearance_m);
+        initial.position_m = Vec3(centre.x(), centre.y(), highest + t.start_clearance_m);
         initial.velocity_m_s = Vec3(0.0, 0.0, -t.speed_m_s);
         dem::MeshBody plate("plate", plateMesh(radius, thickness, t.plate_segments), initial);
         plate.friction_coefficient = t.plate_friction_coefficient;
@@ -162,8 +172,8 @@ BevameterResult runBevameter(const BevameterScenario &scenario, const BevameterO
         });
         sys.prepare();
 
-        const auto total_steps =
-            std::uint64_t(std::ceil((t.start_clearance_m + t.max_sinkage_m) / (t.speed_m_s * dt)));
+        const auto total_steps = std::uint64_t(
+            std::ceil((initial.position_m.z() - surface + t.max_sinkage_m) / (t.speed_m_s * dt)));
         const auto steps_per_sample =
             std::max<std::uint64_t>(1, std::llround(t.sample_interval_s / dt));
         const double area = kPi * radius * radius;

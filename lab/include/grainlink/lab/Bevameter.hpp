@@ -18,7 +18,7 @@ struct BevameterSpec {
     std::optional<double> plate_friction_coefficient; ///< unset: the grains' own angles
     double speed_m_s = 0.0;                           ///< [m/s] downward plate speed
     double max_sinkage_m = 0.0;                       ///< [m] the run stops at this sinkage
-    double start_clearance_m = 0.001;        ///< [m] plate bottom above the bed surface at start
+    double start_clearance_m = 0.001;        ///< [m] plate bottom above the highest grain under it
     double sample_interval_s = 0.005;        ///< [s] force averaged over each interval
     double min_resolution = 10.0;            ///< [-] required R / r_max (seed: Gamma >= 10)
     std::optional<Eigen::Vector2d> centre_m; ///< [m] plate axis (x, y); unset: region centre
