@@ -66,6 +66,34 @@ void RollingEpsd::validate() const {
         badParameter("rolling epsd", "coefficient", coefficient, "must be >= 0");
 }
 
+void RollingGrainShape::validate() const {
+    static const char *const names[3] = {"aspect_ratio_angle_deg[0]", "aspect_ratio_angle_deg[1]",
+                                         "aspect_ratio_angle_deg[2]"};
+    for (int k = 0; k < 3; ++k)
+        if (!(aspect_ratio_angle_deg[k] > 0.0 && aspect_ratio_angle_deg[k] < 90.0))
+            badParameter("rolling grain_shape", names[k], aspect_ratio_angle_deg[k],
+                         "must be in (0, 90): gamma = arctan(A), seed eq. 7");
+}
+
+void RollingGrainShape::derive() {
+    for (int k = 0; k < 3; ++k) {
+        gamma_rad[k] = aspect_ratio_angle_deg[k] * M_PI / 180.0;
+        tan_gamma[k] = std::tan(gamma_rad[k]);
+        elastic_slope[k] = 0.5 * tan_gamma[k] * tan_gamma[k];
+    }
+}
+
+Vec3 grainShapeInertia(const RollingGrainShape &model, double radius_m, double density_kg_m3) {
+    // Seed eq. 12: J_k = (1/9) pi rho r^3 (r / A_k)^2, A_k = tan(gamma_k).
+    Vec3 inertia;
+    for (int k = 0; k < 3; ++k) {
+        const double aspect = std::tan(model.aspect_ratio_angle_deg[k] * M_PI / 180.0);
+        const double length = radius_m / aspect;
+        inertia[k] = M_PI / 9.0 * density_kg_m3 * radius_m * radius_m * radius_m * length * length;
+    }
+    return inertia;
+}
+
 void CohesionLinear::validate() const {
     if (!(energy_density_J_m3 >= 0.0))
         badParameter("cohesion linear", "energy_density_J_m3", energy_density_J_m3, "must be >= 0");
@@ -86,6 +114,8 @@ void ContactLaw::finalize() {
         restitution->derive();
         beta = restitution->beta;
     }
+    if (auto *shape = std::get_if<RollingGrainShape>(&rolling))
+        shape->derive();
     // Cross-slot rule: Mindlin's tangential dashpot takes the normal restitution (LIGGGHTS).
     if (auto *mindlin = std::get_if<TangentialMindlin>(&tangential))
         mindlin->beta = beta;
@@ -116,6 +146,11 @@ std::string ContactLaw::describe() const {
         tangential);
     if (auto *r = std::get_if<RollingEpsd>(&rolling))
         out << " rolling=epsd(mu_r=" << r->coefficient << ")";
+    if (auto *r = std::get_if<RollingGrainShape>(&rolling))
+        out << " rolling=grain_shape(gamma=" << r->aspect_ratio_angle_deg.x() << ","
+            << r->aspect_ratio_angle_deg.y() << "," << r->aspect_ratio_angle_deg.z()
+            << " deg, inertia="
+            << (r->inertia == RollingGrainShape::Inertia::SeedEq12 ? "seed_eq12" : "sphere") << ")";
     if (auto *c = std::get_if<CohesionLinear>(&cohesion))
         out << " cohesion=linear(k_c=" << c->energy_density_J_m3 << " J/m^3)";
     if (background_damping_1_s > 0.0)

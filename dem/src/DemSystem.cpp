@@ -140,7 +140,16 @@ void DemSystem::initialise() {
         history_planes_ != planes_.size())
         resizeWallHistories();
     body_reference_.resize(bodies_.size());
-    neighbours_.keepRollingHistory(std::holds_alternative<RollingEpsd>(law_.rolling));
+    neighbours_.keepRollingHistory(std::holds_alternative<RollingEpsd>(law_.rolling) ||
+                                   std::holds_alternative<RollingGrainShape>(law_.rolling));
+    if (const auto *shape = std::get_if<RollingGrainShape>(&law_.rolling))
+        if (shape->inertia == RollingGrainShape::Inertia::SeedEq12)
+            for (std::size_t i = 0; i < n; ++i) {
+                // Seed eq. 12 per local axis (docs/physics.md §2.6.1); idempotent.
+                const double r = particles_.radius[i];
+                const double density = particles_.mass[i] / (4.0 / 3.0 * M_PI * r * r * r);
+                particles_.inertia[i] = grainShapeInertia(*shape, r, density);
+            }
     initialised_ = true;
     prepared_particles_ = n;
     if (reference_position_.size() != n)
@@ -622,7 +631,9 @@ void DemSystem::pairContacts() {
     withConcreteLaw(law_, [&](const auto &normal, const auto &damping, const auto &tangential,
                               const auto &rolling, const auto &cohesion) {
         using Normal = std::decay_t<decltype(normal)>;
-        constexpr bool kRolling = std::is_same_v<std::decay_t<decltype(rolling)>, RollingEpsd>;
+        using Rolling = std::decay_t<decltype(rolling)>;
+        constexpr bool kGrainShape = std::is_same_v<Rolling, RollingGrainShape>;
+        constexpr bool kRolling = std::is_same_v<Rolling, RollingEpsd> || kGrainShape;
 #pragma omp parallel num_threads(threads)
         {
             // Thread t owns particles [begin, end) and writes their forces directly. The
@@ -723,6 +734,10 @@ void DemSystem::pairContacts() {
                         g.arm_j_m = 0.0;
                         g.contact_velocity_m_s = velocity[i] - dist * spin[i].cross(g.normal);
                         g.relative_spin_rad_s = spin[i];
+                        if constexpr (kGrainShape) {
+                            g.orientation_i = &p.orientation[i];
+                            g.orientation_j = nullptr;
+                        }
                         const Vec3 contact_point = position[i] - dist * wall.normal;
                         std::size_t slot = std::size_t(material[i]);
                         if (wall.track && wall.track->contains(contact_point))
@@ -785,6 +800,10 @@ void DemSystem::pairContacts() {
                         velocity[i] - velocity[j] -
                         (g.arm_i_m * spin[i] + g.arm_j_m * spin[j]).cross(g.normal);
                     g.relative_spin_rad_s = spin[i] - spin[j];
+                    if constexpr (kGrainShape) {
+                        g.orientation_i = &p.orientation[i];
+                        g.orientation_j = &p.orientation[j];
+                    }
                     ContactHistory h;
                     h.tangential_m = tangential_history[k];
                     if constexpr (kRolling)
@@ -943,6 +962,11 @@ void DemSystem::meshContacts() {
                                              body.state().pointVelocity(touch.point);
                     g.relative_spin_rad_s =
                         p.angular_velocity[i] - body.state().angular_velocity_rad_s;
+                    if constexpr (std::is_same_v<std::decay_t<decltype(rolling)>,
+                                                 RollingGrainShape>) {
+                        g.orientation_i = &p.orientation[i];
+                        g.orientation_j = nullptr;
+                    }
                     const auto &props =
                         body_props_[std::size_t(touch.body)][std::size_t(p.material[i])];
                     evaluateContact<Normal>(damping, tangential, rolling, cohesion, props, g, dt, h,

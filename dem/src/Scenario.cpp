@@ -89,8 +89,27 @@ ContactLaw parseContact(const ConfigNode &node) {
     validateAt(tangential, law.tangential);
 
     if (const auto rolling = node.optional("rolling")) {
-        if ((*rolling)["model"].choice({"none", "epsd"}) == "epsd")
+        const std::string model = (*rolling)["model"].choice({"none", "epsd", "grain_shape"});
+        if (model == "epsd") {
             law.rolling = RollingEpsd{(*rolling)["coefficient"].number()};
+        } else if (model == "grain_shape") {
+            // gamma per local axis: one number for all three, or a list of three (§2.6.1).
+            RollingGrainShape shape;
+            const ConfigNode gamma = (*rolling)["aspect_ratio_angle_deg"];
+            if (gamma.isSequence()) {
+                const std::vector<double> values = gamma.numbers();
+                if (values.size() != 3)
+                    gamma.fail("needs one angle or three (one per local axis), got " +
+                               std::to_string(values.size()));
+                shape.aspect_ratio_angle_deg = Vec3(values[0], values[1], values[2]);
+            } else {
+                shape.aspect_ratio_angle_deg.setConstant(gamma.number());
+            }
+            if (const auto inertia = rolling->optional("inertia"))
+                if (inertia->choice({"sphere", "seed_eq12"}) == "seed_eq12")
+                    shape.inertia = RollingGrainShape::Inertia::SeedEq12;
+            law.rolling = shape;
+        }
         rolling->finish();
         validateAt(*rolling, law.rolling);
     }

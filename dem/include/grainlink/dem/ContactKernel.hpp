@@ -19,6 +19,9 @@ struct ContactGeometry {
     double arm_j_m;            ///< centre of j to contact point (0 for walls)
     Vec3 contact_velocity_m_s; ///< velocity of i relative to j at the contact point
     Vec3 relative_spin_rad_s;  ///< omega_i - omega_j
+    // Read only by the grain-shape rolling law (set only where it is the law in use):
+    const Quat *orientation_i; ///< particle frame of i
+    const Quat *orientation_j; ///< particle frame of j; nullptr for walls
 };
 
 struct ContactResult {
@@ -46,6 +49,48 @@ inline void rotateIntoPlane(Vec3 &history, const Vec3 &normal) {
     } else if (x < 1.0) {
         history *= 1.0 / std::sqrt(1.0 - x);
     }
+}
+
+/// Moment arms of the grain-shape law in one rotation plane, as fractions of the sphere's
+/// contact arm a (docs/physics.md §2.6.1): the pivot lies x = a X along T and y = a Y below the
+/// centre along -N. `theta` is the grain's tilt about the plane's axis, `tan_gamma` = A and
+/// `elastic` the face-regime slope (a tan^2(gamma) / 2 delta).
+struct GrainShapeArms {
+    double X, Y;
+};
+inline GrainShapeArms grainShapeArms(double theta, double gamma, double tan_gamma, double elastic) {
+    // The virtual grain lands on its next face every 2 gamma: the tilt within the current face.
+    const double period = 2.0 * gamma;
+    const double tilt = theta - period * std::floor(theta / period + 0.5); // in [-gamma, gamma]
+    const double a = std::abs(tilt);
+    const double s = std::sin(a), c = std::cos(a);
+    // Corner regime: x = d sin(gamma - a), y = d cos(gamma - a), d = a / cos(gamma).
+    const double x_corner = tan_gamma * c - s;
+    const double x = std::min(elastic * a, x_corner); // face regime near a = 0
+    return {std::copysign(x, tilt), c + tan_gamma * s};
+}
+
+/// Torque of the grain-shape law on one grain beyond the sphere's own -a n x F_t (§2.6.1): the
+/// contact force f_n n + f_t acts, in the rotation plane of each local axis e_k, at the pivot
+/// corner of that axis' rectangle. `n` points from the contact into the grain, `tilt` is the
+/// grain's rolling rotation relative to the contact (world frame, in the contact plane).
+inline Vec3 grainShapeTorque(const RollingGrainShape &law, const Quat &orientation, const Vec3 &n,
+                             double arm_m, double overlap_m, double normal_force_N,
+                             const Vec3 &f_tangential, const Vec3 &tilt) {
+    const Mat3 frame = orientation.toRotationMatrix();
+    const double arm_over_overlap = arm_m / overlap_m;
+    Vec3 torque = Vec3::Zero();
+    for (int k = 0; k < 3; ++k) {
+        const Vec3 e = frame.col(k);
+        const Vec3 u = e.cross(n); // |u| = s_k, the share of the contact in this plane
+        const GrainShapeArms arms = grainShapeArms(tilt.dot(e), law.gamma_rad[k], law.tan_gamma[k],
+                                                   law.elastic_slope[k] * arm_over_overlap);
+        // M_k = -a (X f_n s_k^2 + Y f_t.u_k); the sphere's part (Y = 1, X = 0) is already applied.
+        const double moment = -arm_m * (arms.X * normal_force_N * u.squaredNorm() +
+                                        (arms.Y - 1.0) * f_tangential.dot(u));
+        torque += moment * e;
+    }
+    return torque;
 }
 } // namespace detail
 
@@ -137,6 +182,22 @@ evaluateContact(const Damping &damping, const Tangential &tangential, const Roll
             history.rolling_N_m *= max_moment / std::sqrt(moment_sq);
         out.torque_on_i_N_m += history.rolling_N_m;
         out.torque_on_j_N_m -= history.rolling_N_m;
+    } else if constexpr (std::is_same_v<Rolling, RollingGrainShape>) {
+        // Seed eq. 8 with the moment arms of a rectangle tilting over its corner (§2.6.1). The
+        // history is the relative rolling angle; each grain's tilt is its share of the rolling
+        // displacement at the contact point: a_j / (a_i + a_j) for i (R*/r_i), 1 at a wall.
+        Vec3 spin = g.relative_spin_rad_s;
+        spin -= spin.dot(n) * n;
+        detail::rotateIntoPlane(history.rolling_N_m, n);
+        history.rolling_N_m += dt_s * spin;
+        const double share_i = g.orientation_j ? g.arm_j_m / (g.arm_i_m + g.arm_j_m) : 1.0;
+        out.torque_on_i_N_m +=
+            detail::grainShapeTorque(rolling, *g.orientation_i, n, g.arm_i_m, g.overlap_m,
+                                     normal_force, f_tangential, share_i * history.rolling_N_m);
+        if (g.orientation_j)
+            out.torque_on_j_N_m += detail::grainShapeTorque(
+                rolling, *g.orientation_j, -n, g.arm_j_m, g.overlap_m, normal_force, -f_tangential,
+                -(1.0 - share_i) * history.rolling_N_m);
     } else {
         (void)rolling;
     }

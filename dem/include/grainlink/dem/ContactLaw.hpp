@@ -79,7 +79,28 @@ struct RollingEpsd {
     double coefficient = 0.1; ///< mu_r (rolling friction coefficient, dimensionless)
     void validate() const;
 };
-using RollingModel = std::variant<RollingNone, RollingEpsd>;
+/// The seed's grain-shape law (eqs. 6-8), §2.6.1: for each local axis k of the grain a virtual
+/// rectangle of aspect-ratio angle gamma_k (A_k = tan gamma_k = half base / half height) rests
+/// on the contact with a face and tilts over its corner as the grain rolls; the contact force
+/// acts at the pivot corner. Per-contact history: the relative rolling angle [rad].
+struct RollingGrainShape {
+    enum class Inertia {
+        Sphere,  ///< the store's moments (solid sphere unless set)
+        SeedEq12 ///< J_k = (1/9) pi rho r^3 (r / A_k)^2, seed eq. 12
+    };
+    Vec3 aspect_ratio_angle_deg = Vec3::Constant(30.0); ///< gamma_k per local axis, in (0, 90)
+    Inertia inertia = Inertia::Sphere;
+    // Derived by derive(): per local axis.
+    Vec3 gamma_rad = Vec3::Zero();
+    Vec3 tan_gamma = Vec3::Zero();
+    Vec3 elastic_slope = Vec3::Zero(); ///< tan^2(gamma_k) / 2: face-regime slope times delta/a
+    void validate() const;
+    void derive();
+};
+using RollingModel = std::variant<RollingNone, RollingEpsd, RollingGrainShape>;
+
+/// Principal moments of seed eq. 12 for a grain of radius r and density rho [kg m^2].
+Vec3 grainShapeInertia(const RollingGrainShape &model, double radius_m, double density_kg_m3);
 
 // ---- cohesion slot ---------------------------------------------------------------------------
 struct CohesionNone {
@@ -116,8 +137,10 @@ PairProperties pairProperties(const Material &a, const Material &b, const Contac
 /// Per-contact memory that survives neighbour-list rebuilds and re-sorts.
 struct ContactHistory {
     Vec3 tangential_m = Vec3::Zero(); ///< accumulated tangential displacement of i rel. to j
-    Vec3 rolling_N_m = Vec3::Zero();  ///< elastic rolling moment on i
-    bool sliding = false;             ///< two-angle Coulomb state (seed eq. 5)
+    /// Rolling slot's memory: EPSD's elastic rolling moment on i [N m]; grain_shape's relative
+    /// rolling angle of i to j, integral of (omega_i - omega_j) in the contact plane [rad].
+    Vec3 rolling_N_m = Vec3::Zero();
+    bool sliding = false; ///< two-angle Coulomb state (seed eq. 5)
     bool active() const { return sliding || !tangential_m.isZero() || !rolling_N_m.isZero(); }
     /// The same contact seen from the other particle.
     ContactHistory reversed() const { return {-tangential_m, -rolling_N_m, sliding}; }

@@ -50,7 +50,7 @@ public:
     /// Sets the build counter (it schedules re-sorts), e.g. to continue a checkpointed run.
     void restoreBuildCount(std::uint64_t count) { builds_ = count; }
 
-    /// Keeps the rolling moment per entry (only the EPSD rolling model needs it); set before
+    /// Keeps the rolling slot's history per entry (EPSD and grain_shape need it); set before
     /// the first build.
     void keepRollingHistory(bool keep) { keep_rolling_ = keep; }
     bool keepsRollingHistory() const { return keep_rolling_; }
@@ -65,7 +65,7 @@ public:
     std::vector<int> neighbour;
     std::vector<std::uint8_t> state; ///< kTouching | kSliding; 0 for pairs that do not touch
     std::vector<Vec3> tangential_m;  ///< accumulated tangential displacement of i rel. to j [m]
-    std::vector<Vec3> rolling_N_m;   ///< elastic rolling moment on i [N m]; empty unless kept
+    std::vector<Vec3> rolling_N_m;   ///< rolling history (ContactHistory); empty unless kept
 
     /// History of entry k as one value, and back (sets kTouching).
     ContactHistory history(std::size_t k) const {
