@@ -131,13 +131,6 @@ struct Coordinator::Impl {
     std::vector<BodyState> resumed_states;                ///< from the checkpoint, if resuming
     std::vector<Wrench> resumed_wrenches;
     std::unique_ptr<CouplingSeries> series;
-    struct PendingRow {
-        CouplingSeries::Row row;
-        std::vector<BodyState> states;
-        std::vector<Wrench> wrenches;
-    };
-    PendingRow pending_row;   ///< the last window, not yet in coupling.csv (storage reused)
-    bool row_pending = false; ///< pending_row holds a row to write
     std::string completed_by; ///< the participant that declared the experiment complete
     const std::string heartbeat_bytes = [] {
         pb::Envelope e;
@@ -156,18 +149,10 @@ struct Coordinator::Impl {
                " (t = " + formatSeconds(tick * config.tick_s) + " s)";
     }
 
-    void writePendingRow() {
-        if (series && row_pending) {
-            series->append(pending_row.row, pending_row.states, pending_row.wrenches);
-            row_pending = false;
-        }
-    }
-
     /// Stops every participant, then throws the one line that names who failed and why.
     [[noreturn]] void fail(const std::string &who, const std::string &why) {
         const std::string message = who + " failed " + where() + ": " + why;
         shutdownAll(true, message);
-        writePendingRow();
         if (series)
             series->flush();
         throw CouplingError(message);
@@ -614,7 +599,6 @@ struct Coordinator::Impl {
                     send(p, e);
                     pending.insert(p);
                 }
-            writePendingRow();
             received_states.clear();
             received_wrenches.clear();
             double mb_work = 0.0, soil_work = 0.0;
@@ -744,7 +728,6 @@ struct Coordinator::Impl {
         codec::toWire(scheme->states(), tick, state.mutable_states());
         codec::toWire(scheme->wrenches(), tick, tick, state.mutable_wrenches());
         state.set_cumulative_mismatch_j(cumulative_mismatch_J);
-        writePendingRow();
         series->flush();
         writeAtomically((fs::path(directory) / "coordinator.pb").string(),
                         state.SerializeAsString());
@@ -960,12 +943,7 @@ CoordinatorSummary Coordinator::run() {
             row.work_soil_J = work_soil;
             row.cumulative_mismatch_J = s.cumulative_mismatch_J;
             row.wall_s = sockets::secondsSince(window_started);
-            // Written once the next window's inputs are out (or at the end, a checkpoint, a
-            // failure): the formatting then overlaps the participants' work.
-            s.pending_row.row = row;
-            s.pending_row.states = s.scheme->states(); // assigned: keeps the vectors' storage
-            s.pending_row.wrenches = s.scheme->wrenches();
-            s.row_pending = true;
+            s.series->append(row, s.scheme->states(), s.scheme->wrenches()); // queued, cheap
         }
         s.tick += step;
         ++s.window;
@@ -995,7 +973,6 @@ CoordinatorSummary Coordinator::run() {
     s.shutdownAll(false, s.completed_by.empty()
                              ? "the run reached its end time"
                              : "participant '" + s.completed_by + "' completed its experiment");
-    s.writePendingRow();
     if (s.series)
         s.series->flush();
     summary.end_time_s = s.tick * c.tick_s;

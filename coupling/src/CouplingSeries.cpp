@@ -26,8 +26,7 @@ std::string header(const std::vector<std::string> &bodies) {
 
 CouplingSeries::CouplingSeries(const std::string &directory, const std::vector<std::string> &bodies,
                                std::optional<std::uint64_t> resume_window)
-    : path_((fs::path(directory) / "coupling.csv").string()),
-      last_flush_(std::chrono::steady_clock::now()) {
+    : path_((fs::path(directory) / "coupling.csv").string()) {
     fs::create_directories(directory);
     const std::string expected_header = header(bodies);
     std::vector<std::string> kept;
@@ -50,60 +49,105 @@ CouplingSeries::CouplingSeries(const std::string &directory, const std::vector<s
     for (const auto &line : kept)
         std::fprintf(file_, "%s\n", line.c_str());
     std::fflush(file_);
+    writer_ = std::thread([this] { writerLoop(); });
 }
 
 CouplingSeries::~CouplingSeries() {
-    if (file_)
-        std::fclose(file_);
+    {
+        std::lock_guard lock(queue_mutex_);
+        stop_ = true;
+    }
+    wake_.notify_one();
+    writer_.join();
+    writeQueued();
+    std::fclose(file_);
 }
 
 void CouplingSeries::append(const Row &row, const std::vector<BodyState> &states,
                             const std::vector<Wrench> &wrenches) {
-    // Shortest round-trip text (std::to_chars) into one reused buffer, one fwrite: the row is
-    // written every window, so it must cost microseconds, not tens of them.
-    line_.clear();
-    auto put = [this](auto value) {
-        char text[32];
-        const auto end = std::to_chars(text, text + sizeof text, value).ptr;
-        line_.append(text, end);
-        line_.push_back(',');
-    };
-    put(row.window);
-    put(row.start_s);
-    put(row.end_s);
-    put(row.end_s - row.start_s);
-    put(row.iterations);
-    put(row.residual);
-    put(row.work_multibody_J);
-    put(row.work_soil_J);
-    put(row.work_multibody_J - row.work_soil_J);
-    put(row.cumulative_mismatch_J);
-    put(row.wall_s);
-    for (std::size_t b = 0; b < states.size(); ++b) {
-        const auto &s = states[b];
-        const auto &w = wrenches[b];
-        for (const Vec3 *v : {&s.position_m})
-            for (int k = 0; k < 3; ++k)
-                put((*v)[k]);
-        put(s.orientation.w());
-        put(s.orientation.x());
-        put(s.orientation.y());
-        put(s.orientation.z());
-        for (const Vec3 *v :
-             {&s.linear_velocity_m_s, &s.angular_velocity_rad_s, &w.force_N, &w.torque_N_m})
-            for (int k = 0; k < 3; ++k)
-                put((*v)[k]);
+    // Copies into reused storage under an uncontended lock, and no wake-up call: the writer
+    // looks by itself every 0.1 s.
+    std::lock_guard lock(queue_mutex_);
+    if (spare_.empty())
+        queued_.emplace_back();
+    else {
+        queued_.push_back(std::move(spare_.back()));
+        spare_.pop_back();
     }
-    line_.back() = '\n';
-    std::fwrite(line_.data(), 1, line_.size(), file_);
-    const auto now = std::chrono::steady_clock::now();
-    if (now - last_flush_ > std::chrono::milliseconds(500))
-        flush();
+    Entry &e = queued_.back();
+    e.row = row;
+    e.states.assign(states.begin(), states.end());
+    e.wrenches.assign(wrenches.begin(), wrenches.end());
 }
 
 void CouplingSeries::flush() {
+    writeQueued();
+}
+
+void CouplingSeries::writerLoop() {
+    std::unique_lock lock(queue_mutex_);
+    while (!stop_) {
+        wake_.wait_for(lock, std::chrono::milliseconds(100));
+        lock.unlock();
+        writeQueued();
+        lock.lock();
+    }
+}
+
+void CouplingSeries::writeQueued() {
+    std::lock_guard write_lock(write_mutex_);
+    {
+        std::lock_guard lock(queue_mutex_);
+        writing_.swap(queued_);
+    }
+    if (writing_.empty())
+        return;
+    for (const Entry &e : writing_) {
+        const Row &row = e.row;
+        const auto &states = e.states;
+        const auto &wrenches = e.wrenches;
+        // Shortest round-trip text (std::to_chars) into one reused buffer, one fwrite per row.
+        line_.clear();
+        auto put = [this](auto value) {
+            char text[32];
+            const auto end = std::to_chars(text, text + sizeof text, value).ptr;
+            line_.append(text, end);
+            line_.push_back(',');
+        };
+        put(row.window);
+        put(row.start_s);
+        put(row.end_s);
+        put(row.end_s - row.start_s);
+        put(row.iterations);
+        put(row.residual);
+        put(row.work_multibody_J);
+        put(row.work_soil_J);
+        put(row.work_multibody_J - row.work_soil_J);
+        put(row.cumulative_mismatch_J);
+        put(row.wall_s);
+        for (std::size_t b = 0; b < states.size(); ++b) {
+            const auto &s = states[b];
+            const auto &w = wrenches[b];
+            for (const Vec3 *v : {&s.position_m})
+                for (int k = 0; k < 3; ++k)
+                    put((*v)[k]);
+            put(s.orientation.w());
+            put(s.orientation.x());
+            put(s.orientation.y());
+            put(s.orientation.z());
+            for (const Vec3 *v :
+                 {&s.linear_velocity_m_s, &s.angular_velocity_rad_s, &w.force_N, &w.torque_N_m})
+                for (int k = 0; k < 3; ++k)
+                    put((*v)[k]);
+        }
+        line_.back() = '\n';
+        std::fwrite(line_.data(), 1, line_.size(), file_);
+    }
     std::fflush(file_);
-    last_flush_ = std::chrono::steady_clock::now();
+    std::lock_guard lock(queue_mutex_);
+    for (auto &e : writing_)
+        spare_.push_back(std::move(e));
+    writing_.clear();
 }
 
 } // namespace grainlink::coupling

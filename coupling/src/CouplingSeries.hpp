@@ -1,13 +1,18 @@
 #pragma once
 // coupling.csv: one row per accepted window with the coupling's health (iterations, residual,
-// energy mismatch) and every body's state and wrench. Rows reach the disk at most 0.5 s after
-// their window, and at every checkpoint; a resumed run drops the rows after its checkpoint.
+// energy mismatch) and every body's state and wrench. append() only queues the numbers; a writer
+// thread formats and writes them every 0.1 s, off the window's critical path (formatting ~125
+// numbers costs ~10 us, a tenth of a window's coupling latency). flush() writes everything queued
+// before it returns (checkpoints, failures, the end); a resumed run drops the rows after its
+// checkpoint.
 #include "grainlink/coupling/Types.hpp"
 
-#include <chrono>
+#include <condition_variable>
 #include <cstdio>
+#include <mutex>
 #include <optional>
 #include <string>
+#include <thread>
 #include <vector>
 
 namespace grainlink::coupling {
@@ -36,10 +41,24 @@ public:
     void flush();
 
 private:
+    struct Entry {
+        Row row;
+        std::vector<BodyState> states;
+        std::vector<Wrench> wrenches;
+    };
+    void writeQueued();
+    void writerLoop();
+
     std::string path_;
     std::FILE *file_ = nullptr;
-    std::string line_; ///< reused row buffer
-    std::chrono::steady_clock::time_point last_flush_;
+    std::mutex queue_mutex_;            ///< guards queued_, spare_, stop_
+    std::vector<Entry> queued_, spare_; ///< spare_: written entries, storage kept for reuse
+    bool stop_ = false;
+    std::condition_variable wake_;
+    std::mutex write_mutex_;     ///< one writer at a time: rows stay in order
+    std::vector<Entry> writing_; ///< under write_mutex_
+    std::string line_;           ///< reused row buffer, under write_mutex_
+    std::thread writer_;
 };
 
 } // namespace grainlink::coupling
