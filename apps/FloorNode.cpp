@@ -18,6 +18,7 @@ int runFloorNode(const NodeOptions &options) {
 
     coupling::ParticipantConfig config;
     config.name = options.name;
+    config.handshake_timeout_s = handshakeTimeout(root);
     config.role = coupling::Role::Soil;
     config.endpoint = options.endpoint;
     config.consumes = options.bodies;

@@ -16,8 +16,10 @@ namespace grainlink::apps {
 namespace {
 
 coupling::ParticipantConfig participantConfig(const NodeOptions &options,
+                                              const config::ConfigNode &root,
                                               const mbs::MultibodyModel &model) {
     coupling::ParticipantConfig config;
+    config.handshake_timeout_s = handshakeTimeout(root);
     config.name = options.name;
     config.role = coupling::Role::Multibody;
     config.endpoint = options.endpoint;
@@ -39,7 +41,7 @@ int runRig(const config::ConfigNode &root, const NodeOptions &options) {
     const auto test_node = root.optional("wheel_test");
     mbs::WheelTest test(test_node ? mbs::parseWheelTest(*test_node) : mbs::WheelTestSettings{});
     const std::string body = rig.coupledBodies()[0].name;
-    coupling::Participant participant(participantConfig(options, rig));
+    coupling::Participant participant(participantConfig(options, root, rig));
     const auto &run = participant.initialize();
     if (run.restore)
         rig.readCheckpoint(run.restore->checkpoint_directory + "/rig.txt");
@@ -99,8 +101,9 @@ int runRig(const config::ConfigNode &root, const NodeOptions &options) {
 
 /// Any other model: advance window by window to the end time, forwarding the model's hint for
 /// the next macro step (the mole asks for small ones around its impacts).
-int runModel(mbs::MultibodyModel &model, const NodeOptions &options) {
-    coupling::Participant participant(participantConfig(options, model));
+int runModel(const config::ConfigNode &root, mbs::MultibodyModel &model,
+             const NodeOptions &options) {
+    coupling::Participant participant(participantConfig(options, root, model));
     const auto &run = participant.initialize();
     if (run.restore)
         model.readCheckpoint(run.restore->checkpoint_directory + "/model.txt");
@@ -179,7 +182,7 @@ int runMultibodyNode(const NodeOptions &options) {
     if (root.has("rig"))
         return runRig(root, options);
     const auto model = makeModel(root, options.scenario_path);
-    return runModel(*model, options);
+    return runModel(root, *model, options);
 }
 
 } // namespace grainlink::apps

@@ -21,6 +21,16 @@ struct NodeOptions {
     double progress_interval_s = 10.0;
 };
 
+/// How long a node waits for the coordinator's Welcome: the scenario's
+/// `coupling.handshake_timeout_s` (the coordinator waits as long for every node to join, e.g.
+/// while the soil node deposits a large bed the first time), else 120 s.
+inline double handshakeTimeout(const config::ConfigNode &root) {
+    const auto coupling = root.optional("coupling");
+    return coupling && coupling->has("handshake_timeout_s")
+               ? (*coupling)["handshake_timeout_s"].positive()
+               : 120.0;
+}
+
 /// `grainlink mbs-node`: the multibody participant: the single-wheel rig (section `rig:`) with
 /// its test procedure (`wheel_test:`), or the model `makeModel` finds in the scenario.
 int runMultibodyNode(const NodeOptions &options);

@@ -29,6 +29,7 @@ int runSoilNode(const NodeOptions &options) {
 
     coupling::ParticipantConfig config;
     config.name = options.name;
+    config.handshake_timeout_s = handshakeTimeout(root);
     config.role = coupling::Role::Soil;
     config.endpoint = options.endpoint;
     config.consumes = options.bodies;
