@@ -161,6 +161,10 @@ BevameterResult runBevameter(const BevameterScenario &scenario, const BevameterO
         dem::RigidBodyState initial;
         initial.position_m = Vec3(centre.x(), centre.y(), highest + t.start_clearance_m);
         initial.velocity_m_s = Vec3(0.0, 0.0, -t.speed_m_s);
+        std::fprintf(stderr,
+                     "[bevameter] R = %s: bed surface %.5f m, highest grain under the plate "
+                     "%.5f m, plate starts at %.5f m\n",
+                     mm(radius).c_str(), surface, highest, initial.position_m.z());
         dem::MeshBody plate("plate", plateMesh(radius, thickness, t.plate_segments), initial);
         plate.friction_coefficient = t.plate_friction_coefficient;
         const double t0 = sys.time();
