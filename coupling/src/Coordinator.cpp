@@ -699,6 +699,9 @@ struct Coordinator::Impl {
             step =
                 hint_ticks != std::numeric_limits<Ticks>::max() ? hint_ticks : nominal_step_ticks;
             step = std::clamp(step, min_step_ticks, max_step_ticks);
+            // Whole multiples of the smallest step: a participant with a fixed internal step
+            // (the DEM's, when min_macro_step_s is it) takes every window in whole steps.
+            step -= step % min_step_ticks;
         }
         hint_ticks = std::numeric_limits<Ticks>::max();
         return std::min(step, end_tick - tick);

@@ -69,7 +69,7 @@ TEST_CASE("Adaptive stepping follows the smallest hint and lands on the end tick
     // (0 .. 0.11 s; the hint of the window starting at 0.1 s applies from 0.11 s), then 2.5 ms
     // windows while the hints last: 0.11 .. 0.2025 s is 37 windows, then back to 10 ms.
     auto config = twoMassRun(SchemeKind::ExplicitSerial, "inproc://adaptive", 0.01, 0.5);
-    config.min_macro_step_s = 0.001;
+    config.min_macro_step_s = 0.0005; // 2.5 ms is a whole multiple: taken as asked
     config.max_macro_step_s = 0.01;
     const std::string out = (std::filesystem::temp_directory_path() /
                              ("grainlink-adaptive-" + std::to_string(::getpid())))
@@ -97,6 +97,26 @@ TEST_CASE("Adaptive stepping follows the smallest hint and lands on the end tick
     CHECK_THAT(last, Catch::StartsWith("77,0.4925"));
     CHECK_THAT(last, Catch::Contains(",0.5,0.0074999"));
     std::filesystem::remove_all(out);
+}
+
+TEST_CASE("Adaptive steps are whole multiples of the smallest step", "[coupling][coordinator]") {
+    // As above, but min_macro_step_s = 1 ms: the 2.5 ms hint becomes 2 ms windows, so that a
+    // DEM participant stepping 1 ms (or any divisor) takes each window in whole steps. The
+    // hinting windows start at 0.11 .. 0.198 s (45) plus the one they shape after them: 46 windows
+    // of 2 ms to 0.202 s, then 10 ms windows to 0.492 s (29) and a last 8 ms one.
+    auto config = twoMassRun(SchemeKind::ExplicitSerial, "inproc://adaptive-whole", 0.01, 0.5);
+    config.min_macro_step_s = 0.001;
+    config.max_macro_step_s = 0.01;
+    Coordinator coordinator(config);
+    grainlink::examples::SideHooks hooks;
+    hooks.suggest_step_s = [](double t) { return t >= 0.1 - 1e-12 && t < 0.2 ? 0.0025 : 0.0; };
+    auto mbs = startSide(Role::Multibody, coordinator.boundEndpoint());
+    auto soil = startSide(Role::Soil, coordinator.boundEndpoint(), hooks);
+    const auto summary = coordinator.run();
+    mbs.get();
+    soil.get();
+    CHECK(summary.end_time_s == 0.5);
+    CHECK(summary.windows == 11 + 46 + 29 + 1);
 }
 
 TEST_CASE("A failed run resumes from its last checkpoint and ends as if never stopped",
