@@ -323,6 +323,41 @@ TEST_CASE("Rocker-bogie: driven wheels hold their speed and climb a slope", "[mb
     CHECK(rover.chassisState().linear_velocity_m_s.x() == Approx(r - creep).epsilon(1e-3));
 }
 
+TEST_CASE("Rocker-bogie: torque-driven wheels accelerate the rover up the slope", "[mbs][rover]") {
+    // The slope of the test above, reached at steady speed with the speed drive; then torque
+    // drive with each wheel's steady motor torque plus 10 % of the total shared equally.
+    const double alpha = 10.0 * SimTK::Pi / 180.0, g = 3.71;
+    auto settings = resting();
+    settings.rotation_locked = false;
+    settings.gravity_m_s2 = Vec3(-g * std::sin(alpha), 0.0, -g * std::cos(alpha));
+    settings.wheel_speeds_rad_s.fill(1.0);
+    RockerBogie rover(settings);
+    PenaltyGround ground;
+    ground.friction_coefficient = 0.6;
+    ground.run(rover, 0.8);
+    const double r = rover.wheelRadius_m();
+    const double total = rover.totalMass_kg() * g * std::sin(alpha) * r;
+    std::array<double, 6> torques{};
+    auto o = rover.observables();
+    for (int i = 0; i < 6; ++i)
+        torques[i] = o.at("wheel_" + RockerBogie::wheelSuffixes()[i] + "_motor_torque_N_m") +
+                     0.1 * total / 6;
+    rover.setDriveTorques(torques);
+    o = rover.observables();
+    CHECK(o.at("wheel_lf_motor_torque_N_m") == torques[0]);
+    ground.run(rover, 1.0); // let the slip settle at the new traction
+    const double v0 = rover.chassisState().linear_velocity_m_s.x();
+    const double w0 = rover.observables().at("wheel_rm_omega_rad_s");
+    ground.run(rover, 1.3);
+    // Wheel spin I ω̇ = τ - F_t r and M a = Σ F_t - M g sin α with ω̇ r = a (steady slip):
+    // a = (Σ Δτ / r) / (M + 6 I / r²), the thin-ring wheels adding 6 m_w = 18 kg.
+    // Tolerance 1e-3: the slip settles at the rate (Σ μ N / v_reg) / M ≈ 400 /s, long before.
+    const double a = 0.1 * total / r / (rover.totalMass_kg() + 6 * settings.wheel_mass_kg);
+    CHECK((rover.chassisState().linear_velocity_m_s.x() - v0) / 0.3 == Approx(a).epsilon(1e-3));
+    CHECK((rover.observables().at("wheel_rm_omega_rad_s") - w0) / 0.3 ==
+          Approx(a / r).epsilon(1e-3));
+}
+
 TEST_CASE("Rocker-bogie: save/restore and checkpoints continue identically", "[mbs][rover]") {
     auto settings = resting();
     RockerBogie rover(settings);
