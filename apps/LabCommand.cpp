@@ -2,6 +2,7 @@
 #include "LabCommands.hpp"
 
 #include "grainlink/lab/Bevameter.hpp"
+#include "grainlink/lab/Repose.hpp"
 
 #include <cstdio>
 #include <stdexcept>
@@ -9,20 +10,33 @@
 namespace grainlink::apps {
 
 int runLab(const LabOptions &options) {
-    if (options.test != "bevameter")
-        throw std::invalid_argument("lab test '" + options.test +
-                                    "' is not implemented; available: bevameter");
-    const auto scenario = lab::loadBevameter(options.scenario_path);
-    lab::BevameterOptions run;
-    run.output_directory =
-        options.output_directory.empty() ? "out/" + scenario.name : options.output_directory;
-    run.progress_interval_s = options.progress_interval_s;
-    const auto result = lab::runBevameter(scenario, run);
-    std::printf("%s", result.report().c_str());
-    std::printf("written: %s/{pressure_sinkage.csv,bekker_fit.csv,report.txt}; plot with "
-                "tools/plot_lab.py %s\n",
-                run.output_directory.c_str(), run.output_directory.c_str());
-    return 0;
+    if (options.test == "bevameter") {
+        const auto scenario = lab::loadBevameter(options.scenario_path);
+        lab::BevameterOptions run;
+        run.output_directory =
+            options.output_directory.empty() ? "out/" + scenario.name : options.output_directory;
+        run.progress_interval_s = options.progress_interval_s;
+        const auto result = lab::runBevameter(scenario, run);
+        std::printf("%s", result.report().c_str());
+        std::printf("written: %s/{pressure_sinkage.csv,bekker_fit.csv,report.txt}; plot with "
+                    "tools/plot_lab.py %s\n",
+                    run.output_directory.c_str(), run.output_directory.c_str());
+        return 0;
+    }
+    if (options.test == "repose") {
+        const auto scenario = lab::loadRepose(options.scenario_path);
+        lab::ReposeOptions run;
+        run.output_directory =
+            options.output_directory.empty() ? "out/" + scenario.name : options.output_directory;
+        run.progress_interval_s = options.progress_interval_s;
+        const auto result = lab::runRepose(scenario, run);
+        std::printf("%s", result.report().c_str());
+        std::printf("written: %s/{heap_profile.csv,report.txt}; plot with tools/plot_lab.py %s\n",
+                    run.output_directory.c_str(), run.output_directory.c_str());
+        return 0;
+    }
+    throw std::invalid_argument("lab test '" + options.test +
+                                "' is not implemented; available: bevameter, repose");
 }
 
 } // namespace grainlink::apps

@@ -12,7 +12,7 @@ struct ParamsOptions {
 int runParams(const ParamsOptions &options);
 
 struct LabOptions {
-    std::string test; ///< "bevameter"
+    std::string test; ///< "bevameter" or "repose"
     std::string scenario_path;
     std::string output_directory; ///< empty: out/<scenario name>
     double progress_interval_s = 5.0;

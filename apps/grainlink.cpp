@@ -69,9 +69,9 @@ int main(int argc, char **argv) {
 
     grainlink::apps::LabOptions lab_options;
     auto *lab = app.add_subcommand("lab", "virtual soil laboratory test (docs/lab.md)");
-    lab->add_option("test", lab_options.test, "the test: bevameter")
+    lab->add_option("test", lab_options.test, "the test: bevameter or repose")
         ->required()
-        ->check(CLI::IsMember({"bevameter"}));
+        ->check(CLI::IsMember({"bevameter", "repose"}));
     lab->add_option("scenario", lab_options.scenario_path, "lab scenario YAML")->required();
     lab->add_option("--out", lab_options.output_directory, "output directory (default out/<name>)");
     lab->add_option("--progress-interval", lab_options.progress_interval_s,

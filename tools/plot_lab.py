@@ -1,12 +1,17 @@
 #!/usr/bin/python3
-"""Plots a virtual bevameter run (grainlink lab bevameter SCENARIO --out RUN_DIR): the measured
-p(z) of every plate and Bekker's fitted p = (k_c/b + k_phi) z^n over it, with the fit's values
-and 95 % intervals in the legend. Reads RUN_DIR/pressure_sinkage.csv and RUN_DIR/bekker_fit.csv.
+"""Plots a virtual lab run (grainlink lab TEST SCENARIO --out RUN_DIR).
 
-Usage: tools/plot_lab.py RUN_DIR   -> RUN_DIR/bevameter.png
+bevameter: the measured p(z) of every plate and Bekker's fitted p = (k_c/b + k_phi) z^n over it,
+with the fit's values and 95 % intervals (RUN_DIR/pressure_sinkage.csv, bekker_fit.csv)
+-> RUN_DIR/bevameter.png.
+repose: the heap profile (highest grain top per radial bin, RUN_DIR/heap_profile.csv) with the
+angle from RUN_DIR/report.txt -> RUN_DIR/repose.png.
+
+Usage: tools/plot_lab.py RUN_DIR
 Runs under Debian's /usr/bin/python3 (python3-matplotlib).
 """
 import csv
+import os
 import sys
 
 import matplotlib
@@ -20,10 +25,32 @@ def read(path):
         return list(csv.DictReader(f))
 
 
+def repose(run_dir):
+    rows = read(f"{run_dir}/heap_profile.csv")
+    with open(f"{run_dir}/report.txt") as f:
+        angle = next((l.strip() for l in f if "angle of repose" in l), "")
+    r = [1e3 * float(x["radius_m"]) for x in rows]
+    h = [1e3 * float(x["height_m"]) for x in rows]
+    fig, ax = plt.subplots(figsize=(7, 4))
+    ax.step(r, h, where="mid", label="highest grain top per radial bin")
+    ax.set_xlabel("distance from the tube axis [mm]")
+    ax.set_ylabel("heap height [mm]")
+    ax.set_aspect("equal")
+    ax.grid(alpha=0.3)
+    ax.set_title(angle, fontsize=9)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    out = f"{run_dir}/repose.png"
+    fig.savefig(out, dpi=120)
+    print(f"wrote {out}")
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit(__doc__)
     run_dir = sys.argv[1]
+    if os.path.exists(f"{run_dir}/heap_profile.csv"):
+        return repose(run_dir)
     rows = read(f"{run_dir}/pressure_sinkage.csv")
     if not rows:
         sys.exit(f"{run_dir}/pressure_sinkage.csv is empty")

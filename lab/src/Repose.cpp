@@ -1,0 +1,265 @@
+#include "grainlink/lab/Repose.hpp"
+
+#include "grainlink/dem/Deposition.hpp"
+#include "grainlink/dem/Progress.hpp"
+#include "grainlink/lab/BekkerFit.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+namespace grainlink::lab {
+
+namespace fs = std::filesystem;
+using dem::Vec3;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+/// Open tube (side wall only) of radius R and height H about the body z axis, bottom at z = 0.
+/// Mesh contacts are two-sided, so grains inside touch it.
+dem::TriangleMesh tubeMesh(double radius_m, double height_m, int segments) {
+    dem::TriangleMesh mesh;
+    for (int k = 0; k < segments; ++k) {
+        const double a = 2.0 * kPi * k / segments;
+        mesh.vertices_m.emplace_back(radius_m * std::cos(a), radius_m * std::sin(a), 0.0);
+        mesh.vertices_m.emplace_back(radius_m * std::cos(a), radius_m * std::sin(a), height_m);
+    }
+    for (int k = 0; k < segments; ++k) {
+        const int b0 = 2 * k, t0 = b0 + 1, b1 = 2 * ((k + 1) % segments), t1 = b1 + 1;
+        mesh.triangles.push_back({b0, t1, b1}); // normals towards the axis, where the grains are
+        mesh.triangles.push_back({b0, t0, t1});
+    }
+    return mesh;
+}
+
+double meanKineticEnergy(const dem::DemSystem &sys) {
+    const auto e = sys.energies();
+    return (e.translational_J + e.rotational_J) /
+           double(std::max<std::size_t>(1, sys.particles().size()));
+}
+
+} // namespace
+
+ReposeScenario parseRepose(const config::ConfigNode &root) {
+    ReposeScenario s;
+    s.name = root["name"].text();
+    s.soil = dem::parseScenario(root["soil"], true);
+    const auto r = root["repose"];
+    ReposeSpec &t = s.test;
+    t.tube_radius_m = r["tube_radius_m"].positive();
+    t.tube_height_m = r["tube_height_m"].positive();
+    if (r.has("tube_segments")) {
+        t.tube_segments = int(r["tube_segments"].integer());
+        if (t.tube_segments < 8)
+            r["tube_segments"].fail("must be >= 8");
+    }
+    t.lift_speed_m_s = r["lift_speed_m_s"].positive();
+    if (r.has("settle_kinetic_energy_J"))
+        t.settle_kinetic_energy_J = r["settle_kinetic_energy_J"].positive();
+    if (r.has("max_settle_time_s"))
+        t.max_settle_time_s = r["max_settle_time_s"].positive();
+    if (r.has("bin_width_m"))
+        t.bin_width_m = r["bin_width_m"].positive();
+    if (auto c = r.optional("centre_m")) {
+        const auto xy = c->numbers();
+        if (xy.size() != 2)
+            c->fail("expected [x, y]");
+        t.centre_m = Eigen::Vector2d(xy[0], xy[1]);
+    }
+    r.finish();
+    if (!s.soil.bodies.empty())
+        root["soil"]["bodies"].fail("the repose test adds its own tube; remove soil.bodies");
+
+    // The grains are inserted inside the tube: every corner of the region must be.
+    const auto &d = s.soil.deposition;
+    const Eigen::Vector2d centre =
+        t.centre_m.value_or(Eigen::Vector2d(0.5 * (d.region_lower_m.x() + d.region_upper_m.x()),
+                                            0.5 * (d.region_lower_m.y() + d.region_upper_m.y())));
+    double far = 0.0;
+    for (double x : {d.region_lower_m.x(), d.region_upper_m.x()})
+        for (double y : {d.region_lower_m.y(), d.region_upper_m.y()})
+            far = std::max(far, std::hypot(x - centre.x(), y - centre.y()));
+    if (far > t.tube_radius_m || d.region_upper_m.z() - d.region_lower_m.z() > t.tube_height_m) {
+        std::ostringstream msg;
+        msg << "the deposition region reaches " << far << " m from the tube axis and "
+            << d.region_upper_m.z() - d.region_lower_m.z()
+            << " m high: it must lie inside the tube (radius " << t.tube_radius_m << " m, height "
+            << t.tube_height_m << " m)";
+        r["tube_radius_m"].fail(msg.str());
+    }
+    root.finish();
+    return s;
+}
+
+ReposeScenario loadRepose(const std::string &path) {
+    return parseRepose(config::ConfigNode::loadFile(path));
+}
+
+void measureHeap(const std::vector<Eigen::Vector3d> &positions, const std::vector<double> &radii,
+                 const Eigen::Vector2d &centre, double bin_width, ReposeResult &result) {
+    double floor_z = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < positions.size(); ++i)
+        floor_z = std::min(floor_z, positions[i].z() - radii[i]);
+    std::vector<ProfileBin> bins;
+    for (std::size_t i = 0; i < positions.size(); ++i) {
+        const double rho = std::hypot(positions[i].x() - centre.x(), positions[i].y() - centre.y());
+        const auto k = std::size_t(rho / bin_width);
+        if (k >= bins.size())
+            bins.resize(k + 1);
+        bins[k].height_m = std::max(bins[k].height_m, positions[i].z() + radii[i] - floor_z);
+        ++bins[k].grains;
+    }
+    for (std::size_t k = 0; k < bins.size(); ++k)
+        bins[k].radius_m = (double(k) + 0.5) * bin_width;
+    result.profile = bins;
+    const auto top = std::max_element(bins.begin(), bins.end(), [](const auto &a, const auto &b) {
+        return a.height_m < b.height_m;
+    });
+    const double h = top == bins.end() ? 0.0 : top->height_m;
+    result.heap_height_m = h;
+    // Heap flank: from the top outwards, bins between 20 % and 80 % of the top height (apex and
+    // toe left out) and above one and a half grain diameters (the layer of single grains that
+    // rolled out is not heap), fitted by a straight line h = a + s rho. Angle = atan(-s).
+    const double r_max = radii.empty() ? 0.0 : *std::max_element(radii.begin(), radii.end());
+    const double lower = std::max(0.2 * h, 3.0 * r_max);
+    std::vector<double> x, y;
+    for (auto it = top; it != bins.end(); ++it)
+        if (it->height_m > lower && it->height_m < 0.8 * h) {
+            x.push_back(it->radius_m);
+            y.push_back(it->height_m);
+        }
+    result.flank_bins = x.size();
+    if (x.size() < 3)
+        throw std::runtime_error("repose: only " + std::to_string(x.size()) +
+                                 " profile bins on the heap's flank (need 3): the heap is too "
+                                 "small for the bin width " +
+                                 std::to_string(bin_width) + " m");
+    const double n = double(x.size());
+    double mx = 0.0, my = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        mx += x[i] / n;
+        my += y[i] / n;
+    }
+    double sxx = 0.0, sxy = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        sxx += (x[i] - mx) * (x[i] - mx);
+        sxy += (x[i] - mx) * (y[i] - my);
+    }
+    const double slope = sxy / sxx;
+    double rss = 0.0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        const double e = y[i] - (my + slope * (x[i] - mx));
+        rss += e * e;
+    }
+    const double se = std::sqrt(rss / (n - 2.0) / sxx);
+    result.angle_deg = std::atan(-slope) * 180.0 / kPi;
+    // d(atan s)/ds = 1 / (1 + s^2)
+    result.angle_half_width_95_deg =
+        studentT975(int(x.size()) - 2) * se / (1.0 + slope * slope) * 180.0 / kPi;
+}
+
+ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &options) {
+    const auto start = std::chrono::steady_clock::now();
+    const ReposeSpec &t = scenario.test;
+    const auto &d = scenario.soil.deposition;
+    const Eigen::Vector2d centre =
+        t.centre_m.value_or(Eigen::Vector2d(0.5 * (d.region_lower_m.x() + d.region_upper_m.x()),
+                                            0.5 * (d.region_lower_m.y() + d.region_upper_m.y())));
+    auto sys = dem::makeSystem(scenario.soil);
+    const double dt = sys->settings().time_step_s;
+
+    dem::RigidBodyState initial;
+    initial.position_m = Vec3(centre.x(), centre.y(), d.region_lower_m.z());
+    auto lift_start = std::make_shared<double>(std::numeric_limits<double>::infinity());
+    const double v = t.lift_speed_m_s;
+    sys->addBody(
+        dem::MeshBody("tube", tubeMesh(t.tube_radius_m, t.tube_height_m, t.tube_segments), initial),
+        [initial, lift_start, v](double time_s) {
+            dem::RigidBodyState s = initial;
+            if (time_s > *lift_start) {
+                s.position_m.z() += v * (time_s - *lift_start);
+                s.velocity_m_s = Vec3(0.0, 0.0, v);
+            }
+            return s;
+        });
+
+    // Fill the tube and let the column settle (the tube stands still meanwhile).
+    dem::Progress fill("repose fill", options.progress_interval_s);
+    const auto report = dem::deposit(*sys, d, [&](const dem::DepositionReport &r) {
+        fill.update(sys->time(), std::min(1.0, r.settle_time_s / d.max_settle_time_s),
+                    sys->stepCount() * sys->particles().size());
+    });
+    std::fprintf(stderr, "[repose] %zu grains settled in the tube (%.3f s simulated)\n",
+                 report.inserted, report.settle_time_s);
+
+    // Lift the tube by its own height: its bottom then clears any column it held.
+    *lift_start = sys->time();
+    const auto lift_steps = std::uint64_t(std::ceil(t.tube_height_m / (v * dt)));
+    dem::Progress lift("repose lift", options.progress_interval_s);
+    const std::uint64_t chunk = std::max<std::uint64_t>(1, std::llround(0.01 / dt));
+    for (std::uint64_t done = 0; done < lift_steps;) {
+        const std::uint64_t n = std::min(chunk, lift_steps - done);
+        sys->run(n);
+        done += n;
+        lift.update(sys->time(), double(done) / double(lift_steps), done * sys->particles().size());
+    }
+    // Let the heap come to rest.
+    ReposeResult result;
+    const double settle_start = sys->time();
+    while (true) {
+        sys->run(chunk);
+        result.final_kinetic_energy_per_grain_J = meanKineticEnergy(*sys);
+        result.settle_time_s = sys->time() - settle_start;
+        if (result.final_kinetic_energy_per_grain_J < t.settle_kinetic_energy_J) {
+            result.settled = true;
+            break;
+        }
+        if (result.settle_time_s >= t.max_settle_time_s)
+            break;
+    }
+
+    const auto &p = sys->particles();
+    result.particles = p.size();
+    result.largest_radius_m = d.radius.largest();
+    measureHeap(p.position, p.radius, centre,
+                t.bin_width_m > 0.0 ? t.bin_width_m : 2.0 * result.largest_radius_m, result);
+    result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!options.output_directory.empty())
+        writeReposeOutputs(result, options.output_directory);
+    return result;
+}
+
+std::string ReposeResult::report() const {
+    std::ostringstream out;
+    out << std::setprecision(4);
+    out << "Angle of repose (lifted cylinder)\n";
+    out << "  " << particles << " grains, largest radius " << largest_radius_m * 1e3 << " mm\n";
+    out << "  heap " << heap_height_m * 1e3 << " mm high; "
+        << (settled ? "settled" : "NOT settled (time limit)") << " " << settle_time_s
+        << " s after the lift, mean KE per grain " << final_kinetic_energy_per_grain_J << " J\n";
+    out << "  angle of repose " << angle_deg << " +- " << angle_half_width_95_deg
+        << " deg (95 %, slope regression over " << flank_bins << " flank bins)\n";
+    out << "  wall time " << wall_s << " s\n";
+    return out.str();
+}
+
+void writeReposeOutputs(const ReposeResult &result, const std::string &directory) {
+    fs::create_directories(directory);
+    std::ofstream csv(fs::path(directory) / "heap_profile.csv");
+    csv << "radius_m,height_m,grains\n" << std::setprecision(10);
+    for (const auto &b : result.profile)
+        csv << b.radius_m << ',' << b.height_m << ',' << b.grains << '\n';
+    std::ofstream(fs::path(directory) / "report.txt") << result.report();
+}
+
+} // namespace grainlink::lab
