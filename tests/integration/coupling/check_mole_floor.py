@@ -1,0 +1,28 @@
+#!/usr/bin/python3
+"""The mole on the rigid floor (mole_floor.yaml):
+- two strokes happened (stroke_count 2 at the end);
+- the coordinator followed the hints: the smallest windows are the mole's 50 µs impact step, the
+  largest its 1 ms cocking step (to 1e-12 s);
+- the floor's impulse on the hull over the whole run, divided by the run's length, is the mole's
+  weight 0.85 kg x 3.71 m/s^2 = 3.1535 N within 1 %: the hammer's internal forces cancel, the
+  mole ends near rest (measured 3.1524 N; the impacts throw the mole up to 19 mm high).
+Usage: check_mole_floor.py RUN_DIR"""
+import csv
+import sys
+
+run = sys.argv[1]
+rows = list(csv.DictReader(open(f"{run}/mbs.csv")))
+impulse, previous = 0.0, 0.0
+for r in rows:
+    t = float(r["time_s"])
+    impulse += float(r["mole_Fz_N"]) * (t - previous)
+    previous = t
+mean_force = impulse / previous
+steps = [float(r["macro_step_s"]) for r in csv.DictReader(open(f"{run}/coupling.csv"))]
+strokes = int(float(rows[-1]["stroke_count"]))
+print(f"strokes {strokes}, windows from {min(steps):.6g} s to {max(steps):.6g} s, mean floor "
+      f"force {mean_force:.4f} N (weight 3.1535 N)")
+ok = (strokes == 2 and abs(min(steps) - 5e-5) < 1e-12 and abs(max(steps) - 1e-3) < 1e-12
+      and abs(mean_force - 3.1535) <= 0.01 * 3.1535)
+print("ok" if ok else "FAILED")
+sys.exit(0 if ok else 1)
