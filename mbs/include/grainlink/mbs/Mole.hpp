@@ -11,8 +11,6 @@
 #include "grainlink/config/ConfigNode.hpp"
 #include "grainlink/mbs/SimbodyModel.hpp"
 
-#include <memory>
-
 namespace grainlink::mbs {
 
 struct MoleSettings {
