@@ -40,6 +40,26 @@ struct StopSignals {
     }
 };
 
+/// The bed sections the scenario's soil nodes read: `soil`, or what each `--section` names.
+std::vector<std::string> soilSections(const config::ConfigNode &root) {
+    std::vector<std::string> sections;
+    for (const auto &p : root["participants"].items()) {
+        if (!p.has("command"))
+            continue;
+        const auto words = p["command"].items();
+        bool soil_node = false;
+        std::string section = "soil";
+        for (std::size_t w = 0; w < words.size(); ++w) {
+            soil_node = soil_node || words[w].text() == "dem-node";
+            if (words[w].text() == "--section" && w + 1 < words.size())
+                section = words[w + 1].text();
+        }
+        if (soil_node)
+            sections.push_back(section);
+    }
+    return sections;
+}
+
 /// Whether a participant of the scenario runs `grainlink mbs-node`.
 bool hasSimbodyParticipant(const config::ConfigNode &root) {
     for (const auto &p : root["participants"].items())
@@ -54,8 +74,8 @@ CoordinatorConfig configFor(const CoupledRunOptions &options, const char *defaul
     // stops the run before any process starts.
     const auto root = config::ConfigNode::loadFile(options.config_path);
     CoordinatorConfig config = coupling::coordinatorConfigFrom(root);
-    if (const auto soil = root.optional("soil"))
-        dem::parseScenario(*soil, true);
+    for (const auto &section : soilSections(root))
+        dem::parseScenario(root[section], true);
     MirrorSymmetry::parse(root);
     if (const auto floor = root.optional("floor"))
         dem::parseRigidFloor(*floor);

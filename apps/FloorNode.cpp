@@ -16,14 +16,7 @@ int runFloorNode(const NodeOptions &options) {
     const auto root = config::ConfigNode::loadFile(options.scenario_path);
     const dem::RigidFloorSettings floor = dem::parseRigidFloor(root["floor"]);
 
-    coupling::ParticipantConfig config;
-    config.name = options.name;
-    config.handshake_timeout_s = handshakeTimeout(root);
-    config.role = coupling::Role::Soil;
-    config.endpoint = options.endpoint;
-    config.consumes = options.bodies;
-    if (!options.keys_directory.empty())
-        config.curve = coupling::loadClientKeys(options.keys_directory, options.name);
+    auto config = soilParticipantConfig(options, root);
     coupling::Participant participant(config);
     const auto &run = participant.initialize();
 

@@ -17,6 +17,7 @@ struct NodeOptions {
     std::string endpoint;
     std::string output_directory;
     std::vector<std::string> bodies; ///< soil node: the bodies it consumes
+    std::string section = "soil";    ///< soil node: the scenario section of its bed
     std::string keys_directory;      ///< CURVE keys (<name>.key, coordinator.pub)
     double progress_interval_s = 10.0;
 };

@@ -20,22 +20,21 @@ namespace grainlink::apps {
 
 int runSoilNode(const NodeOptions &options) {
     const auto root = config::ConfigNode::loadFile(options.scenario_path);
-    const dem::DemScenario scenario = dem::parseScenario(root["soil"], true);
+    const dem::DemScenario scenario = dem::parseScenario(root[options.section], true);
+    // Its files: soil.csv and snapshots/ for the usual single bed, named after the section when
+    // several soil nodes share a run.
+    const bool single = options.section == "soil";
+    const std::string series_name = options.section + ".csv";
+    const std::string snapshot_directory =
+        options.output_directory + (single ? "/snapshots" : "/snapshots_" + options.section);
     auto sys = dem::prepareSoil(scenario, options.progress_interval_s);
     const double surface = dem::bedSurface(sys->particles());
     const double dt = scenario.settings.time_step_s;
     std::fprintf(stderr, "[%s] %zu particles, bed surface at z = %.4f m\n", options.name.c_str(),
                  sys->particles().size(), surface);
 
-    coupling::ParticipantConfig config;
-    config.name = options.name;
-    config.handshake_timeout_s = handshakeTimeout(root);
-    config.role = coupling::Role::Soil;
-    config.endpoint = options.endpoint;
-    config.consumes = options.bodies;
+    auto config = soilParticipantConfig(options, root);
     config.capabilities.checkpoint = true;
-    if (!options.keys_directory.empty())
-        config.curve = coupling::loadClientKeys(options.keys_directory, options.name);
     coupling::Participant participant(config);
     const auto &run = participant.initialize();
     const auto mirror = MirrorSymmetry::parse(root);
@@ -54,7 +53,7 @@ int runSoilNode(const NodeOptions &options) {
     // Particle and wheel snapshots for ParaView (soil.output.snapshot_interval_s), at the first
     // window end past each multiple of the interval; their times are kept in the checkpoint.
     const double snapshot_interval_s = scenario.output.snapshot_interval_s;
-    dem::VtkWriter vtk(options.output_directory + "/snapshots");
+    dem::VtkWriter vtk(snapshot_directory);
     if (run.restore) {
         const auto extras =
             dem::readCheckpoint(*sys, run.restore->checkpoint_directory + "/soil.bin");
@@ -67,7 +66,7 @@ int runSoilNode(const NodeOptions &options) {
 
     std::filesystem::create_directories(options.output_directory);
     std::ofstream series =
-        openSeries(options.output_directory + "/soil.csv",
+        openSeries(options.output_directory + "/" + series_name,
                    "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts",
                    run.restore ? std::optional<double>(double(run.restore->tick) * run.tick_s)
                                : std::nullopt);
@@ -151,7 +150,7 @@ int runSoilNode(const NodeOptions &options) {
             }
             if (snapshot_interval_s > 0.0 &&
                 in.end_s >= snapshot_interval_s * double(vtk.count()) - 1e-12) {
-                std::filesystem::create_directories(options.output_directory + "/snapshots");
+                std::filesystem::create_directories(snapshot_directory);
                 vtk.write(*sys, in.end_s);
             }
             participant.writeOutputs(std::move(out));

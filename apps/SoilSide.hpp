@@ -2,6 +2,8 @@
 // What the soil-side participants (the DEM soil, the rigid floor) share: the mesh of a coupled
 // body from its handshake description, and the body's motion through a window, interpolated so
 // that position and velocity agree with the received states at both ends.
+#include "Nodes.hpp"
+#include "grainlink/coupling/Participant.hpp"
 #include "grainlink/coupling/Types.hpp"
 #include "grainlink/dem/Walls.hpp"
 #include "grainlink/dem/WheelMesh.hpp"
@@ -13,6 +15,20 @@
 #include <optional>
 
 namespace grainlink::apps {
+
+/// A soil-side participant of the scenario `root` consuming the node's `--bodies`.
+inline coupling::ParticipantConfig soilParticipantConfig(const NodeOptions &options,
+                                                         const config::ConfigNode &root) {
+    coupling::ParticipantConfig config;
+    config.name = options.name;
+    config.handshake_timeout_s = handshakeTimeout(root);
+    config.role = coupling::Role::Soil;
+    config.endpoint = options.endpoint;
+    config.consumes = options.bodies;
+    if (!options.keys_directory.empty())
+        config.curve = coupling::loadClientKeys(options.keys_directory, options.name);
+    return config;
+}
 
 /// The triangle mesh of a body as its provider described it (parametric wheel or mesh).
 inline dem::TriangleMesh meshOf(const coupling::BodyDescription &body, bool half = false) {

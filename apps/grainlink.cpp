@@ -97,6 +97,9 @@ int main(int argc, char **argv) {
         command->add_option("--bodies", node.bodies, "the coupled bodies it loads (comma separated)")
             ->delimiter(',')
             ->required();
+    dem_node->add_option("--section", node.section,
+                         "the scenario section of its bed (default soil; one per soil node when "
+                         "several share the bodies)");
 
     CLI11_PARSE(app, argc, argv);
     try {
