@@ -467,9 +467,10 @@ TEST_CASE("grain shape: a poured bed comes to rest and a checkpoint continues bi
     // restarts to round-off differences under every rolling law, none included, a restart
     // issue outside this law (the contact pass's thread split is not restored). The grains
     // must also come to rest (a law that created energy would keep the bed boiling): kinetic
-    // energy at 0.4 s below 1e-3 of the potential energy the fall released. Measured 2e-5: the
-    // face regime is elastic and, like the seed's law, undamped, so some rocking outlives the
-    // spheres' 1e-6.
+    // energy at 0.6 s below 1e-3 of the potential energy the fall released. Measured 2.4e-5,
+    // falling from 1e-4 at 0.2 s with spikes up to 2e-4 where a grain tips onto its next face;
+    // the face regime is elastic and, like the seed's law, undamped, so some rocking outlives
+    // the spheres' 1e-7.
     const fs::path dir =
         fs::temp_directory_path() / ("grainlink-test-grain-shape-" + std::to_string(::getpid()));
     fs::create_directories(dir);
@@ -484,16 +485,6 @@ TEST_CASE("grain shape: a poured bed comes to rest and a checkpoint continues bi
     readCheckpoint(*resumed, file);
     resumed->run(2000);
     fs::remove_all(dir);
-
-    const Energies e = straight->energies();
-    const double fall = potential_start - e.gravitational_J;
-    INFO("fall released " << fall << " J; kinetic at 0.4 s: " << e.translational_J << " + "
-                          << e.rotational_J << " J; contacts " << straight->contactCount());
-    CHECK(straight->contactCount() > 300);
-    CHECK(straight->wallContactCount() > 0);
-    CHECK(fall > 0.0);
-    CHECK(e.translational_J + e.rotational_J < 1e-3 * fall);
-    CHECK(straight->neighbourBuilds() > 6);
     const auto &a = straight->particles(), &b = resumed->particles();
     REQUIRE(a.size() == b.size());
     bool same = true;
@@ -502,4 +493,15 @@ TEST_CASE("grain shape: a poured bed comes to rest and a checkpoint continues bi
                a.angular_velocity[i] == b.angular_velocity[i] &&
                a.orientation[i].coeffs() == b.orientation[i].coeffs();
     CHECK(same);
+    CHECK(straight->neighbourBuilds() > 6);
+
+    straight->run(2000);
+    const Energies e = straight->energies();
+    const double fall = potential_start - e.gravitational_J;
+    INFO("fall released " << fall << " J; kinetic at 0.6 s: " << e.translational_J << " + "
+                          << e.rotational_J << " J; contacts " << straight->contactCount());
+    CHECK(straight->contactCount() > 300);
+    CHECK(straight->wallContactCount() > 0);
+    CHECK(fall > 0.0);
+    CHECK(e.translational_J + e.rotational_J < 1e-3 * fall);
 }

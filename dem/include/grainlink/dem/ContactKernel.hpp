@@ -74,23 +74,25 @@ inline GrainShapeArms grainShapeArms(double theta, double gamma, double tan_gamm
 /// contact force f_n n + f_t acts, in the rotation plane of each local axis e_k, at the pivot
 /// corner of that axis' rectangle. `n` points from the contact into the grain, `tilt` is the
 /// grain's rolling rotation relative to the contact (world frame, in the contact plane).
-inline Vec3 grainShapeTorque(const RollingGrainShape &law, const Quat &orientation, const Vec3 &n,
-                             double arm_m, double overlap_m, double normal_force_N,
-                             const Vec3 &f_tangential, const Vec3 &tilt) {
+/// Out of line: one copy for all slot combinations, so that the Eigen kernels it uses do not
+/// multiply in every instantiation of the contact loops (which changed their inlining).
+[[gnu::noinline]] inline Vec3 grainShapeTorque(const RollingGrainShape &law,
+                                               const Quat &orientation, const Vec3 &n, double arm_m,
+                                               double overlap_m, double normal_force_N,
+                                               const Vec3 &f_tangential, const Vec3 &tilt) {
     const Mat3 frame = orientation.toRotationMatrix();
     const double arm_over_overlap = arm_m / overlap_m;
-    Vec3 torque = Vec3::Zero();
+    Vec3 moments; // about the local axes
     for (int k = 0; k < 3; ++k) {
         const Vec3 e = frame.col(k);
         const Vec3 u = e.cross(n); // |u| = s_k, the share of the contact in this plane
         const GrainShapeArms arms = grainShapeArms(tilt.dot(e), law.gamma_rad[k], law.tan_gamma[k],
                                                    law.elastic_slope[k] * arm_over_overlap);
         // M_k = -a (X f_n s_k^2 + Y f_t.u_k); the sphere's part (Y = 1, X = 0) is already applied.
-        const double moment = -arm_m * (arms.X * normal_force_N * u.squaredNorm() +
-                                        (arms.Y - 1.0) * f_tangential.dot(u));
-        torque += moment * e;
+        moments[k] = -arm_m * (arms.X * normal_force_N * u.squaredNorm() +
+                               (arms.Y - 1.0) * f_tangential.dot(u));
     }
-    return torque;
+    return frame * moments;
 }
 } // namespace detail
 
@@ -186,18 +188,23 @@ evaluateContact(const Damping &damping, const Tangential &tangential, const Roll
         // Seed eq. 8 with the moment arms of a rectangle tilting over its corner (§2.6.1). The
         // history is the relative rolling angle; each grain's tilt is its share of the rolling
         // displacement at the contact point: a_j / (a_i + a_j) for i (R*/r_i), 1 at a wall.
-        Vec3 spin = g.relative_spin_rad_s;
-        spin -= spin.dot(n) * n;
+        // (Plain assignments here, not +=: see grainShapeTorque.)
+        const Vec3 spin = g.relative_spin_rad_s - g.relative_spin_rad_s.dot(n) * n;
         detail::rotateIntoPlane(history.rolling_N_m, n);
-        history.rolling_N_m += dt_s * spin;
+        history.rolling_N_m = history.rolling_N_m + dt_s * spin;
         const double share_i = g.orientation_j ? g.arm_j_m / (g.arm_i_m + g.arm_j_m) : 1.0;
-        out.torque_on_i_N_m +=
-            detail::grainShapeTorque(rolling, *g.orientation_i, n, g.arm_i_m, g.overlap_m,
-                                     normal_force, f_tangential, share_i * history.rolling_N_m);
-        if (g.orientation_j)
-            out.torque_on_j_N_m += detail::grainShapeTorque(
-                rolling, *g.orientation_j, -n, g.arm_j_m, g.overlap_m, normal_force, -f_tangential,
-                -(1.0 - share_i) * history.rolling_N_m);
+        const Vec3 tilt_i = share_i * history.rolling_N_m;
+        out.torque_on_i_N_m =
+            out.torque_on_i_N_m + detail::grainShapeTorque(rolling, *g.orientation_i, n, g.arm_i_m,
+                                                           g.overlap_m, normal_force, f_tangential,
+                                                           tilt_i);
+        if (g.orientation_j) {
+            const Vec3 tilt_j = (share_i - 1.0) * history.rolling_N_m;
+            out.torque_on_j_N_m =
+                out.torque_on_j_N_m + detail::grainShapeTorque(rolling, *g.orientation_j, -n,
+                                                               g.arm_j_m, g.overlap_m, normal_force,
+                                                               -f_tangential, tilt_j);
+        }
     } else {
         (void)rolling;
     }
