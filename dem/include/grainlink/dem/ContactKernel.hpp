@@ -62,11 +62,11 @@ inline GrainShapeArms grainShapeArms(double theta, double gamma, double tan_gamm
     // The virtual grain lands on its next face every 2 gamma: the tilt within the current face.
     const double period = 2.0 * gamma;
     const double tilt = theta - period * std::floor(theta / period + 0.5); // in [-gamma, gamma]
-    const double a = std::abs(tilt);
-    const double s = std::sin(a), c = std::cos(a);
-    // Corner regime: x = d sin(gamma - a), y = d cos(gamma - a), d = a / cos(gamma).
+    const double t = std::abs(tilt);
+    const double s = std::sin(t), c = std::cos(t);
+    // Corner regime: x = d sin(gamma - t), y = d cos(gamma - t), d = a / cos(gamma), over a.
     const double x_corner = tan_gamma * c - s;
-    const double x = std::min(elastic * a, x_corner); // face regime near a = 0
+    const double x = std::min(elastic * t, x_corner); // face regime near t = 0
     return {std::copysign(x, tilt), c + tan_gamma * s};
 }
 
