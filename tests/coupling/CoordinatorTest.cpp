@@ -62,19 +62,16 @@ TEST_CASE("Networked two-mass runs equal the in-process scheme bit for bit",
     }
 }
 
-TEST_CASE("Adaptive stepping follows the smallest hint and lands on the end tick exactly",
-          "[coupling][coordinator]") {
-    // Nominal 10 ms windows; the soil side asks for 2.5 ms while 0.1 s <= t < 0.2 s (an impact,
-    // say). A hint shapes the window after the one it came with, so: windows 0..10 at 10 ms
-    // (0 .. 0.11 s; the hint of the window starting at 0.1 s applies from 0.11 s), then 2.5 ms
-    // windows while the hints last: 0.11 .. 0.2025 s is 37 windows, then back to 10 ms.
-    auto config = twoMassRun(SchemeKind::ExplicitSerial, "inproc://adaptive", 0.01, 0.5);
-    config.min_macro_step_s = 0.0005; // 2.5 ms is a whole multiple: taken as asked
+namespace {
+
+/// A two-mass run of nominal 10 ms windows to 0.5 s whose soil side asks for 2.5 ms steps while
+/// 0.1 s <= t < 0.2 s (an impact, say), with adaptive stepping between `min_step_s` and 10 ms.
+CoordinatorSummary runWithImpactHints(const std::string &endpoint, double min_step_s,
+                                      const std::string &output_directory = "") {
+    auto config = twoMassRun(SchemeKind::ExplicitSerial, endpoint, 0.01, 0.5);
+    config.min_macro_step_s = min_step_s;
     config.max_macro_step_s = 0.01;
-    const std::string out = (std::filesystem::temp_directory_path() /
-                             ("grainlink-adaptive-" + std::to_string(::getpid())))
-                                .string();
-    config.output_directory = out;
+    config.output_directory = output_directory;
     Coordinator coordinator(config);
     grainlink::examples::SideHooks hooks;
     hooks.suggest_step_s = [](double t) { return t >= 0.1 - 1e-12 && t < 0.2 ? 0.0025 : 0.0; };
@@ -83,6 +80,21 @@ TEST_CASE("Adaptive stepping follows the smallest hint and lands on the end tick
     const auto summary = coordinator.run();
     mbs.get();
     soil.get();
+    return summary;
+}
+
+} // namespace
+
+TEST_CASE("Adaptive stepping follows the smallest hint and lands on the end tick exactly",
+          "[coupling][coordinator]") {
+    // A hint shapes the window after the one it came with, so: windows 0..10 at 10 ms
+    // (0 .. 0.11 s; the hint of the window starting at 0.1 s applies from 0.11 s), then 2.5 ms
+    // windows while the hints last: 0.11 .. 0.2025 s is 37 windows, then back to 10 ms. The
+    // smallest step, 0.5 ms, divides 2.5 ms: the hint is taken as asked.
+    const std::string out = (std::filesystem::temp_directory_path() /
+                             ("grainlink-adaptive-" + std::to_string(::getpid())))
+                                .string();
+    const auto summary = runWithImpactHints("inproc://adaptive", 0.0005, out);
     CHECK(summary.end_time_s == 0.5);
     // 11 + 37 windows to 0.2025 s, then 10 ms windows to 0.4925 s (29) and a last 7.5 ms one.
     CHECK(summary.windows == 11 + 37 + 29 + 1);
@@ -100,21 +112,11 @@ TEST_CASE("Adaptive stepping follows the smallest hint and lands on the end tick
 }
 
 TEST_CASE("Adaptive steps are whole multiples of the smallest step", "[coupling][coordinator]") {
-    // As above, but min_macro_step_s = 1 ms: the 2.5 ms hint becomes 2 ms windows, so that a
+    // As above with min_macro_step_s = 1 ms: the 2.5 ms hint becomes 2 ms windows, so that a
     // DEM participant stepping 1 ms (or any divisor) takes each window in whole steps. The
-    // hinting windows start at 0.11 .. 0.198 s (45) plus the one they shape after them: 46 windows
-    // of 2 ms to 0.202 s, then 10 ms windows to 0.492 s (29) and a last 8 ms one.
-    auto config = twoMassRun(SchemeKind::ExplicitSerial, "inproc://adaptive-whole", 0.01, 0.5);
-    config.min_macro_step_s = 0.001;
-    config.max_macro_step_s = 0.01;
-    Coordinator coordinator(config);
-    grainlink::examples::SideHooks hooks;
-    hooks.suggest_step_s = [](double t) { return t >= 0.1 - 1e-12 && t < 0.2 ? 0.0025 : 0.0; };
-    auto mbs = startSide(Role::Multibody, coordinator.boundEndpoint());
-    auto soil = startSide(Role::Soil, coordinator.boundEndpoint(), hooks);
-    const auto summary = coordinator.run();
-    mbs.get();
-    soil.get();
+    // hinting windows start at 0.11 .. 0.198 s (45) plus the one they shape after them: 46
+    // windows of 2 ms to 0.202 s, then 10 ms windows to 0.492 s (29) and a last 8 ms one.
+    const auto summary = runWithImpactHints("inproc://adaptive-whole", 0.001);
     CHECK(summary.end_time_s == 0.5);
     CHECK(summary.windows == 11 + 46 + 29 + 1);
 }

@@ -1,6 +1,8 @@
 // Virtual bevameter on a tiny bed (docs/lab.md): the p(z) it measures and the input checks.
 #include "grainlink/lab/Bevameter.hpp"
 
+#include "TextEdit.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <string>
@@ -47,10 +49,7 @@ lab::BevameterScenario parse(const std::string &text) {
 }
 
 std::string edited(const std::string &from, const std::string &to) {
-    std::string text = kTiny;
-    const auto at = text.find(from);
-    REQUIRE(at != std::string::npos);
-    return text.replace(at, from.size(), to);
+    return replacedOnce(kTiny, from, to);
 }
 
 } // namespace

@@ -1,6 +1,8 @@
 // Angle of repose, lifted-cylinder test (docs/lab.md, physics.md §12.10).
 #include "grainlink/lab/Repose.hpp"
 
+#include "TextEdit.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
@@ -44,10 +46,7 @@ lab::ReposeScenario parse(const std::string &text) {
 }
 
 std::string edited(const std::string &from, const std::string &to) {
-    std::string text = kTiny;
-    const auto at = text.find(from);
-    REQUIRE(at != std::string::npos);
-    return text.replace(at, from.size(), to);
+    return replacedOnce(kTiny, from, to);
 }
 
 } // namespace
