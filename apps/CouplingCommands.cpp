@@ -40,33 +40,31 @@ struct StopSignals {
     }
 };
 
-/// The bed sections the scenario's soil nodes read: `soil`, or what each `--section` names.
-std::vector<std::string> soilSections(const config::ConfigNode &root) {
-    std::vector<std::string> sections;
+/// What the scenario's own participant commands run: a Simbody node, and the bed sections
+/// its soil nodes read (`soil`, or what each `--section` names).
+struct NodesInScenario {
+    bool simbody = false;
+    std::vector<std::string> soil_sections;
+};
+
+NodesInScenario nodesIn(const config::ConfigNode &root) {
+    NodesInScenario nodes;
     for (const auto &p : root["participants"].items()) {
         if (!p.has("command"))
-            continue;
+            continue; // an external participant
         const auto words = p["command"].items();
         bool soil_node = false;
         std::string section = "soil";
         for (std::size_t w = 0; w < words.size(); ++w) {
+            nodes.simbody = nodes.simbody || words[w].text() == "mbs-node";
             soil_node = soil_node || words[w].text() == "dem-node";
             if (words[w].text() == "--section" && w + 1 < words.size())
                 section = words[w + 1].text();
         }
         if (soil_node)
-            sections.push_back(section);
+            nodes.soil_sections.push_back(section);
     }
-    return sections;
-}
-
-/// Whether a participant of the scenario runs `grainlink mbs-node`.
-bool hasSimbodyParticipant(const config::ConfigNode &root) {
-    for (const auto &p : root["participants"].items())
-        for (const auto &word : p.has("command") ? p["command"].items() : std::vector<config::ConfigNode>{})
-            if (word.text() == "mbs-node")
-                return true;
-    return false;
+    return nodes;
 }
 
 CoordinatorConfig configFor(const CoupledRunOptions &options, const char *default_endpoint) {
@@ -74,14 +72,15 @@ CoordinatorConfig configFor(const CoupledRunOptions &options, const char *defaul
     // stops the run before any process starts.
     const auto root = config::ConfigNode::loadFile(options.config_path);
     CoordinatorConfig config = coupling::coordinatorConfigFrom(root);
-    for (const auto &section : soilSections(root))
+    const NodesInScenario nodes = nodesIn(root);
+    for (const auto &section : nodes.soil_sections)
         dem::parseScenario(root[section], true);
     MirrorSymmetry::parse(root);
     if (const auto floor = root.optional("floor"))
         dem::parseRigidFloor(*floor);
     if (const auto rig = root.optional("rig"))
         mbs::parseSingleWheelRig(*rig);
-    else if (hasSimbodyParticipant(root))
+    else if (nodes.simbody)
         makeModel(root, options.config_path); // builds it once: every model error shows now
     if (const auto test = root.optional("wheel_test"))
         mbs::parseWheelTest(*test);

@@ -3,6 +3,7 @@
 // floor, each a `grainlink` subcommand that `grainlink run` starts from the scenario's
 // participant commands.
 #include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/coupling/Participant.hpp"
 #include "grainlink/mbs/MultibodyModel.hpp"
 
 #include <memory>
@@ -24,12 +25,12 @@ struct NodeOptions {
 
 /// How long a node waits for the coordinator's Welcome: the scenario's
 /// `coupling.handshake_timeout_s` (the coordinator waits as long for every node to join, e.g.
-/// while the soil node deposits a large bed the first time), else 120 s.
+/// while the soil node deposits a large bed the first time), else the participant's default.
 inline double handshakeTimeout(const config::ConfigNode &root) {
     const auto coupling = root.optional("coupling");
     return coupling && coupling->has("handshake_timeout_s")
                ? (*coupling)["handshake_timeout_s"].positive()
-               : 120.0;
+               : coupling::ParticipantConfig{}.handshake_timeout_s;
 }
 
 /// `grainlink mbs-node`: the multibody participant: the single-wheel rig (section `rig:`) with
