@@ -2,6 +2,7 @@
 #include "LabCommands.hpp"
 
 #include "grainlink/lab/Bevameter.hpp"
+#include "grainlink/lab/NumericalChecks.hpp"
 #include "grainlink/lab/Repose.hpp"
 
 #include <cstdio>
@@ -9,7 +10,26 @@
 
 namespace grainlink::apps {
 
+namespace {
+
+/// Prints and writes the checks (numerical_check.csv, report.txt) when --check asked for them.
+void reportChecks(const std::vector<lab::NumericalCheck> &checks, const std::string &directory) {
+    if (checks.empty())
+        return;
+    std::printf("%s", lab::describeNumericalChecks(checks).c_str());
+    lab::writeNumericalChecks(checks, directory);
+    std::printf("written: %s/numerical_check.csv, reruns in %s/check_*\n", directory.c_str(),
+                directory.c_str());
+}
+
+} // namespace
+
 int runLab(const LabOptions &options) {
+    lab::CheckRequest check;
+    if (!options.check.empty())
+        check = lab::parseCheckRequest(options.check, options.check_factor);
+    else if (options.check_factor != 0.0)
+        throw std::invalid_argument("--check-factor needs --check walls or --check resolution");
     if (options.test == "bevameter") {
         const auto scenario = lab::loadBevameter(options.scenario_path);
         lab::BevameterOptions run;
@@ -21,6 +41,8 @@ int runLab(const LabOptions &options) {
         std::printf("written: %s/{pressure_sinkage.csv,bekker_fit.csv,report.txt}; plot with "
                     "tools/plot_lab.py %s\n",
                     run.output_directory.c_str(), run.output_directory.c_str());
+        if (check.any())
+            reportChecks(lab::checkBevameter(scenario, result, check, run), run.output_directory);
         return 0;
     }
     if (options.test == "repose") {
@@ -33,6 +55,8 @@ int runLab(const LabOptions &options) {
         std::printf("%s", result.report().c_str());
         std::printf("written: %s/{heap_profile.csv,report.txt}; plot with tools/plot_lab.py %s\n",
                     run.output_directory.c_str(), run.output_directory.c_str());
+        if (check.any())
+            reportChecks(lab::checkRepose(scenario, result, check, run), run.output_directory);
         return 0;
     }
     throw std::invalid_argument("lab test '" + options.test +

@@ -16,6 +16,8 @@ struct LabOptions {
     std::string scenario_path;
     std::string output_directory; ///< empty: out/<scenario name>
     double progress_interval_s = 5.0;
+    std::string check;         ///< "", "walls", "resolution" or "both" (lab/NumericalChecks.hpp)
+    double check_factor = 0.0; ///< 0: the check's default (width x 2, radii x 0.75)
 };
 int runLab(const LabOptions &options);
 

@@ -76,6 +76,12 @@ int main(int argc, char **argv) {
     lab->add_option("--out", lab_options.output_directory, "output directory (default out/<name>)");
     lab->add_option("--progress-interval", lab_options.progress_interval_s,
                     "seconds between progress lines");
+    lab->add_option("--check", lab_options.check,
+                    "rerun on a wider box (walls), finer grains (resolution) or both and report "
+                    "how far the answers moved")
+        ->check(CLI::IsMember({"walls", "resolution", "both"}));
+    lab->add_option("--check-factor", lab_options.check_factor,
+                    "box width factor (> 1, default 2) or grain radius factor (< 1, default 0.75)");
 
     grainlink::apps::NodeOptions node;
     auto *mbs_node = app.add_subcommand(
