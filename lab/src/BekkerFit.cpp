@@ -37,40 +37,73 @@ double studentT975(int dof) {
 
 namespace {
 
+/// Adapts a LeastSquaresProblem to Eigen's functor interface.
+struct Functor : Eigen::DenseFunctor<double> {
+    explicit Functor(const LeastSquaresProblem &p)
+        : Eigen::DenseFunctor<double>(p.parameter_count, p.residual_count), problem(p) {}
+    int operator()(const InputType &x, ValueType &f) const {
+        problem.residuals(x, f);
+        return 0;
+    }
+    int df(const InputType &x, JacobianType &jac) const {
+        problem.jacobian(x, jac);
+        return 0;
+    }
+    const LeastSquaresProblem &problem;
+};
+
 struct Point {
     double b, z, p;
 };
 
-/// Residuals in scaled form: theta = (c1, c2, n) with
-/// p = p_ref (c1 b_ref / b + c2) (z / z_ref)^n, residual (p_model - p) / p_ref.
-struct BekkerResiduals : Eigen::DenseFunctor<double> {
-    BekkerResiduals(const std::vector<Point> &points, double b_ref, double z_ref, double p_ref)
-        : Eigen::DenseFunctor<double>(3, int(points.size())), points(points), b_ref(b_ref),
-          z_ref(z_ref), p_ref(p_ref) {}
-    int operator()(const InputType &x, ValueType &f) const {
-        for (std::size_t i = 0; i < points.size(); ++i) {
-            const Point &q = points[i];
-            const double s = std::pow(q.z / z_ref, x[2]);
-            f[Eigen::Index(i)] = (x[0] * b_ref / q.b + x[1]) * s - q.p / p_ref;
-        }
-        return 0;
-    }
-    int df(const InputType &x, JacobianType &jac) const {
-        for (std::size_t i = 0; i < points.size(); ++i) {
-            const Point &q = points[i];
-            const double s = std::pow(q.z / z_ref, x[2]);
-            const auto row = Eigen::Index(i);
-            jac(row, 0) = b_ref / q.b * s;
-            jac(row, 1) = s;
-            jac(row, 2) = (x[0] * b_ref / q.b + x[1]) * s * std::log(q.z / z_ref);
-        }
-        return 0;
-    }
-    const std::vector<Point> &points;
-    double b_ref, z_ref, p_ref;
-};
-
 } // namespace
+
+LeastSquaresSolution solveLeastSquares(const LeastSquaresProblem &problem, Eigen::VectorXd x) {
+    const int n = problem.parameter_count, m = problem.residual_count;
+    if (n < 1 || m <= n || x.size() != n)
+        throw std::invalid_argument("solveLeastSquares: needs more residuals (" +
+                                    std::to_string(m) + ") than parameters (" + std::to_string(n) +
+                                    ") and a start of that size");
+    Functor functor(problem);
+    Eigen::LevenbergMarquardt<Functor> lm(functor);
+    lm.setXtol(1e-14);
+    lm.setFtol(1e-14);
+    lm.setMaxfev(2000);
+    lm.minimize(x);
+
+    LeastSquaresSolution out;
+    out.theta = x;
+    out.iterations = int(lm.iterations());
+    out.degrees_of_freedom = m - n;
+    Eigen::VectorXd f(m);
+    problem.residuals(x, f);
+    Eigen::MatrixXd jac(m, n);
+    problem.jacobian(x, jac);
+    out.rss = f.squaredNorm();
+    const Eigen::MatrixXd jtj = jac.transpose() * jac;
+    out.covariance = out.rss / double(out.degrees_of_freedom) * jtj.inverse();
+    return out;
+}
+
+Eigen::VectorXd separableStart(const std::vector<double> &grid,
+                               const std::function<Eigen::MatrixXd(double q)> &design,
+                               const Eigen::VectorXd &y) {
+    Eigen::VectorXd best_x;
+    double best = std::numeric_limits<double>::infinity();
+    for (double q : grid) {
+        const Eigen::MatrixXd a = design(q);
+        const Eigen::VectorXd c = a.colPivHouseholderQr().solve(y);
+        const double rss = (a * c - y).squaredNorm();
+        if (rss < best) {
+            best = rss;
+            best_x.resize(c.size() + 1);
+            best_x << c, q;
+        }
+    }
+    if (best_x.size() == 0)
+        throw std::invalid_argument("separableStart: no finite fit on the grid");
+    return best_x;
+}
 
 BekkerFit fitBekker(const std::vector<PressureSinkageCurve> &curves, double min_sinkage_m) {
     std::vector<Point> points;
@@ -111,48 +144,55 @@ BekkerFit fitBekker(const std::vector<PressureSinkageCurve> &curves, double min_
     if (!(p_ref > 0.0))
         throw std::invalid_argument("fitBekker: every pressure is zero");
 
-    // Start: for each n on a grid the model is linear in (c1, c2); take the best.
+    // Scaled parameters theta = (c1, c2, n): p = p_ref (c1 b_ref / b + c2) (z / z_ref)^n,
+    // residual (p_model - p) / p_ref.
     const auto m = Eigen::Index(points.size());
-    Eigen::VectorXd x(3);
-    double best = std::numeric_limits<double>::infinity();
-    for (double n = 0.2; n <= 2.5001; n += 0.05) {
+    Eigen::VectorXd y(m);
+    for (Eigen::Index i = 0; i < m; ++i)
+        y[i] = points[std::size_t(i)].p / p_ref;
+    // Start: for each n on a grid the model is linear in (c1, c2); take the best.
+    std::vector<double> n_grid;
+    for (int k = 0; k <= 46; ++k)
+        n_grid.push_back(0.2 + 0.05 * k);
+    auto design = [&](double n) {
         Eigen::MatrixXd a(m, 2);
-        Eigen::VectorXd y(m);
         for (Eigen::Index i = 0; i < m; ++i) {
             const Point &q = points[std::size_t(i)];
             const double s = std::pow(q.z / z_ref, n);
             a(i, 0) = b_ref / q.b * s;
             a(i, 1) = s;
-            y[i] = q.p / p_ref;
         }
-        const Eigen::Vector2d c = a.colPivHouseholderQr().solve(y);
-        const double rss = (a * c - y).squaredNorm();
-        if (rss < best) {
-            best = rss;
-            x << c[0], c[1], n;
+        return a;
+    };
+    LeastSquaresProblem problem;
+    problem.parameter_count = 3;
+    problem.residual_count = int(m);
+    problem.residuals = [&](const Eigen::VectorXd &x, Eigen::VectorXd &f) {
+        for (Eigen::Index i = 0; i < m; ++i) {
+            const Point &q = points[std::size_t(i)];
+            f[i] = (x[0] * b_ref / q.b + x[1]) * std::pow(q.z / z_ref, x[2]) - y[i];
         }
-    }
-
-    BekkerResiduals residuals(points, b_ref, z_ref, p_ref);
-    Eigen::LevenbergMarquardt<BekkerResiduals> lm(residuals);
-    lm.setXtol(1e-14);
-    lm.setFtol(1e-14);
-    lm.setMaxfev(2000);
-    lm.minimize(x);
+    };
+    problem.jacobian = [&](const Eigen::VectorXd &x, Eigen::MatrixXd &jac) {
+        for (Eigen::Index i = 0; i < m; ++i) {
+            const Point &q = points[std::size_t(i)];
+            const double s = std::pow(q.z / z_ref, x[2]);
+            jac(i, 0) = b_ref / q.b * s;
+            jac(i, 1) = s;
+            jac(i, 2) = (x[0] * b_ref / q.b + x[1]) * s * std::log(q.z / z_ref);
+        }
+    };
+    const LeastSquaresSolution solution =
+        solveLeastSquares(problem, separableStart(n_grid, design, y));
+    const Eigen::VectorXd &x = solution.theta;
 
     BekkerFit fit;
     fit.points = points.size();
-    fit.degrees_of_freedom = int(points.size()) - 3;
-    fit.iterations = int(lm.iterations());
-    Eigen::VectorXd f(m);
-    residuals(x, f);
-    Eigen::MatrixXd jac(m, 3);
-    residuals.df(x, jac);
-    const double s2 = f.squaredNorm() / double(fit.degrees_of_freedom);
-    fit.rms_residual_Pa = p_ref * std::sqrt(f.squaredNorm() / double(m));
-    // Covariance of theta, s^2 (J^T J)^-1, then to (k_c, k_phi, n) by the delta method.
-    const Eigen::Matrix3d jtj = jac.transpose() * jac;
-    const Eigen::Matrix3d cov_theta = s2 * jtj.inverse();
+    fit.degrees_of_freedom = solution.degrees_of_freedom;
+    fit.iterations = solution.iterations;
+    fit.rms_residual_Pa = p_ref * std::sqrt(solution.rss / double(m));
+    // Covariance of theta, s^2 (J^T J)^-1, carried to (k_c, k_phi, n) by the delta method.
+    const Eigen::Matrix3d cov_theta = solution.covariance;
     const double zn = std::pow(z_ref, x[2]), lz = std::log(z_ref);
     BekkerParameters &p = fit.parameters;
     p.k_c = p_ref * x[0] * b_ref / zn;

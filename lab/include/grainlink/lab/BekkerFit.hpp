@@ -3,6 +3,7 @@
 // more sizes by nonlinear least squares, with confidence intervals (docs/physics.md §12.6).
 #include <Eigen/Core>
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -38,6 +39,33 @@ struct BekkerFit {
 /// Fits all curves' points with z > min_sinkage_m. Throws std::invalid_argument with fewer than
 /// two distinct plate radii (k_c and k_phi are then not separable) or fewer than four points.
 BekkerFit fitBekker(const std::vector<PressureSinkageCurve> &curves, double min_sinkage_m = 0.0);
+
+/// A nonlinear least-squares problem in (scaled) parameters theta: residuals f(theta) and their
+/// Jacobian. Shared by the lab's fits (Bekker, Janosi-Hanamoto).
+struct LeastSquaresProblem {
+    int parameter_count = 0;
+    int residual_count = 0;
+    std::function<void(const Eigen::VectorXd &theta, Eigen::VectorXd &f)> residuals;
+    std::function<void(const Eigen::VectorXd &theta, Eigen::MatrixXd &jacobian)> jacobian;
+};
+
+struct LeastSquaresSolution {
+    Eigen::VectorXd theta;
+    Eigen::MatrixXd covariance; ///< of theta: s^2 (J^T J)^-1, s^2 = RSS / dof
+    double rss = 0.0;           ///< sum of squared residuals at theta
+    int degrees_of_freedom = 0; ///< residuals - parameters
+    int iterations = 0;
+};
+
+/// Levenberg-Marquardt (Eigen's unsupported module) from `start`, then the covariance at the
+/// optimum. Needs more residuals than parameters (throws std::invalid_argument otherwise).
+LeastSquaresSolution solveLeastSquares(const LeastSquaresProblem &problem, Eigen::VectorXd start);
+
+/// Starting point for a model linear in every parameter but the last, q: for each q on `grid`
+/// solves design(q) c = y in the least-squares sense and returns (c, q) of the smallest residual.
+Eigen::VectorXd separableStart(const std::vector<double> &grid,
+                               const std::function<Eigen::MatrixXd(double q)> &design,
+                               const Eigen::VectorXd &y);
 
 /// Student-t quantile t(0.975, dof) (Cornish-Fisher expansion, A&S 26.7.5; exact table for
 /// dof <= 4), for the confidence intervals.
