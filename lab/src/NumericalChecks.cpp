@@ -89,7 +89,7 @@ dem::DemScenario refinedSoil(const dem::DemScenario &soil, double factor) {
     r.max_m *= factor;
     for (double &x : r.radii_m)
         x *= factor;
-    // Same solid volume in the same region: count / f^3 (physics.md §12.11).
+    // Same solid volume in the same region: count / f^3 (physics.md §12.14).
     s.deposition.count = scaledCount(s.deposition.count, 1.0 / (factor * factor * factor));
     s.deposition.settle_kinetic_energy_J *= factor * factor * factor; // per grain, ~ mass
     // At a fixed overlap ratio the Hertz secant stiffness goes as E r: a linear tangential spring

@@ -1,4 +1,4 @@
-// Numerical checks of the lab tests (docs/lab.md, physics.md §12.11): the widened and refined
+// Numerical checks of the lab tests (docs/lab.md, physics.md §12.14): the widened and refined
 // scenarios, the stability margin of the refined step, and the baseline-vs-rerun report.
 #include "grainlink/lab/NumericalChecks.hpp"
 

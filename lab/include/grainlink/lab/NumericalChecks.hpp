@@ -1,5 +1,5 @@
 #pragma once
-// Numerical checks of a lab test (docs/lab.md, physics.md §12.11): the test reruns itself on a
+// Numerical checks of a lab test (docs/lab.md, physics.md §12.14): the test reruns itself on a
 // wider box (wall effects) or on finer grains (resolution), and the report says how far each
 // answer moved. The moves are the test's numerical uncertainty.
 #include "grainlink/dem/Scenario.hpp"
@@ -24,7 +24,7 @@ std::string checkName(CheckKind kind); ///< "walls" or "resolution"
 dem::DemScenario widenedSoil(const dem::DemScenario &soil, double factor);
 
 /// The soil with every grain radius scaled by `factor` in (0, 1) and the contact law scaled so
-/// that grains of the new size behave as the old ones did (physics.md §12.11): count / factor^3
+/// that grains of the new size behave as the old ones did (physics.md §12.14): count / factor^3
 /// (same solid volume), time step, linear tangential stiffness and neighbour skin times factor,
 /// viscous dampers times factor^2, the settling energy per grain times factor^3.
 dem::DemScenario refinedSoil(const dem::DemScenario &soil, double factor);
