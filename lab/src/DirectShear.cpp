@@ -194,7 +194,7 @@ DirectShearScenario loadDirectShear(const std::string &path) {
 
 MohrCoulombFit fitMohrCoulomb(const std::vector<double> &sigma, const std::vector<double> &tau,
                               bool with_cohesion) {
-    // Mohr-Coulomb line by linear least squares, docs/physics.md §12.12.
+    // Mohr-Coulomb line by linear least squares, docs/physics.md §12.15.
     if (sigma.size() != tau.size())
         throw std::invalid_argument("fitMohrCoulomb: " + std::to_string(sigma.size()) +
                                     " normal stresses but " + std::to_string(tau.size()) +
@@ -467,7 +467,7 @@ DirectShearResult runDirectShear(const DirectShearScenario &scenario,
     result.largest_radius_m = scenario.soil.deposition.radius.largest();
     result.time_step_s = base->settings().time_step_s;
     result.bed_height_m = dem::bedSurface(grains);
-    // Bulk density of the settled bed, docs/physics.md §12.12.
+    // Bulk density of the settled bed, docs/physics.md §12.15.
     double mass = 0.0;
     for (double m : grains.mass)
         mass += m;

@@ -1,4 +1,4 @@
-// Direct shear box (docs/lab.md, physics.md §12.12).
+// Direct shear box (docs/lab.md, physics.md §12.15).
 #include "grainlink/lab/DirectShear.hpp"
 
 #include "TextEdit.hpp"

@@ -2,7 +2,7 @@
 // Direct shear box: a split box of grains, the lower half fixed, the upper half moved along x at
 // constant speed under a top plate that a force servo keeps at a constant normal load; tau(d)
 // per normal stress, peak and residual strength, and the Mohr-Coulomb line tau = c + sigma tan psi
-// fitted with its confidence intervals (docs/lab.md, docs/physics.md §12.12).
+// fitted with its confidence intervals (docs/lab.md, docs/physics.md §12.15).
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/LoadServo.hpp"
 
