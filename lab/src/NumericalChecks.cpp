@@ -52,13 +52,14 @@ std::string checkName(CheckKind kind) {
     return kind == CheckKind::Walls ? "walls" : "resolution";
 }
 
-dem::DemScenario widenedSoil(const dem::DemScenario &soil, double factor) {
+dem::DemScenario widenedSoil(const dem::DemScenario &soil, double factor,
+                             const std::optional<Eigen::Vector2d> &about_m) {
     if (!(factor > 1.0))
         throw std::invalid_argument("widening factor " + number(factor) + " must be > 1");
     dem::DemScenario s = soil;
     auto &d = s.deposition;
-    const double cx = 0.5 * (d.region_lower_m.x() + d.region_upper_m.x());
-    const double cy = 0.5 * (d.region_lower_m.y() + d.region_upper_m.y());
+    const double cx = about_m ? about_m->x() : 0.5 * (d.region_lower_m.x() + d.region_upper_m.x());
+    const double cy = about_m ? about_m->y() : 0.5 * (d.region_lower_m.y() + d.region_upper_m.y());
     // x -> c + F (x - c) in x and y: points map directly, plane normals by the inverse
     // transpose (n_x / F, n_y / F, n_z), renormalised.
     const auto map = [&](Vec3 p) {
@@ -279,6 +280,47 @@ std::vector<NumericalCheck> checkRepose(const ReposeScenario &scenario,
             if (!o.output_directory.empty())
                 o.output_directory = (fs::path(o.output_directory) / ("check_" + name)).string();
             return reposeQuantities(runRepose(changed, o));
+        });
+}
+
+Quantities directShearQuantities(const DirectShearResult &result) {
+    Quantities q;
+    for (const auto &[label, fit] :
+         {std::pair{"peak", &result.peak_fit}, std::pair{"residual", &result.residual_fit}}) {
+        if (!*fit)
+            continue;
+        q.push_back(
+            {std::string(label) + " friction angle psi", "deg", (*fit)->friction_angle_deg});
+        if ((*fit)->cohesion_fitted)
+            q.push_back({std::string(label) + " cohesion c", "Pa", (*fit)->cohesion_Pa});
+    }
+    q.push_back({"packing fraction", "-", result.packing_fraction});
+    return q;
+}
+
+std::vector<NumericalCheck> checkDirectShear(const DirectShearScenario &scenario,
+                                             const DirectShearResult &baseline,
+                                             const CheckRequest &request,
+                                             const DirectShearOptions &options) {
+    return runNumericalChecks(
+        request, directShearQuantities(baseline),
+        [&](CheckKind kind, double factor, const std::string &name) {
+            DirectShearScenario changed = scenario;
+            if (kind == CheckKind::Walls) {
+                // The box spans [0, L] x [0, W]: widen about its corner.
+                changed.soil = widenedSoil(scenario.soil, factor, Eigen::Vector2d::Zero());
+                auto &t = changed.test;
+                t.length_m *= factor;
+                t.width_m *= factor;
+                t.servo_gain_m_s_per_N /= factor * factor;
+                t.servo_deadband_N *= factor * factor;
+            } else {
+                changed.soil = refinedSoil(scenario.soil, factor);
+            }
+            DirectShearOptions o = options;
+            if (!o.output_directory.empty())
+                o.output_directory = (fs::path(o.output_directory) / ("check_" + name)).string();
+            return directShearQuantities(runDirectShear(changed, o));
         });
 }
 

@@ -87,6 +87,11 @@ TEST_CASE("Widened soil: region and side walls x F about the centre, grains x F^
     CHECK(w.deposition.radius.max_m == base.deposition.radius.max_m);
     CHECK(w.settings.time_step_s == base.settings.time_step_s);
     CHECK(lab::widenedSoil(base, 1.5).deposition.count == 2250);
+    // About a given point (the direct shear box's corner at the origin).
+    const auto corner = lab::widenedSoil(base, 2.0, Eigen::Vector2d::Zero());
+    CHECK(corner.deposition.region_lower_m.isApprox(dem::Vec3(0.0, 0.0, 0.0), eps));
+    CHECK(corner.deposition.region_upper_m.isApprox(dem::Vec3(0.08, 0.12, 0.05), eps));
+    CHECK(plane(corner, "bin.ymax").point_m.y() == Approx(0.12).margin(eps));
     CHECK_THROWS_WITH(lab::widenedSoil(base, 0.9), Contains("must be > 1"));
 }
 

@@ -4,9 +4,13 @@
 // answer moved. The moves are the test's numerical uncertainty.
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/Bevameter.hpp"
+#include "grainlink/lab/DirectShear.hpp"
 #include "grainlink/lab/Repose.hpp"
 
+#include <Eigen/Core>
+
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -18,10 +22,12 @@ enum class CheckKind {
 };
 std::string checkName(CheckKind kind); ///< "walls" or "resolution"
 
-/// The soil widened by `factor` > 1 in x and y about the centre of the deposition region: the
-/// region, every wall plane (points mapped, normals by the inverse transpose) and the grain count
-/// (times factor^2, so the settled bed keeps its depth). Heights, grains and contact law stay.
-dem::DemScenario widenedSoil(const dem::DemScenario &soil, double factor);
+/// The soil widened by `factor` > 1 in x and y about `about_m` (unset: the centre of the
+/// deposition region): the region, every wall plane (points mapped, normals by the inverse
+/// transpose) and the grain count (times factor^2, so the settled bed keeps its depth). Heights,
+/// grains and contact law stay.
+dem::DemScenario widenedSoil(const dem::DemScenario &soil, double factor,
+                             const std::optional<Eigen::Vector2d> &about_m = std::nullopt);
 
 /// The soil with every grain radius scaled by `factor` in (0, 1) and the contact law scaled so
 /// that grains of the new size behave as the old ones did (physics.md §12.14): count / factor^3
@@ -101,5 +107,17 @@ Quantities reposeQuantities(const ReposeResult &result);
 std::vector<NumericalCheck> checkRepose(const ReposeScenario &scenario,
                                         const ReposeResult &baseline, const CheckRequest &request,
                                         const ReposeOptions &options);
+
+/// Direct shear answers: psi and c of the peak and of the residual Mohr-Coulomb fits (those
+/// that exist) and the bed's packing fraction.
+Quantities directShearQuantities(const DirectShearResult &result);
+/// Reruns the direct shear test. Walls: the box's length and width x F (the soil widened about
+/// the box corner (0, 0)), the servo gain / F^2 and its deadband x F^2 (the bed's stiffness
+/// under the plate grows with its area, so gain x stiffness x interval stays). Resolution: the
+/// servo is kept (the bed's stiffness E A / H does not depend on the grain size).
+std::vector<NumericalCheck> checkDirectShear(const DirectShearScenario &scenario,
+                                             const DirectShearResult &baseline,
+                                             const CheckRequest &request,
+                                             const DirectShearOptions &options);
 
 } // namespace grainlink::lab
