@@ -84,6 +84,34 @@ TEST_CASE("Load servo gain beyond 2 / (k dt) oscillates with growing amplitude",
     }
 }
 
+TEST_CASE("Load servo against a receding soil: proportional lags by v / gain, the integral "
+          "term removes the lag",
+          "[lab][servo]") {
+    // The soil gives way at v = 5 mm/s: F = k (depth - v t). Proportional control settles at
+    // the error v / gain exactly (u = v): 0.005 / 1e-3 = 5 N. With the integral term
+    // (k g dt = 0.1, integral time gain / integral_gain = 0.1 s = 20 intervals) the error
+    // decays to zero; after 400 intervals 1e-6 N is rounding.
+    const double k = 2e4, dt = 0.005, target = 20.0, v = 0.005;
+    auto run = [&](lab::LoadServo s, bool integral) {
+        double depth = 0.0, force = 0.0;
+        for (int n = 1; n <= 400; ++n) {
+            depth += (integral ? s.update(force, dt) : s.approachSpeed(force)) * dt;
+            force = k * std::max(depth - v * n * dt, 0.0);
+        }
+        return force;
+    };
+    auto s = servo(target, 1e-3, 0.05);
+    CHECK(target - run(s, false) == Approx(v / 1e-3).epsilon(1e-9));
+    s.integral_gain_m_s2_per_N = 1e-3 / 0.1;
+    s.validate();
+    CHECK(run(s, true) == Approx(target).margin(1e-6));
+    // Anti-windup: while clamped (far from the target) the integral does not grow.
+    auto clamped = servo(target, 1e-3, 0.001);
+    clamped.integral_gain_m_s2_per_N = 1.0;
+    CHECK(clamped.update(0.0, dt) == Approx(0.001).epsilon(1e-12));
+    CHECK(clamped.integral_m_s == 0.0);
+}
+
 TEST_CASE("Load servo input errors name the member", "[lab][servo]") {
     lab::LoadServo s;
     s.target_force_N = 1.0;
@@ -97,5 +125,8 @@ TEST_CASE("Load servo input errors name the member", "[lab][servo]") {
     s.deadband_N = -0.1;
     CHECK_THROWS_WITH(s.validate(), Contains("deadband_N"));
     s.deadband_N = 0.0;
+    s.integral_gain_m_s2_per_N = -1.0;
+    CHECK_THROWS_WITH(s.validate(), Contains("integral_gain_m_s2_per_N"));
+    s.integral_gain_m_s2_per_N = 0.0;
     CHECK_NOTHROW(s.validate());
 }
