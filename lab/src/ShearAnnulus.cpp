@@ -145,7 +145,7 @@ dem::TriangleMesh makeShearAnnulus(const AnnulusGeometry &g) {
 }
 
 double JanosiParameters::shearStress(double sigma, double j) const {
-    // Janosi-Hanamoto, docs/physics.md §12.12.
+    // Janosi-Hanamoto, docs/physics.md §12.13.
     const double tan_phi = std::tan(friction_angle_deg * kPi / 180.0);
     return (cohesion_Pa + sigma * tan_phi) * (1.0 - std::exp(-j / shear_modulus_m));
 }
@@ -615,6 +615,40 @@ void writeShearAnnulusOutputs(const ShearAnnulusResult &result, const std::strin
         }
     }
     std::ofstream(dir / "report.txt") << result.report();
+}
+
+Quantities shearAnnulusQuantities(const ShearAnnulusResult &result) {
+    Quantities q;
+    for (const auto &r : result.runs) {
+        std::ostringstream name;
+        name << "tau_max, sigma = " << r.target_pressure_Pa << " Pa";
+        q.push_back({name.str(), "Pa", r.max_shear_stress_Pa});
+    }
+    if (result.fit) {
+        q.push_back({"Janosi c", "Pa", result.fit->parameters.cohesion_Pa});
+        q.push_back({"Janosi phi", "deg", result.fit->parameters.friction_angle_deg});
+        q.push_back({"Janosi K", "m", result.fit->parameters.shear_modulus_m});
+    }
+    return q;
+}
+
+std::vector<NumericalCheck> checkShearAnnulus(const ShearAnnulusScenario &scenario,
+                                              const ShearAnnulusResult &baseline,
+                                              const CheckRequest &request,
+                                              const ShearAnnulusOptions &options) {
+    return runNumericalChecks(
+        request, shearAnnulusQuantities(baseline),
+        [&](CheckKind kind, double factor, const std::string &name) {
+            ShearAnnulusScenario changed = scenario;
+            // Widened about the annulus's axis, so that it stays centred in the wider box.
+            changed.soil = kind == CheckKind::Walls
+                               ? widenedSoil(scenario.soil, factor, scenario.test.centre_m)
+                               : refinedSoil(scenario.soil, factor);
+            ShearAnnulusOptions o = options;
+            if (!o.output_directory.empty())
+                o.output_directory = (fs::path(o.output_directory) / ("check_" + name)).string();
+            return shearAnnulusQuantities(runShearAnnulus(changed, o));
+        });
 }
 
 } // namespace grainlink::lab

@@ -4,6 +4,7 @@
 // pressure and the Janosi-Hanamoto law fitted over the pressures (docs/lab.md, physics.md §12.12).
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/dem/TriangleMesh.hpp"
+#include "grainlink/lab/NumericalChecks.hpp"
 
 #include <Eigen/Core>
 
@@ -148,5 +149,17 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
 
 /// Writes shear_displacement.csv, janosi_fit.csv and report.txt into `directory`.
 void writeShearAnnulusOutputs(const ShearAnnulusResult &result, const std::string &directory);
+
+/// Shear annulus answers for the numerical checks: tau_max per normal pressure and the Janosi
+/// c, phi and K when the result has a fit.
+Quantities shearAnnulusQuantities(const ShearAnnulusResult &result);
+/// Reruns the shear test on a wider box or finer grains (lab/NumericalChecks.hpp; outputs in
+/// options.output_directory/check_<name>) and compares. The annulus, its axis (the region's
+/// centre, about which the box widens) and the servo stay: the bed's stiffness under the annulus
+/// depends on its area and the bed's depth, neither of which changes.
+std::vector<NumericalCheck> checkShearAnnulus(const ShearAnnulusScenario &scenario,
+                                              const ShearAnnulusResult &baseline,
+                                              const CheckRequest &request,
+                                              const ShearAnnulusOptions &options);
 
 } // namespace grainlink::lab
