@@ -10,7 +10,9 @@ namespace grainlink::dem {
 
 namespace {
 
-constexpr char kMagic[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '1'};
+// Version 2 adds the contact pass's thread split; version 1 files are still read.
+constexpr char kMagic[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '2'};
+constexpr char kMagicVersion1[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '1'};
 
 class Writer {
 public:
@@ -155,6 +157,7 @@ void writeCheckpoint(const DemSystem &system, const std::string &path,
         w.pod(s.step_offset);
         w.pod(s.time_offset_s);
         w.pod(s.max_overlap_ratio);
+        w.vec(s.contact_split);
         w.pod<std::uint64_t>(extras.size());
         for (const auto &[key, value] : extras) {
             w.text(key);
@@ -176,8 +179,10 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
         throw std::runtime_error("cannot open checkpoint '" + path + "'");
     char magic[8];
     in.read(magic, sizeof magic);
-    if (!in || std::memcmp(magic, kMagic, sizeof magic) != 0)
-        throw std::runtime_error("'" + path + "' is not a grainlink DEM checkpoint (version 1)");
+    const bool version1 = in && std::memcmp(magic, kMagicVersion1, sizeof magic) == 0;
+    if (!in || (!version1 && std::memcmp(magic, kMagic, sizeof magic) != 0))
+        throw std::runtime_error("'" + path +
+                                 "' is not a grainlink DEM checkpoint (version 1 or 2)");
     Reader r(in, path);
     p.setNextId(r.pod<std::uint64_t>());
     r.vec(p.id);
@@ -210,6 +215,8 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
     s.step_offset = r.pod<std::uint64_t>();
     s.time_offset_s = r.pod<double>();
     s.max_overlap_ratio = r.pod<double>();
+    if (!version1)
+        r.vec(s.contact_split);
     CheckpointExtras extras;
     const auto count = r.pod<std::uint64_t>();
     for (std::uint64_t k = 0; k < count; ++k) {
@@ -217,7 +224,7 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
         extras[key] = r.pod<double>();
     }
     in.read(magic, sizeof magic);
-    if (!in || std::memcmp(magic, kMagic, sizeof magic) != 0)
+    if (!in || std::memcmp(magic, version1 ? kMagicVersion1 : kMagic, sizeof magic) != 0)
         throw std::runtime_error("checkpoint '" + path + "' is truncated (no trailer)");
     for (const auto &c : s.contacts)
         if (c.i >= n || c.j >= n)

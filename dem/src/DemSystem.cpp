@@ -162,7 +162,13 @@ void DemSystem::initialise() {
         neighbours_.build(reference_position_, particles_.radius, settings_.skin_m, {}, threads);
         neighbours_.restoreBuildCount(builds);
         updatePlaneMasks();
-        balanceContactWork();
+        // The thread split was estimated from the contacts at the last rebuild, which the
+        // checkpoint no longer has: take the saved one, or the summation order would change.
+        if (restored_split_.size() == std::size_t(threads) + 1 && restored_split_.back() == n)
+            contact_split_ = restored_split_;
+        else
+            balanceContactWork();
+        restored_split_.clear();
     }
     candidates_stale_ = true;
 }
@@ -1127,6 +1133,7 @@ DemSystem::Internals DemSystem::saveInternals() const {
     s.step_offset = step_offset_;
     s.time_offset_s = time_offset_s_;
     s.max_overlap_ratio = max_overlap_ratio_;
+    s.contact_split = contact_split_;
     return s;
 }
 
@@ -1154,6 +1161,7 @@ void DemSystem::restoreInternals(const Internals &s) {
     neighbours_.setPendingContacts(s.contacts);
     neighbours_.restoreBuildCount(s.neighbour_builds);
     forces_valid_ = s.forces_valid;
+    restored_split_ = s.contact_split;
     initialised_ = false;
 }
 

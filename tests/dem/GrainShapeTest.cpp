@@ -463,9 +463,7 @@ TEST_CASE("grain shape: a poured bed comes to rest and a checkpoint continues bi
           "[dem][contact][grain_shape][checkpoint]") {
     // The law's history (the rolling angle) rides in the rolling slot's array, which
     // checkpoints already carry: a restart at 0.2 s must continue bit for bit (pair and plane
-    // contacts, re-sorts between checkpoint and end). One thread: with two, this settled bed
-    // restarts to round-off differences under every rolling law, none included, a restart
-    // issue outside this law (the contact pass's thread split is not restored). The grains
+    // contacts, re-sorts between checkpoint and end), with two threads. The grains
     // must also come to rest (a law that created energy would keep the bed boiling): kinetic
     // energy at 0.6 s below 1e-3 of the potential energy the fall released. Measured 2.4e-5,
     // falling from 1e-4 at 0.2 s with spikes up to 2e-4 where a grain tips onto its next face;
@@ -476,12 +474,12 @@ TEST_CASE("grain shape: a poured bed comes to rest and a checkpoint continues bi
     fs::create_directories(dir);
     const std::string file = (dir / "state.bin").string();
 
-    auto straight = shapedBed(1);
+    auto straight = shapedBed(2);
     const double potential_start = straight->energies().gravitational_J;
     straight->run(2000);
     writeCheckpoint(*straight, file);
     straight->run(2000);
-    auto resumed = shapedBed(1);
+    auto resumed = shapedBed(2);
     readCheckpoint(*resumed, file);
     resumed->run(2000);
     fs::remove_all(dir);

@@ -162,6 +162,7 @@ private:
     };
     std::vector<PlaneCandidate> plane_candidates_; ///< the masks as a list, in particle order
     std::vector<std::size_t> contact_split_; ///< thread t owns particles [split[t], split[t+1])
+    std::vector<std::size_t> restored_split_; ///< from a checkpoint, used once at initialise
     double max_displacement_sq_ = 0.0, max_mesh_displacement_sq_ = 0.0;
     bool displacement_known_ = false;
     CellGrid mesh_grid_;
@@ -211,6 +212,8 @@ struct DemSystem::Internals {
     std::uint64_t step_offset = 0; ///< clock: t = time_offset + (step - step_offset) dt
     double time_offset_s = 0.0;
     double max_overlap_ratio = 0.0;
+    /// Contact-pass thread split (thread count + 1 entries); empty in version-1 checkpoints.
+    std::vector<std::size_t> contact_split;
 };
 
 } // namespace grainlink::dem
