@@ -2,6 +2,7 @@
 #include "grainlink/lab/DirectShear.hpp"
 
 #include "TextEdit.hpp"
+#include "TinyShearBox.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -15,44 +16,12 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// ~420 grains of 2-2.25 mm in a 30 x 30 mm box (L / d = 7), the shear plane 12 mm up,
-/// sheared 3 mm at 20 mm/s under 4 and 12 kPa (smooth frames and plate).
-const char *kTiny = R"(name: tiny-shear
-soil:
-  simulation: {time_step_s: 5.0e-5, threads: 1}
-  material: {youngs_modulus_Pa: 2.7e7, poisson_ratio: 0.2, density_kg_m3: 2400}
-  contact:
-    damping: {model: viscous, coefficient_N_s_m: 0.2}
-    tangential: {model: linear, stiffness_N_m: 300, damping_N_s_m: 0.03, stick_angle_deg: 30, slip_angle_deg: 30}
-    rolling: {model: grain_shape, aspect_ratio_angle_deg: 20}
-  deposition:
-    region: {lower_m: [0, 0, 0], upper_m: [0.03, 0.03, 0.1]}
-    count: 420
-    radius: {distribution: uniform, min_m: 0.002, max_m: 0.00225}
-    seed: 3
-    settle_kinetic_energy_J: 1.0e-8
-    max_settle_time_s: 0.4
-  packing_cache_directory: ""
-direct_shear:
-  length_m: 0.03
-  width_m: 0.03
-  lower_height_m: 0.012
-  upper_height_m: 0.03
-  normal_stresses_Pa: [4000, 12000]
-  shear_speed_m_s: 0.02
-  max_displacement_m: 0.003
-  sample_interval_s: 0.002
-  fit_cohesion: false
-  wall_friction_coefficient: 0
-  servo: {gain_m_s_per_N: 1.0e-2, max_speed_m_s: 0.05, control_interval_s: 0.00025}
-)";
-
 lab::DirectShearScenario parse(const std::string &text) {
     return lab::parseDirectShear(config::ConfigNode::loadString(text, "direct_shear.yaml"));
 }
 
 std::string edited(const std::string &from, const std::string &to) {
-    return replacedOnce(kTiny, from, to);
+    return replacedOnce(kTinyShearBox, from, to);
 }
 
 std::string errorOf(const std::string &text) {
@@ -112,7 +81,7 @@ TEST_CASE("Mohr-Coulomb fit: standard errors as the textbook line fit", "[lab][d
 }
 
 TEST_CASE("Direct shear input errors name the key", "[lab][direct_shear]") {
-    CHECK_NOTHROW(parse(kTiny));
+    CHECK_NOTHROW(parse(kTinyShearBox));
     CHECK_THAT(errorOf(edited("  packing_cache_directory: \"\"\n",
                               "  packing_cache_directory: \"\"\n  walls: []\n")),
                Contains("remove soil.walls"));
@@ -127,7 +96,7 @@ TEST_CASE("Direct shear input errors name the key", "[lab][direct_shear]") {
 
 TEST_CASE("Direct shear on a tiny box: the servo holds sigma and strength grows with it",
           "[lab][direct_shear][dem]") {
-    const auto scenario = parse(kTiny);
+    const auto scenario = parse(kTinyShearBox);
     const auto result = lab::runDirectShear(scenario, {});
     REQUIRE(result.runs.size() == 2);
     for (const auto &run : result.runs) {
@@ -158,7 +127,7 @@ TEST_CASE("Direct shear: frictionless spheres are much weaker than phi = 30 deg 
           "[lab][direct_shear][dem]") {
     // Same box, stresses and packing procedure; phi = 0 with no rolling resistance against
     // phi = 30 deg with grain-shape rolling resistance.
-    const auto rough = lab::runDirectShear(parse(kTiny), {});
+    const auto rough = lab::runDirectShear(parse(kTinyShearBox), {});
     const auto smooth = lab::runDirectShear(
         parse(edited("stick_angle_deg: 30, slip_angle_deg: 30}\n    rolling: {model: "
                      "grain_shape, aspect_ratio_angle_deg: 20}",

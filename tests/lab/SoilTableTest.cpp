@@ -1,12 +1,17 @@
 // Soil lookup table and its inversion (docs/lab.md, physics.md §12.16).
 #include "grainlink/lab/SoilTable.hpp"
 
+#include "grainlink/lab/DirectShear.hpp"
+
+#include "TinyShearBox.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <string>
 
 using namespace grainlink;
@@ -122,5 +127,57 @@ TEST_CASE("Soil table file: written rows read back; a gap in the grid is an erro
     rows.erase(rows.begin() + 5);
     CHECK_THROWS_WITH(lab::soilTableFromRows(rows, "gappy.csv"),
                       Contains("gappy.csv") && Contains("phi = 20") && Contains("gamma = 10"));
+    std::filesystem::remove_all(dir);
+}
+
+TEST_CASE("Grain parameters of a table point: stick = slip = phi, gamma 0 is the sphere",
+          "[lab][soil_table]") {
+    const auto base =
+        lab::parseDirectShear(config::ConfigNode::loadString(kTinyShearBox, "direct_shear.yaml"))
+            .soil;
+    const auto shaped = lab::soilWithGrainParameters(base, 12.0, 35.0);
+    const auto &t = std::get<dem::TangentialLinear>(shaped.law.tangential);
+    CHECK(t.stick_angle_deg == 12.0);
+    CHECK(t.slip_angle_deg == 12.0);
+    const auto &r = std::get<dem::RollingGrainShape>(shaped.law.rolling);
+    CHECK(r.aspect_ratio_angle_deg == dem::Vec3::Constant(35.0));
+    CHECK(std::holds_alternative<dem::RollingNone>(
+        lab::soilWithGrainParameters(base, 12.0, 0.0).law.rolling));
+    // A different law gives a different packing: the cache must not mix them up.
+    CHECK(dem::packingKey(shaped) != dem::packingKey(base));
+}
+
+TEST_CASE("Soil table generated on the tiny box reads back and inverts", "[lab][soil_table][dem]") {
+    // Two friction angles (0 and 30 deg) at gamma 20 deg on the tiny direct-shear box, no
+    // repose test. The run writes the table; it must read back with the regenerate command in
+    // its header. psi must rise with phi by more than 5 deg: measured 17.5 deg at phi 0 (the same
+    // as the frictionless spheres of DirectShearTest to 1e-10: without tangential forces the
+    // grain-shape law has nothing to resist) and 36.9 deg at phi 30. The inversion of the
+    // mean psi must land at the middle phi (psi is linear between two nodes).
+    const auto dir = std::filesystem::temp_directory_path() / "grainlink_soil_table_run";
+    std::filesystem::create_directories(dir);
+    std::ofstream(dir / "shear.yaml") << kTinyShearBox;
+    std::ofstream(dir / "spec.yaml") << "direct_shear: shear.yaml\n"
+                                        "friction_angles_deg: [0, 30]\n"
+                                        "aspect_ratio_angles_deg: [20]\n";
+    const auto spec = lab::loadSoilTableSpec((dir / "spec.yaml").string());
+    CHECK(spec.direct_shear_path == (dir / "shear.yaml").string());
+    lab::SoilTableOptions options;
+    options.output_csv = (dir / "table.csv").string();
+    options.command_line = "grainlink soil-table spec.yaml --out table.csv";
+    const auto rows = lab::generateSoilTable(spec, options);
+    REQUIRE(rows.size() == 2);
+    CHECK(rows[1].psi_deg > rows[0].psi_deg + 5.0);
+    CHECK(std::isnan(rows[0].repose_deg));
+    std::ifstream csv(options.output_csv);
+    const std::string text((std::istreambuf_iterator<char>(csv)), {});
+    CHECK_THAT(text, Contains("# regenerate: grainlink soil-table spec.yaml --out table.csv"));
+    const auto table = lab::readSoilTable(options.output_csv);
+    const double mid = 0.5 * (rows[0].psi_deg + rows[1].psi_deg);
+    const auto inv = lab::invertSoilTable(table, mid);
+    // psi is linear in phi between the two nodes: the middle psi sits at the middle phi.
+    CHECK(inv.chosen.phi_deg == Approx(15.0).margin(1e-9));
+    CHECK(inv.chosen.gamma_deg == 20.0);
+    CHECK_FALSE(inv.phi_from_resolution_deg); // two phi nodes: no curvature estimate
     std::filesystem::remove_all(dir);
 }
