@@ -158,6 +158,11 @@ DirectShearScenario parseDirectShear(const config::ConfigNode &root) {
         if (t.servo_deadband_N < 0.0)
             servo["deadband_N"].fail("must be >= 0");
     }
+    if (servo.has("integral_gain_m_s2_per_N")) {
+        t.servo_integral_gain_m_s2_per_N = servo["integral_gain_m_s2_per_N"].number();
+        if (t.servo_integral_gain_m_s2_per_N < 0.0)
+            servo["integral_gain_m_s2_per_N"].fail("must be >= 0");
+    }
     if (servo.has("control_interval_s"))
         t.control_interval_s = servo["control_interval_s"].positive();
     if (servo.has("tolerance"))
@@ -326,6 +331,7 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
     servo.gain_m_s_per_N = t.servo_gain_m_s_per_N;
     servo.max_speed_m_s = t.servo_max_speed_m_s;
     servo.deadband_N = t.servo_deadband_N;
+    servo.integral_gain_m_s2_per_N = t.servo_integral_gain_m_s2_per_N;
     servo.validate();
     const auto control_steps = std::max<std::uint64_t>(1, std::llround(t.control_interval_s / dt));
     const double control_dt = double(control_steps) * dt;
@@ -342,9 +348,10 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
         // Servo on the top plate's vertical speed, physics.md §12.11.
         motion->plate_z_ref_m = motion->plateZ(sys.time());
         motion->plate_t_ref_s = sys.time();
-        // Until the plate touches the bed it comes down at the servo's top speed.
+        // Until the plate touches the bed it comes down at the servo's top speed; then the
+        // proportional-integral law (integral gain 0: proportional alone).
         motion->plate_vz_m_s =
-            r.plate_N.z() > 0.0 ? servo.verticalVelocity(r.plate_N.z()) : -servo.max_speed_m_s;
+            r.plate_N.z() > 0.0 ? -servo.update(r.plate_N.z(), control_dt) : -servo.max_speed_m_s;
         return r;
     };
 

@@ -33,7 +33,8 @@ struct DirectShearSpec {
     double servo_gain_m_s_per_N = 0.0;
     double servo_max_speed_m_s = 0.0;
     double servo_deadband_N = 0.0;
-    double control_interval_s = 0.0005;    ///< [s] servo update period
+    double servo_integral_gain_m_s2_per_N = 0.0; ///< [m/(s^2 N)] 0: proportional only
+    double control_interval_s = 0.0005;          ///< [s] servo update period
     double consolidation_tolerance = 0.05; ///< [-] |N - N_target| / N_target to start shearing
     double consolidation_hold_s = 0.02;    ///< [s] ... held this long
     double max_consolidation_time_s = 0.3; ///< [s] else the run stops with an error
