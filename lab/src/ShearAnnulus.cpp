@@ -394,6 +394,7 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
     const auto steps_per_sample =
         std::max<std::uint64_t>(1, std::llround(t.sample_interval_s / dt));
     const double area = g.area_m2(), torque_factor = g.torqueFactor_m3(), r_mean = g.meanRadius_m();
+    const double interval_s = double(steps_per_sample) * dt; // the servo's real interval
 
     for (double pressure : t.normal_pressures_Pa) {
         const auto run_start = std::chrono::steady_clock::now();
@@ -463,7 +464,7 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
             progress.update(sys.time() - t0, 0.0, run.steps * sys.particles().size(),
                             "approach, F " + std::to_string(s.force_N) + " N");
             if (s.force_N >= run.target_force_N) {
-                drive->retarget(sys.time(), -servo.update(s.force_N, t.sample_interval_s), 0.0);
+                drive->retarget(sys.time(), -servo.update(s.force_N, interval_s), 0.0);
                 break;
             }
             if (sys.time() - t0 > t.max_load_time_s) {
@@ -482,7 +483,7 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
         const double hold_end = sys.time() + t.load_hold_s;
         while (sys.time() < hold_end - 0.5 * dt) {
             const Interval s = interval();
-            drive->retarget(sys.time(), -servo.update(s.force_N, t.sample_interval_s), 0.0);
+            drive->retarget(sys.time(), -servo.update(s.force_N, interval_s), 0.0);
         }
         run.load_time_s = sys.time() - t0;
         run.sinkage_at_load_m = surface - (drive->z(sys.time()) - g.grouser_height_m);
@@ -493,7 +494,7 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
         double err2 = 0.0;
         for (;;) {
             const Interval s = interval();
-            drive->retarget(sys.time(), -servo.update(s.force_N, t.sample_interval_s),
+            drive->retarget(sys.time(), -servo.update(s.force_N, interval_s),
                             t.angular_speed_rad_s);
             ShearSample x;
             x.time_s = s.t_mid_s - t_shear;

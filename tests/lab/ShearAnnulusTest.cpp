@@ -194,8 +194,8 @@ TEST_CASE("Shear annulus on a tiny bed: load held, tau(j) rises and saturates, h
         // the steady sinkage of the shearing annulus, which a proportional servo would lag by
         // v / gain (~10 % of the load here). So: the mean normal pressure while shearing
         // within 5 % of the target, the rms deviation of the 1 ms means (grains rattle; the
-        // rotation's start makes the bed yield) below 12 %. Written: 995.6 and 2004.4 Pa,
-        // rms 6.3 % and 4.5 %.
+        // rotation's start makes the bed yield) below 12 %. Written: 1000.3 and 2001.7 Pa,
+        // rms 6.0 % and 2.4 %.
         CHECK(run.mean_pressure_Pa == Approx(run.target_pressure_Pa).epsilon(0.05));
         CHECK(run.rms_load_error < 0.12);
         // tau(j) rises: the mean over the first 10 % of j is below 3/4 of the mean over the
@@ -209,7 +209,7 @@ TEST_CASE("Shear annulus on a tiny bed: load held, tau(j) rises and saturates, h
         CHECK(std::abs(q4 - q3) < 0.2 * late);
     }
     // Twice the normal pressure, a clearly higher strength: tau_max at 2 kPa above 1.3 x that
-    // at 1 kPa (written: 766 and 1235 Pa, 1.61 x; the fit c = 205 Pa, phi = 22.6 deg).
+    // at 1 kPa (written: 735 and 1256 Pa, 1.71 x; the fit c = 155 Pa, phi = 24.3 deg).
     CHECK(result.runs[1].max_shear_stress_Pa > 1.3 * result.runs[0].max_shear_stress_Pa);
     REQUIRE(result.fit);
     WARN(result.report());
@@ -223,7 +223,7 @@ TEST_CASE("Shear annulus: frictionless grains carry a much smaller tau_max than 
           "[lab][shear_annulus]") {
     // Same bed and load (1 kPa); frictionless grains without rolling resistance (the annulus
     // takes the grains' friction, so it is frictionless too) resist only through the grousers
-    // pushing grains aside. Written: 300 Pa against 766 Pa (ratio 0.39); required below 0.6,
+    // pushing grains aside. Written: 195 Pa against 735 Pa (ratio 0.26); required below 0.6,
     // which a frictionless bed that still carried 60 % of the frictional strength would fail.
     auto one = [](const std::string &text) {
         auto scenario = parse(text);
