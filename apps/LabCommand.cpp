@@ -2,8 +2,10 @@
 #include "LabCommands.hpp"
 
 #include "grainlink/lab/Bevameter.hpp"
+#include "grainlink/lab/DirectShear.hpp"
 #include "grainlink/lab/NumericalChecks.hpp"
 #include "grainlink/lab/Repose.hpp"
+#include "grainlink/lab/ShearAnnulus.hpp"
 
 #include <cstdio>
 #include <stdexcept>
@@ -59,8 +61,41 @@ int runLab(const LabOptions &options) {
             reportChecks(lab::checkRepose(scenario, result, check, run), run.output_directory);
         return 0;
     }
+    if (options.test == "direct_shear") {
+        const auto scenario = lab::loadDirectShear(options.scenario_path);
+        lab::DirectShearOptions run;
+        run.output_directory =
+            options.output_directory.empty() ? "out/" + scenario.name : options.output_directory;
+        run.progress_interval_s = options.progress_interval_s;
+        const auto result = lab::runDirectShear(scenario, run);
+        std::printf("%s", result.report().c_str());
+        std::printf("written: %s/{shear_curves.csv,mohr_coulomb.csv,report.txt}; plot with "
+                    "tools/plot_lab.py %s\n",
+                    run.output_directory.c_str(), run.output_directory.c_str());
+        if (check.any())
+            reportChecks(lab::checkDirectShear(scenario, result, check, run),
+                         run.output_directory);
+        return 0;
+    }
+    if (options.test == "bevameter_shear") {
+        const auto scenario = lab::loadShearAnnulus(options.scenario_path);
+        lab::ShearAnnulusOptions run;
+        run.output_directory =
+            options.output_directory.empty() ? "out/" + scenario.name : options.output_directory;
+        run.progress_interval_s = options.progress_interval_s;
+        const auto result = lab::runShearAnnulus(scenario, run);
+        std::printf("%s", result.report().c_str());
+        std::printf("written: %s/{shear_displacement.csv,janosi_fit.csv,report.txt}; plot with "
+                    "tools/plot_lab.py %s\n",
+                    run.output_directory.c_str(), run.output_directory.c_str());
+        if (check.any())
+            reportChecks(lab::checkShearAnnulus(scenario, result, check, run),
+                         run.output_directory);
+        return 0;
+    }
     throw std::invalid_argument("lab test '" + options.test +
-                                "' is not implemented; available: bevameter, repose");
+                                "' is not implemented; available: bevameter, repose, direct_shear, "
+                                "bevameter_shear");
 }
 
 } // namespace grainlink::apps

@@ -13,6 +13,17 @@ namespace grainlink::apps {
 namespace fs = std::filesystem;
 
 int runParams(const ParamsOptions &options) {
+    if (options.friction_angle_deg) {
+        if (!options.input_path.empty())
+            throw std::invalid_argument("give either a soil description file or "
+                                        "--friction-angle, not both");
+        return runTableInversion(options);
+    }
+    if (options.repose_angle_deg)
+        throw std::invalid_argument("--repose-angle needs --friction-angle");
+    if (options.input_path.empty())
+        throw std::invalid_argument("give a soil description file (docs/lab.md) or "
+                                    "--friction-angle PSI");
     const auto description = lab::loadSoilTestDescription(options.input_path);
     const auto matrix = lab::estimateParameters(description);
     const fs::path out =

@@ -62,16 +62,34 @@ int main(int argc, char **argv) {
     grainlink::apps::ParamsOptions params_options;
     auto *params = app.add_subcommand(
         "params", "derive DEM parameters from a soil and test description (docs/lab.md)");
-    params->add_option("description", params_options.input_path, "soil and test YAML")
-        ->required();
+    params->add_option("description", params_options.input_path, "soil and test YAML");
+    params->add_option("--friction-angle", params_options.friction_angle_deg,
+                       "instead of a description: propose (phi, gamma) for this macroscopic "
+                       "friction angle [deg] from the soil table");
+    params->add_option("--repose-angle", params_options.repose_angle_deg,
+                       "with --friction-angle: also match this angle of repose [deg]");
+    params->add_option("--table", params_options.table_path,
+                       "soil table CSV (default data/soil_table.csv)");
     params->add_option("--out", params_options.output_path,
                        "matrix file, .yaml or .csv (default out/params/<name>.yaml)");
 
+    grainlink::apps::SoilTableCommandOptions table_options;
+    auto *soil_table = app.add_subcommand(
+        "soil-table", "run the direct shear (and repose) test over a (phi, gamma) grid and write "
+                      "the lookup table (docs/lab.md)");
+    soil_table->add_option("spec", table_options.spec_path, "table spec YAML")->required();
+    soil_table->add_option("--out", table_options.output_path, "table CSV")->required();
+    soil_table->add_option("--runs", table_options.runs_directory,
+                           "keep each grid point's lab outputs under this directory");
+    soil_table->add_option("--progress-interval", table_options.progress_interval_s,
+                           "seconds between progress lines");
+
     grainlink::apps::LabOptions lab_options;
     auto *lab = app.add_subcommand("lab", "virtual soil laboratory test (docs/lab.md)");
-    lab->add_option("test", lab_options.test, "the test: bevameter or repose")
+    lab->add_option("test", lab_options.test,
+                    "the test: bevameter, repose, direct_shear or bevameter_shear")
         ->required()
-        ->check(CLI::IsMember({"bevameter", "repose"}));
+        ->check(CLI::IsMember({"bevameter", "repose", "direct_shear", "bevameter_shear"}));
     lab->add_option("scenario", lab_options.scenario_path, "lab scenario YAML")->required();
     lab->add_option("--out", lab_options.output_directory, "output directory (default out/<name>)");
     lab->add_option("--progress-interval", lab_options.progress_interval_s,
@@ -130,6 +148,8 @@ int main(int argc, char **argv) {
             return grainlink::apps::exportWheelStl(scenario_path, stl_path, stl_binary);
         } else if (params->parsed()) {
             return grainlink::apps::runParams(params_options);
+        } else if (soil_table->parsed()) {
+            return grainlink::apps::runSoilTable(table_options);
         } else if (lab->parsed()) {
             return grainlink::apps::runLab(lab_options);
         } else if (keygen->parsed()) {
