@@ -2,6 +2,7 @@
 
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/lab/LabBed.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -21,10 +22,6 @@ using dem::Vec3;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-double seconds(std::chrono::steady_clock::time_point since) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
 
 /// Flat closed disc of radius R and thickness t, axis z, bottom face at z = 0.
 dem::TriangleMesh plateMesh(double radius_m, double thickness_m, int segments) {
@@ -78,12 +75,7 @@ BevameterScenario parseBevameter(const config::ConfigNode &root) {
         t.sample_interval_s = b["sample_interval_s"].positive();
     if (b.has("min_resolution"))
         t.min_resolution = b["min_resolution"].positive();
-    if (auto c = b.optional("centre_m")) {
-        const auto xy = c->numbers();
-        if (xy.size() != 2)
-            c->fail("expected [x, y]");
-        t.centre_m = Eigen::Vector2d(xy[0], xy[1]);
-    }
+    t.centre_m = parseCentre(b);
     if (b.has("fit_min_sinkage_m"))
         t.fit_min_sinkage_m = b["fit_min_sinkage_m"].number();
     b.finish();
@@ -122,22 +114,21 @@ BevameterResult runBevameter(const BevameterScenario &scenario, const BevameterO
     const auto start = std::chrono::steady_clock::now();
     const BevameterSpec &t = scenario.test;
     BevameterResult result;
-    auto base =
-        dem::prepareSoil(scenario.soil, options.progress_interval_s, &result.packing_from_cache);
-    result.preparation_wall_s = seconds(start);
-    result.particles = base->particles().size();
-    result.largest_radius_m = scenario.soil.deposition.radius.largest();
-    result.time_step_s = base->settings().time_step_s;
-    const double surface = dem::bedSurface(base->particles());
+    const LabBed bed = prepareLabBed(scenario.soil, options.progress_interval_s);
+    result.packing_from_cache = bed.from_cache;
+    result.preparation_wall_s = bed.preparation_wall_s;
+    result.particles = bed.particles;
+    result.largest_radius_m = bed.largest_radius_m;
+    result.time_step_s = bed.time_step_s;
+    const double surface = bed.surface_m;
     const Vec3 lower = scenario.soil.deposition.region_lower_m;
     const Vec3 upper = scenario.soil.deposition.region_upper_m;
-    const Eigen::Vector2d centre = t.centre_m.value_or(
-        Eigen::Vector2d(0.5 * (lower.x() + upper.x()), 0.5 * (lower.y() + upper.y())));
-    const double dt = base->settings().time_step_s;
+    const Eigen::Vector2d centre = testCentre(scenario.soil, t.centre_m);
+    const double dt = bed.time_step_s;
 
     for (double radius : t.plate_radii_m) {
         const auto plate_start = std::chrono::steady_clock::now();
-        dem::DemSystem sys = *base; // every plate presses into the same settled bed
+        dem::DemSystem sys = *bed.system; // every plate presses into the same settled bed
         PlateRun run;
         run.plate_radius_m = radius;
         run.resolution = radius / result.largest_radius_m;
@@ -150,14 +141,7 @@ BevameterResult runBevameter(const BevameterScenario &scenario, const BevameterO
         const double thickness = t.plate_thickness_m > 0.0 ? t.plate_thickness_m : 0.2 * radius;
         // Start above every grain under the plate (the surface is a percentile: a few grains
         // stick out of it), so the plate never appears inside a grain.
-        double highest = surface;
-        const auto &grains = sys.particles();
-        for (std::size_t i = 0; i < grains.size(); ++i) {
-            const Vec3 &x = grains.position[i];
-            const double reach = radius + grains.radius[i];
-            if (std::hypot(x.x() - centre.x(), x.y() - centre.y()) < reach)
-                highest = std::max(highest, x.z() + grains.radius[i]);
-        }
+        const double highest = highestGrainUnder(sys.particles(), centre, radius, surface);
         dem::RigidBodyState initial;
         initial.position_m = Vec3(centre.x(), centre.y(), highest + t.start_clearance_m);
         initial.velocity_m_s = Vec3(0.0, 0.0, -t.speed_m_s);
@@ -201,7 +185,7 @@ BevameterResult runBevameter(const BevameterScenario &scenario, const BevameterO
                 "sinkage " + mm(s.sinkage_m) + ", p " + std::to_string(s.pressure_Pa) + " Pa");
         }
         run.steps = done;
-        run.wall_s = seconds(plate_start);
+        run.wall_s = secondsSince(plate_start);
         std::fprintf(stderr, "[bevameter] R = %s: %llu steps in %.1f s, p(%s) = %.4g Pa\n",
                      mm(radius).c_str(), static_cast<unsigned long long>(done), run.wall_s,
                      mm(run.samples.back().sinkage_m).c_str(), run.samples.back().pressure_Pa);
@@ -216,7 +200,7 @@ BevameterResult runBevameter(const BevameterScenario &scenario, const BevameterO
     } catch (const std::invalid_argument &e) {
         result.fit_note = e.what();
     }
-    result.wall_s = seconds(start);
+    result.wall_s = secondsSince(start);
     if (!options.output_directory.empty())
         writeBevameterOutputs(result, options.output_directory);
     return result;

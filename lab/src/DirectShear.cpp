@@ -3,6 +3,7 @@
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
+#include "grainlink/lab/LabBed.hpp"
 
 #include <Eigen/Dense>
 
@@ -27,10 +28,6 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = 180.0 / kPi;
-
-double seconds(std::chrono::steady_clock::time_point since) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
 
 /// Open rectangular frame [0, L] x [0, W] x [0, h] (four side walls, no floor or lid) plus a
 /// horizontal lip y in [0, W], x in [lip_x0, lip_x1] at z = lip_z: the lip stands in for the wall
@@ -449,7 +446,7 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
         run.residual_shear_stress_Pa /= residual_n;
         run.residual_normal_stress_Pa /= residual_n;
     }
-    run.wall_s = seconds(start);
+    run.wall_s = secondsSince(start);
     std::fprintf(stderr,
                  "[direct shear] sigma = %s: loaded in %.3f s, peak tau %s at d = %.2f mm, "
                  "residual %s; %.1f s wall\n",
@@ -466,14 +463,14 @@ DirectShearResult runDirectShear(const DirectShearScenario &scenario,
     const auto start = std::chrono::steady_clock::now();
     const DirectShearSpec &t = scenario.test;
     DirectShearResult result;
-    auto base = dem::prepareSoil(boxedSoil(scenario.soil, t), options.progress_interval_s,
-                                 &result.packing_from_cache);
-    result.preparation_wall_s = seconds(start);
-    const auto &grains = base->particles();
-    result.particles = grains.size();
-    result.largest_radius_m = scenario.soil.deposition.radius.largest();
-    result.time_step_s = base->settings().time_step_s;
-    result.bed_height_m = dem::bedSurface(grains);
+    const LabBed bed = prepareLabBed(boxedSoil(scenario.soil, t), options.progress_interval_s);
+    result.packing_from_cache = bed.from_cache;
+    result.preparation_wall_s = bed.preparation_wall_s;
+    const auto &grains = bed.system->particles();
+    result.particles = bed.particles;
+    result.largest_radius_m = bed.largest_radius_m;
+    result.time_step_s = bed.time_step_s;
+    result.bed_height_m = bed.surface_m;
     // Bulk density of the settled bed, docs/physics.md §12.15.
     double mass = 0.0;
     for (double m : grains.mass)
@@ -487,7 +484,7 @@ DirectShearResult runDirectShear(const DirectShearScenario &scenario,
             std::to_string(t.lower_height_m) + " m); deposit more grains or lower lower_height_m");
 
     for (double sigma : t.normal_stresses_Pa)
-        result.runs.push_back(shearOnce(*base, t, sigma, options.progress_interval_s));
+        result.runs.push_back(shearOnce(*bed.system, t, sigma, options.progress_interval_s));
 
     std::vector<double> s_peak, t_peak, s_res, t_res;
     for (const auto &r : result.runs) {
@@ -502,7 +499,7 @@ DirectShearResult runDirectShear(const DirectShearScenario &scenario,
     } catch (const std::invalid_argument &e) {
         result.fit_note = e.what();
     }
-    result.wall_s = seconds(start);
+    result.wall_s = secondsSince(start);
     if (!options.output_directory.empty())
         writeDirectShearOutputs(result, options.output_directory);
     return result;

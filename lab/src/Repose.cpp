@@ -3,6 +3,7 @@
 #include "grainlink/dem/Deposition.hpp"
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
+#include "grainlink/lab/LabBed.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -70,21 +71,14 @@ ReposeScenario parseRepose(const config::ConfigNode &root) {
         t.max_settle_time_s = r["max_settle_time_s"].positive();
     if (r.has("bin_width_m"))
         t.bin_width_m = r["bin_width_m"].positive();
-    if (auto c = r.optional("centre_m")) {
-        const auto xy = c->numbers();
-        if (xy.size() != 2)
-            c->fail("expected [x, y]");
-        t.centre_m = Eigen::Vector2d(xy[0], xy[1]);
-    }
+    t.centre_m = parseCentre(r);
     r.finish();
     if (!s.soil.bodies.empty())
         root["soil"]["bodies"].fail("the repose test adds its own tube; remove soil.bodies");
 
     // The grains are inserted inside the tube: every corner of the region must be.
     const auto &d = s.soil.deposition;
-    const Eigen::Vector2d centre =
-        t.centre_m.value_or(Eigen::Vector2d(0.5 * (d.region_lower_m.x() + d.region_upper_m.x()),
-                                            0.5 * (d.region_lower_m.y() + d.region_upper_m.y())));
+    const Eigen::Vector2d centre = testCentre(s.soil, t.centre_m);
     double far = 0.0;
     for (double x : {d.region_lower_m.x(), d.region_upper_m.x()})
         for (double y : {d.region_lower_m.y(), d.region_upper_m.y()})
@@ -172,9 +166,7 @@ ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &opti
     const auto start = std::chrono::steady_clock::now();
     const ReposeSpec &t = scenario.test;
     const auto &d = scenario.soil.deposition;
-    const Eigen::Vector2d centre =
-        t.centre_m.value_or(Eigen::Vector2d(0.5 * (d.region_lower_m.x() + d.region_upper_m.x()),
-                                            0.5 * (d.region_lower_m.y() + d.region_upper_m.y())));
+    const Eigen::Vector2d centre = testCentre(scenario.soil, t.centre_m);
     auto sys = dem::makeSystem(scenario.soil);
     const double dt = sys->settings().time_step_s;
 
@@ -233,7 +225,7 @@ ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &opti
     result.largest_radius_m = d.radius.largest();
     measureHeap(p.position, p.radius, centre,
                 t.bin_width_m > 0.0 ? t.bin_width_m : 2.0 * result.largest_radius_m, result);
-    result.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.wall_s = secondsSince(start);
     if (!options.output_directory.empty())
         writeReposeOutputs(result, options.output_directory);
     return result;

@@ -3,6 +3,7 @@
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
+#include "grainlink/lab/LabBed.hpp"
 #include "grainlink/lab/LoadServo.hpp"
 
 #include <algorithm>
@@ -24,10 +25,6 @@ using dem::Vec3;
 namespace {
 
 constexpr double kPi = 3.14159265358979323846;
-
-double seconds(std::chrono::steady_clock::time_point since) {
-    return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
 
 /// Appends the quad (a, b, c, d) as two triangles whose normals point along `outward`.
 void appendQuad(dem::TriangleMesh &mesh, int a, int b, int c, int d, const Vec3 &outward) {
@@ -332,12 +329,7 @@ ShearAnnulusScenario parseShearAnnulus(const config::ConfigNode &root) {
     }
     if (b.has("min_resolution"))
         t.min_resolution = b["min_resolution"].positive();
-    if (auto c = b.optional("centre_m")) {
-        const auto xy = c->numbers();
-        if (xy.size() != 2)
-            c->fail("expected [x, y]");
-        t.centre_m = Eigen::Vector2d(xy[0], xy[1]);
-    }
+    t.centre_m = parseCentre(b);
     b.finish();
     if (!s.soil.bodies.empty())
         root["soil"]["bodies"].fail("the shear test adds its own annulus; remove soil.bodies");
@@ -377,19 +369,18 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
     const AnnulusGeometry &g = t.annulus;
     ShearAnnulusResult result;
     result.annulus = g;
-    auto base =
-        dem::prepareSoil(scenario.soil, options.progress_interval_s, &result.packing_from_cache);
-    result.preparation_wall_s = seconds(start);
-    result.particles = base->particles().size();
-    result.largest_radius_m = scenario.soil.deposition.radius.largest();
+    const LabBed bed = prepareLabBed(scenario.soil, options.progress_interval_s);
+    result.packing_from_cache = bed.from_cache;
+    result.preparation_wall_s = bed.preparation_wall_s;
+    result.particles = bed.particles;
+    result.largest_radius_m = bed.largest_radius_m;
     result.resolution = (g.outer_radius_m - g.inner_radius_m) / (2.0 * result.largest_radius_m);
-    const double dt = base->settings().time_step_s;
+    const double dt = bed.time_step_s;
     result.time_step_s = dt;
-    const double surface = dem::bedSurface(base->particles());
+    const double surface = bed.surface_m;
     const Vec3 lower = scenario.soil.deposition.region_lower_m;
     const Vec3 upper = scenario.soil.deposition.region_upper_m;
-    const Eigen::Vector2d centre = t.centre_m.value_or(
-        Eigen::Vector2d(0.5 * (lower.x() + upper.x()), 0.5 * (lower.y() + upper.y())));
+    const Eigen::Vector2d centre = testCentre(scenario.soil, t.centre_m);
     const dem::TriangleMesh mesh = makeShearAnnulus(g);
     const auto steps_per_sample =
         std::max<std::uint64_t>(1, std::llround(t.sample_interval_s / dt));
@@ -398,7 +389,7 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
 
     for (double pressure : t.normal_pressures_Pa) {
         const auto run_start = std::chrono::steady_clock::now();
-        dem::DemSystem sys = *base; // every pressure shears its own copy of the settled bed
+        dem::DemSystem sys = *bed.system; // every pressure shears its own copy of the settled bed
         ShearRun run;
         run.target_pressure_Pa = pressure;
         run.target_force_N = pressure * area;
@@ -407,14 +398,8 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
             {centre.x() - g.outer_radius_m - lower.x(), upper.x() - centre.x() - g.outer_radius_m,
              centre.y() - g.outer_radius_m - lower.y(), upper.y() - centre.y() - g.outer_radius_m});
         // Grouser tips start above every grain under the annulus.
-        double highest = surface;
-        const auto &grains = sys.particles();
-        for (std::size_t i = 0; i < grains.size(); ++i) {
-            const Vec3 &x = grains.position[i];
-            if (std::hypot(x.x() - centre.x(), x.y() - centre.y()) <
-                g.outer_radius_m + grains.radius[i])
-                highest = std::max(highest, x.z() + grains.radius[i]);
-        }
+        const double highest =
+            highestGrainUnder(sys.particles(), centre, g.outer_radius_m, surface);
         auto drive = std::make_shared<AnnulusDrive>();
         drive->initial.position_m =
             Vec3(centre.x(), centre.y(), highest + t.start_clearance_m + g.grouser_height_m);
@@ -529,7 +514,7 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
                 sum += run.samples[k].shear_stress_Pa;
             run.max_shear_stress_Pa = std::max(run.max_shear_stress_Pa, sum / double(w));
         }
-        run.wall_s = seconds(run_start);
+        run.wall_s = secondsSince(run_start);
         std::fprintf(stderr,
                      "[bevameter_shear] sigma = %.4g Pa: loaded in %.3f s (grouser tips %.2f mm "
                      "deep), %llu steps in %.1f s, tau_max %.4g Pa, load held within %.1f %% "
@@ -548,7 +533,7 @@ ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
     } catch (const std::invalid_argument &e) {
         result.fit_note = e.what();
     }
-    result.wall_s = seconds(start);
+    result.wall_s = secondsSince(start);
     if (!options.output_directory.empty())
         writeShearAnnulusOutputs(result, options.output_directory);
     return result;
