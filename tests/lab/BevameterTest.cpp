@@ -2,6 +2,7 @@
 #include "grainlink/lab/Bevameter.hpp"
 
 #include "TextEdit.hpp"
+#include "TinyBed.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -17,25 +18,8 @@ namespace {
 /// the test at a few seconds. Rolling resistance stands in for grain shape: frictional spheres
 /// without it fail under the plate at ~2 kPa (bearing capacity of a bed of low bulk friction)
 /// and p(z) then wanders on a plateau; with it p(z) rises throughout, as for real sand.
-const char *kTiny = R"(name: tiny-bevameter
-soil:
-  simulation: {time_step_s: 4.5e-5, threads: 1}
-  material: {youngs_modulus_Pa: 1.0e7, poisson_ratio: 0.2, density_kg_m3: 2400}
-  contact:
-    damping: {model: viscous, coefficient_N_s_m: 0.1}
-    rolling: {model: epsd, coefficient: 0.3}
-    tangential: {model: linear, stiffness_N_m: 200, stick_angle_deg: 32, slip_angle_deg: 30}
-  walls:
-    - {name: bin, type: box, lower_m: [0, 0, 0], upper_m: [0.05, 0.05, 0.2]}
-  deposition:
-    region: {lower_m: [0, 0, 0], upper_m: [0.05, 0.05, 0.08]}
-    count: 2600
-    radius: {distribution: constant, value_m: 0.0015}
-    seed: 3
-    settle_kinetic_energy_J: 1.0e-8
-    max_settle_time_s: 0.4
-  packing_cache_directory: ""
-bevameter:
+const std::string kTiny =
+    "name: tiny-bevameter\n" + tinyBinSoil("0.05", "0.08", "2600") + R"(bevameter:
   plate_radii_m: [0.010, 0.013]
   speed_m_s: 0.1
   max_sinkage_m: 0.008

@@ -2,6 +2,7 @@
 #include "grainlink/lab/Repose.hpp"
 
 #include "TextEdit.hpp"
+#include "TinyBed.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -16,15 +17,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 
 /// 600 grains of 1.8-2 mm in a tube of 21 mm radius on a rough floor, lifted at 0.1 m/s.
-const char *kTiny = R"(name: tiny-repose
+const std::string kTiny = R"(name: tiny-repose
 soil:
   simulation: {time_step_s: 6.0e-5, threads: 1}
-  material: {youngs_modulus_Pa: 1.0e7, poisson_ratio: 0.2, density_kg_m3: 2400}
-  contact:
-    damping: {model: viscous, coefficient_N_s_m: 0.1}
-    rolling: {model: epsd, coefficient: 0.3}
-    tangential: {model: linear, stiffness_N_m: 200, stick_angle_deg: 32, slip_angle_deg: 30}
-  walls:
+)" + kTinyGrainContacts + R"(  walls:
     - {name: floor, type: plane, point_m: [0, 0, 0], normal: [0, 0, 1], friction_coefficient: 0.6}
   deposition:
     region: {lower_m: [-0.014, -0.014, 0], upper_m: [0.014, 0.014, 0.09]}

@@ -3,6 +3,7 @@
 #include "grainlink/lab/ShearAnnulus.hpp"
 
 #include "TextEdit.hpp"
+#include "TinyBed.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -21,25 +22,8 @@ constexpr double kPi = 3.14159265358979323846;
 /// 22 mm radius with eight 3 mm grousers (Gamma = width / grain diameter = 3.3 instead of the
 /// seed's 10, min_resolution lowered, to keep each run at a few seconds), turned at 4 rad/s to
 /// j = 12 mm (0.7 rad). Rolling resistance stands in for grain shape, as in the bevameter test.
-const char *kTiny = R"(name: tiny-shear
-soil:
-  simulation: {time_step_s: 4.5e-5, threads: 1}
-  material: {youngs_modulus_Pa: 1.0e7, poisson_ratio: 0.2, density_kg_m3: 2400}
-  contact:
-    damping: {model: viscous, coefficient_N_s_m: 0.1}
-    rolling: {model: epsd, coefficient: 0.3}
-    tangential: {model: linear, stiffness_N_m: 200, stick_angle_deg: 32, slip_angle_deg: 30}
-  walls:
-    - {name: bin, type: box, lower_m: [0, 0, 0], upper_m: [0.06, 0.06, 0.2]}
-  deposition:
-    region: {lower_m: [0, 0, 0], upper_m: [0.06, 0.06, 0.04]}
-    count: 2300
-    radius: {distribution: constant, value_m: 0.0015}
-    seed: 3
-    settle_kinetic_energy_J: 1.0e-8
-    max_settle_time_s: 0.4
-  packing_cache_directory: ""
-bevameter_shear:
+const std::string kTiny =
+    "name: tiny-shear\n" + tinyBinSoil("0.06", "0.04", "2300") + R"(bevameter_shear:
   inner_radius_m: 0.012
   outer_radius_m: 0.022
   grouser_count: 8
