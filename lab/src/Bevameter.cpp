@@ -235,16 +235,16 @@ void writeBevameterOutputs(const BevameterResult &result, const std::string &dir
     fs::create_directories(directory);
     const fs::path dir(directory);
     {
-        std::ofstream csv(dir / "pressure_sinkage.csv");
-        csv << "plate_radius_m,time_s,sinkage_m,force_N,pressure_Pa\n" << std::setprecision(10);
+        auto csv = openCsv(dir, "pressure_sinkage.csv",
+                           "plate_radius_m,time_s,sinkage_m,force_N,pressure_Pa");
         for (const auto &p : result.plates)
             for (const auto &s : p.samples)
                 csv << p.plate_radius_m << ',' << s.time_s << ',' << s.sinkage_m << ',' << s.force_N
                     << ',' << s.pressure_Pa << '\n';
     }
     {
-        std::ofstream csv(dir / "bekker_fit.csv");
-        csv << "parameter,value,standard_error,half_width_95,unit\n" << std::setprecision(10);
+        auto csv =
+            openCsv(dir, "bekker_fit.csv", "parameter,value,standard_error,half_width_95,unit");
         if (result.fit) {
             const auto &f = *result.fit;
             csv << "k_c," << f.parameters.k_c << ',' << f.standard_error[0] << ','

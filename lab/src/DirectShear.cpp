@@ -537,10 +537,10 @@ void writeDirectShearOutputs(const DirectShearResult &result, const std::string 
     fs::create_directories(directory);
     const fs::path dir(directory);
     {
-        std::ofstream csv(dir / "shear_curves.csv");
-        csv << "target_normal_stress_Pa,time_s,displacement_m,shear_force_N,normal_force_N,"
-               "area_m2,shear_stress_Pa,normal_stress_Pa,plate_height_m\n"
-            << std::setprecision(10);
+        auto csv =
+            openCsv(dir, "shear_curves.csv",
+                    "target_normal_stress_Pa,time_s,displacement_m,shear_force_N,normal_force_N,"
+                    "area_m2,shear_stress_Pa,normal_stress_Pa,plate_height_m");
         for (const auto &r : result.runs)
             for (const auto &s : r.samples)
                 csv << r.target_normal_stress_Pa << ',' << s.time_s << ',' << s.displacement_m
@@ -550,10 +550,10 @@ void writeDirectShearOutputs(const DirectShearResult &result, const std::string 
     }
     {
         // One row per normal stress and kind, the kind's fitted line repeated on each row.
-        std::ofstream csv(dir / "mohr_coulomb.csv");
-        csv << "kind,target_normal_stress_Pa,normal_stress_Pa,shear_stress_Pa,friction_angle_deg,"
-               "friction_angle_half_width_95_deg,cohesion_Pa,cohesion_half_width_95_Pa\n"
-            << std::setprecision(10);
+        auto csv = openCsv(
+            dir, "mohr_coulomb.csv",
+            "kind,target_normal_stress_Pa,normal_stress_Pa,shear_stress_Pa,friction_angle_deg,"
+            "friction_angle_half_width_95_deg,cohesion_Pa,cohesion_half_width_95_Pa");
         auto row = [&](const char *kind, const BoxShearRun &r, double sigma, double tau,
                        const std::optional<MohrCoulombFit> &fit) {
             csv << kind << ',' << r.target_normal_stress_Pa << ',' << sigma << ',' << tau;

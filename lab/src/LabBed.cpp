@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iomanip>
+#include <stdexcept>
 
 namespace grainlink::lab {
 
@@ -49,6 +51,16 @@ double highestGrainUnder(const dem::ParticleStore &grains, const Eigen::Vector2d
             highest = std::max(highest, x.z() + grains.radius[i]);
     }
     return highest;
+}
+
+std::ofstream openCsv(const std::filesystem::path &directory, const std::string &name,
+                      const std::string &header) {
+    const std::filesystem::path file = directory / name;
+    std::ofstream csv(file);
+    if (!csv)
+        throw std::runtime_error("cannot write " + file.string() + "; check the output directory");
+    csv << header << '\n' << std::setprecision(10);
+    return csv;
 }
 
 } // namespace grainlink::lab

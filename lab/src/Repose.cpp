@@ -247,8 +247,7 @@ std::string ReposeResult::report() const {
 
 void writeReposeOutputs(const ReposeResult &result, const std::string &directory) {
     fs::create_directories(directory);
-    std::ofstream csv(fs::path(directory) / "heap_profile.csv");
-    csv << "radius_m,height_m,grains\n" << std::setprecision(10);
+    auto csv = openCsv(directory, "heap_profile.csv", "radius_m,height_m,grains");
     for (const auto &b : result.profile)
         csv << b.radius_m << ',' << b.height_m << ',' << b.grains << '\n';
     std::ofstream(fs::path(directory) / "report.txt") << result.report();

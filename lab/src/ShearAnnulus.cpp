@@ -574,10 +574,10 @@ void writeShearAnnulusOutputs(const ShearAnnulusResult &result, const std::strin
     fs::create_directories(directory);
     const fs::path dir(directory);
     {
-        std::ofstream csv(dir / "shear_displacement.csv");
-        csv << "target_pressure_Pa,time_s,rotation_rad,shear_displacement_m,normal_force_N,"
-               "normal_pressure_Pa,torque_N_m,shear_stress_Pa,sinkage_m\n"
-            << std::setprecision(10);
+        auto csv =
+            openCsv(dir, "shear_displacement.csv",
+                    "target_pressure_Pa,time_s,rotation_rad,shear_displacement_m,normal_force_N,"
+                    "normal_pressure_Pa,torque_N_m,shear_stress_Pa,sinkage_m");
         for (const auto &r : result.runs)
             for (const auto &s : r.samples)
                 csv << r.target_pressure_Pa << ',' << s.time_s << ',' << s.rotation_rad << ','
@@ -586,8 +586,8 @@ void writeShearAnnulusOutputs(const ShearAnnulusResult &result, const std::strin
                     << ',' << s.sinkage_m << '\n';
     }
     {
-        std::ofstream csv(dir / "janosi_fit.csv");
-        csv << "parameter,value,standard_error,half_width_95,unit\n" << std::setprecision(10);
+        auto csv =
+            openCsv(dir, "janosi_fit.csv", "parameter,value,standard_error,half_width_95,unit");
         if (result.fit) {
             const auto &f = *result.fit;
             csv << "c," << f.parameters.cohesion_Pa << ',' << f.standard_error[0] << ','

@@ -4,6 +4,9 @@
 
 #include <catch2/catch.hpp>
 
+#include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <string>
 
 using namespace grainlink;
@@ -54,4 +57,20 @@ TEST_CASE("Test centre: centre_m when given, else the middle of the deposition r
     CHECK_THROWS_WITH(lab::parseCentre(section("test:\n  centre_m: [0.1]\n")),
                       Contains("lab.yaml:2") && Contains("centre_m") &&
                           Contains("expected [x, y]"));
+}
+
+TEST_CASE("Lab CSV: header line, 10 significant digits, an unwritable file named",
+          "[lab][lab_bed]") {
+    const auto dir = std::filesystem::temp_directory_path() / "grainlink_lab_bed_test";
+    std::filesystem::create_directories(dir);
+    {
+        auto csv = lab::openCsv(dir, "t.csv", "x_m,y_m");
+        csv << 1.0 / 3.0 << ',' << 2.0 << '\n';
+    }
+    std::ifstream in(dir / "t.csv");
+    const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    CHECK(text == "x_m,y_m\n0.3333333333,2\n");
+    std::filesystem::remove_all(dir);
+    CHECK_THROWS_WITH(lab::openCsv(dir / "missing", "t.csv", "x_m"),
+                      Contains("cannot write") && Contains("missing/t.csv"));
 }

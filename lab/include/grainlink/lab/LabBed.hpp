@@ -10,8 +10,11 @@
 
 #include <chrono>
 #include <cstddef>
+#include <filesystem>
+#include <fstream>
 #include <memory>
 #include <optional>
+#include <string>
 
 namespace grainlink::lab {
 
@@ -43,5 +46,10 @@ Eigen::Vector2d testCentre(const dem::DemScenario &soil,
 /// `centre`, and at least `floor_m`: a tool started above it never appears inside a grain.
 double highestGrainUnder(const dem::ParticleStore &grains, const Eigen::Vector2d &centre,
                          double radius_m, double floor_m);
+
+/// Opens `directory / name` for a lab CSV, writes the `header` line (column names with units)
+/// and sets 10 significant digits; throws naming the file when it cannot be written.
+std::ofstream openCsv(const std::filesystem::path &directory, const std::string &name,
+                      const std::string &header);
 
 } // namespace grainlink::lab
