@@ -162,11 +162,15 @@ void DemSystem::initialise() {
         neighbours_.build(reference_position_, particles_.radius, settings_.skin_m, {}, threads);
         neighbours_.restoreBuildCount(builds);
         updatePlaneMasks();
-        // The thread split was estimated from the contacts at the last rebuild, which the
-        // checkpoint no longer has: take the saved one, or the summation order would change.
-        if (restored_split_.size() == std::size_t(threads) + 1 && restored_split_.back() == n)
+        // The thread split is estimated from the contacts at a rebuild, and only there: a
+        // re-initialisation (a body added, a checkpoint read) keeps the last rebuild's split,
+        // saved in the checkpoint, or the summation order would change with it.
+        const auto valid = [&](const std::vector<std::size_t> &split) {
+            return split.size() == std::size_t(threads) + 1 && split.back() == n;
+        };
+        if (valid(restored_split_))
             contact_split_ = restored_split_;
-        else
+        else if (!valid(contact_split_))
             balanceContactWork();
         restored_split_.clear();
     }
