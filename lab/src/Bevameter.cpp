@@ -210,10 +210,8 @@ std::string BevameterResult::report() const {
     std::ostringstream out;
     out << std::setprecision(5);
     out << "Virtual bevameter (pressure-sinkage)\n";
-    out << "  bed: " << particles << " grains, largest radius " << mm(largest_radius_m)
-        << ", time step " << time_step_s << " s, packing "
-        << (packing_from_cache ? "from the cache" : "deposited") << " in " << preparation_wall_s
-        << " s\n";
+    writeBedLine(out, particles, largest_radius_m, time_step_s, packing_from_cache,
+                 preparation_wall_s);
     for (const auto &p : plates) {
         out << "  plate R = " << mm(p.plate_radius_m) << ": Gamma = R/r_max = " << p.resolution
             << ", rim to region side " << mm(p.wall_gap_m) << " ("

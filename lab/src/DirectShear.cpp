@@ -509,10 +509,8 @@ std::string DirectShearResult::report() const {
     std::ostringstream out;
     out << std::setprecision(4);
     out << "Direct shear box\n";
-    out << "  bed: " << particles << " grains, largest radius " << largest_radius_m * 1e3
-        << " mm, time step " << time_step_s << " s, packing "
-        << (packing_from_cache ? "from the cache" : "deposited") << " in " << preparation_wall_s
-        << " s\n";
+    writeBedLine(out, particles, largest_radius_m, time_step_s, packing_from_cache,
+                 preparation_wall_s);
     out << "  settled bed " << bed_height_m * 1e3 << " mm high: bulk density " << bulk_density_kg_m3
         << " kg/m^3, packing fraction " << packing_fraction << "\n";
     for (const auto &r : runs)

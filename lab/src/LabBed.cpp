@@ -63,4 +63,11 @@ std::ofstream openCsv(const std::filesystem::path &directory, const std::string 
     return csv;
 }
 
+void writeBedLine(std::ostream &out, std::size_t particles, double largest_radius_m,
+                  double time_step_s, bool from_cache, double preparation_wall_s) {
+    out << "  bed: " << particles << " grains, largest radius " << largest_radius_m * 1e3
+        << " mm, time step " << time_step_s << " s, packing "
+        << (from_cache ? "from the cache" : "deposited") << " in " << preparation_wall_s << " s\n";
+}
+
 } // namespace grainlink::lab

@@ -543,10 +543,8 @@ std::string ShearAnnulusResult::report() const {
     std::ostringstream out;
     out << std::setprecision(5);
     out << "Virtual bevameter (shear annulus)\n";
-    out << "  bed: " << particles << " grains, largest radius " << largest_radius_m * 1e3
-        << " mm, time step " << time_step_s << " s, packing "
-        << (packing_from_cache ? "from the cache" : "deposited") << " in " << preparation_wall_s
-        << " s\n";
+    writeBedLine(out, particles, largest_radius_m, time_step_s, packing_from_cache,
+                 preparation_wall_s);
     out << "  annulus R_i = " << annulus.inner_radius_m * 1e3
         << " mm, R_o = " << annulus.outer_radius_m * 1e3 << " mm, " << annulus.grouser_count
         << " grousers of " << annulus.grouser_height_m * 1e3

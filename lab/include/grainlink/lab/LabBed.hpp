@@ -14,6 +14,7 @@
 #include <fstream>
 #include <memory>
 #include <optional>
+#include <ostream>
 #include <string>
 
 namespace grainlink::lab {
@@ -31,6 +32,11 @@ struct LabBed {
 
 /// Settles `soil` (or reads it from the packing cache) via dem::prepareSoil.
 LabBed prepareLabBed(const dem::DemScenario &soil, double progress_interval_s);
+
+/// The reports' "  bed: ..." line (grains, largest radius, time step, where the packing came
+/// from and how long it took), in the stream's own precision.
+void writeBedLine(std::ostream &out, std::size_t particles, double largest_radius_m,
+                  double time_step_s, bool from_cache, double preparation_wall_s);
 
 /// Seconds on the steady clock since `since`.
 double secondsSince(std::chrono::steady_clock::time_point since);
