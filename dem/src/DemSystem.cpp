@@ -165,14 +165,8 @@ void DemSystem::initialise() {
         // The thread split is estimated from the contacts at a rebuild, and only there: a
         // re-initialisation (a body added, a checkpoint read) keeps the last rebuild's split,
         // saved in the checkpoint, or the summation order would change with it.
-        const auto valid = [&](const std::vector<std::size_t> &split) {
-            return split.size() == std::size_t(threads) + 1 && split.back() == n;
-        };
-        if (valid(restored_split_))
-            contact_split_ = restored_split_;
-        else if (!valid(contact_split_))
+        if (contact_split_.size() != std::size_t(threads) + 1 || contact_split_.back() != n)
             balanceContactWork();
-        restored_split_.clear();
     }
     candidates_stale_ = true;
 }
@@ -1165,7 +1159,7 @@ void DemSystem::restoreInternals(const Internals &s) {
     neighbours_.setPendingContacts(s.contacts);
     neighbours_.restoreBuildCount(s.neighbour_builds);
     forces_valid_ = s.forces_valid;
-    restored_split_ = s.contact_split;
+    contact_split_ = s.contact_split; // empty from version-1 files: re-estimated
     initialised_ = false;
 }
 

@@ -162,7 +162,6 @@ private:
     };
     std::vector<PlaneCandidate> plane_candidates_; ///< the masks as a list, in particle order
     std::vector<std::size_t> contact_split_; ///< thread t owns particles [split[t], split[t+1])
-    std::vector<std::size_t> restored_split_; ///< from a checkpoint, used once at initialise
     double max_displacement_sq_ = 0.0, max_mesh_displacement_sq_ = 0.0;
     bool displacement_known_ = false;
     CellGrid mesh_grid_;
