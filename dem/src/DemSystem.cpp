@@ -224,6 +224,31 @@ void DemSystem::setTimeStep(double dt_s) {
         validateTimeStep();
 }
 
+void DemSystem::setRolling(RollingModel rolling) {
+    const auto *old_shape = std::get_if<RollingGrainShape>(&law_.rolling);
+    const bool had_eq12 = old_shape && old_shape->inertia == RollingGrainShape::Inertia::SeedEq12;
+    law_.rolling = std::move(rolling);
+    law_.finalize();
+    const std::size_t nm = materials_.size();
+    for (std::size_t a = 0; a < nm; ++a)
+        for (std::size_t b = 0; b < nm; ++b)
+            pair_props_[a * nm + b] = pairProperties(materials_[a], materials_[b], law_);
+    // Histories of another law mean nothing to this one (a moment against an angle).
+    neighbours_.clearRollingHistory();
+    for (ContactHistory &h : plane_history_)
+        h.rolling_N_m.setZero();
+    for (MeshContactSlot &slot : mesh_slots_)
+        slot.history.rolling_N_m.setZero();
+    // initialise() sets seed eq. 12's moments; leaving that law returns to solid spheres.
+    if (had_eq12)
+        for (std::size_t i = 0; i < particles_.size(); ++i) {
+            const double r = particles_.radius[i];
+            particles_.inertia[i].setConstant(0.4 * particles_.mass[i] * r * r);
+        }
+    initialised_ = false;
+    forces_valid_ = false;
+}
+
 // ---------------------------------------------------------------------------------------------
 // The step: few fused passes over the particle arrays (each pass is one timed phase).
 

@@ -60,6 +60,12 @@ std::vector<NeighbourList::StoredContact> NeighbourList::activeContacts() const 
     return out;
 }
 
+void NeighbourList::clearRollingHistory() {
+    std::fill(rolling_N_m.begin(), rolling_N_m.end(), Vec3::Zero());
+    for (StoredContact &c : pending_)
+        c.history.rolling_N_m.setZero();
+}
+
 void NeighbourList::build(const std::vector<Vec3> &positions, const std::vector<double> &radii,
                           double skin_m, const std::vector<std::size_t> &old_to_new, int threads) {
     const std::size_t n = positions.size();

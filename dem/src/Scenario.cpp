@@ -64,6 +64,35 @@ template <class Model> void validateAt(const ConfigNode &node, const Model &mode
     }
 }
 
+/// A `rolling:` section (contact.rolling, deposition.rolling), §2.6.
+RollingModel parseRolling(const ConfigNode &node) {
+    RollingModel rolling = RollingNone{};
+    const std::string model = node["model"].choice({"none", "epsd", "grain_shape"});
+    if (model == "epsd") {
+        rolling = RollingEpsd{node["coefficient"].number()};
+    } else if (model == "grain_shape") {
+        // gamma per local axis: one number for all three, or a list of three (§2.6.1).
+        RollingGrainShape shape;
+        const ConfigNode gamma = node["aspect_ratio_angle_deg"];
+        if (gamma.isSequence()) {
+            const std::vector<double> values = gamma.numbers();
+            if (values.size() != 3)
+                gamma.fail("needs one angle or three (one per local axis), got " +
+                           std::to_string(values.size()));
+            shape.aspect_ratio_angle_deg = Vec3(values[0], values[1], values[2]);
+        } else {
+            shape.aspect_ratio_angle_deg.setConstant(gamma.number());
+        }
+        if (const auto inertia = node.optional("inertia"))
+            if (inertia->choice({"sphere", "seed_eq12"}) == "seed_eq12")
+                shape.inertia = RollingGrainShape::Inertia::SeedEq12;
+        rolling = shape;
+    }
+    node.finish();
+    validateAt(node, rolling);
+    return rolling;
+}
+
 ContactLaw parseContact(const ConfigNode &node) {
     ContactLaw law;
     const ConfigNode damping = node["damping"];
@@ -88,31 +117,8 @@ ContactLaw parseContact(const ConfigNode &node) {
     tangential.finish();
     validateAt(tangential, law.tangential);
 
-    if (const auto rolling = node.optional("rolling")) {
-        const std::string model = (*rolling)["model"].choice({"none", "epsd", "grain_shape"});
-        if (model == "epsd") {
-            law.rolling = RollingEpsd{(*rolling)["coefficient"].number()};
-        } else if (model == "grain_shape") {
-            // gamma per local axis: one number for all three, or a list of three (§2.6.1).
-            RollingGrainShape shape;
-            const ConfigNode gamma = (*rolling)["aspect_ratio_angle_deg"];
-            if (gamma.isSequence()) {
-                const std::vector<double> values = gamma.numbers();
-                if (values.size() != 3)
-                    gamma.fail("needs one angle or three (one per local axis), got " +
-                               std::to_string(values.size()));
-                shape.aspect_ratio_angle_deg = Vec3(values[0], values[1], values[2]);
-            } else {
-                shape.aspect_ratio_angle_deg.setConstant(gamma.number());
-            }
-            if (const auto inertia = rolling->optional("inertia"))
-                if (inertia->choice({"sphere", "seed_eq12"}) == "seed_eq12")
-                    shape.inertia = RollingGrainShape::Inertia::SeedEq12;
-            law.rolling = shape;
-        }
-        rolling->finish();
-        validateAt(*rolling, law.rolling);
-    }
+    if (const auto rolling = node.optional("rolling"))
+        law.rolling = parseRolling(*rolling);
     if (const auto cohesion = node.optional("cohesion")) {
         if ((*cohesion)["model"].choice({"none", "linear"}) == "linear")
             law.cohesion = CohesionLinear{(*cohesion)["energy_density_J_m3"].number()};
@@ -222,6 +228,8 @@ DepositionSpec parseDeposition(const ConfigNode &node) {
     d.layer_interval_s = node.number("layer_interval_s", 0.1);
     d.settle_kinetic_energy_J = node.number("settle_kinetic_energy_J", 1e-9);
     d.max_settle_time_s = node.number("max_settle_time_s", 5.0);
+    if (const auto rolling = node.optional("rolling"))
+        d.rolling = parseRolling(*rolling);
     node.finish();
     return d;
 }
@@ -352,7 +360,13 @@ std::unique_ptr<DemSystem> makeSystem(const DemScenario &s) {
 std::string packingKey(const DemScenario &s) {
     std::ostringstream key;
     key.precision(17);
-    key << "v2|" << s.law.describe() << "|E=" << s.material.youngs_modulus_Pa
+    // The law the grains settle under: rolling laws tested on one packing share its key.
+    ContactLaw settling = s.law;
+    if (s.deposition.rolling) {
+        settling.rolling = *s.deposition.rolling;
+        settling.finalize();
+    }
+    key << "v2|" << settling.describe() << "|E=" << s.material.youngs_modulus_Pa
         << " nu=" << s.material.poisson_ratio << " rho=" << s.material.density_kg_m3
         << "|dt=" << s.settings.time_step_s << " int=" << int(s.settings.integrator) << ','
         << s.settings.newmark_beta << ',' << s.settings.newmark_gamma

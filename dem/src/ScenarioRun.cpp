@@ -31,6 +31,16 @@ double bedSurface(const ParticleStore &p) {
 std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progress_interval_s,
                                        bool *from_cache) {
     auto sys = makeSystem(scenario);
+    // deposition.rolling: the packing (settled or cached) is that law's; the run goes on with
+    // its own law, every rolling history starting afresh (docs/scenario.md).
+    const auto &settling_rolling = scenario.deposition.rolling;
+    if (settling_rolling)
+        sys->setRolling(*settling_rolling);
+    const auto runLaw = [&] {
+        if (settling_rolling)
+            sys->setRolling(scenario.law.rolling);
+        return std::move(sys);
+    };
     const std::string key = packingKey(scenario);
     const fs::path cache =
         scenario.packing_cache_directory.empty()
@@ -42,7 +52,7 @@ std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progr
             *from_cache = true;
         std::fprintf(stderr, "[deposition] reusing cached packing %s (%zu particles)\n",
                      cache.c_str(), sys->particles().size());
-        return sys;
+        return runLaw();
     }
     Progress progress("deposition", progress_interval_s);
     const auto report = deposit(*sys, scenario.deposition, [&](const DepositionReport &r) {
@@ -61,7 +71,7 @@ std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progr
     }
     if (from_cache)
         *from_cache = false;
-    return sys;
+    return runLaw();
 }
 
 namespace {

@@ -87,6 +87,10 @@ public:
     }
     /// Changes the time step between steps (the clock stays exact in steps of the old size).
     void setTimeStep(double dt_s);
+    /// Replaces the rolling slot between steps, e.g. to test several rolling laws on one
+    /// settled packing (docs/scenario.md, deposition.rolling). Every rolling history starts
+    /// afresh; the moments of inertia follow the new law (seed eq. 12 or solid spheres).
+    void setRolling(RollingModel rolling);
 
     /// Largest safe step estimate: half the Rayleigh time of the smallest grain, the viscous
     /// dashpot limit m_min/k_n where one is set, 2/k_h (docs/physics.md §3.3).

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -45,6 +46,10 @@ struct DepositionSpec {
     /// Settling ends when the mean kinetic energy per particle is below this [J] ...
     double settle_kinetic_energy_J = 1e-9;
     double max_settle_time_s = 5.0; ///< ... or when this much time has passed (then a warning)
+    /// Rolling law while the grains settle, if not the run's own: one packing for several
+    /// rolling laws. deposit() does not switch laws; its callers do (prepareSoil, the repose
+    /// test): DemSystem::setRolling before deposit() and back to the run's law after it.
+    std::optional<RollingModel> rolling;
     std::string describe() const;
 };
 

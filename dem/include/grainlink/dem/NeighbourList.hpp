@@ -53,6 +53,8 @@ public:
     /// Keeps the rolling slot's history per entry (EPSD and grain_shape need it); set before
     /// the first build.
     void keepRollingHistory(bool keep) { keep_rolling_ = keep; }
+    /// Zeroes every rolling history, listed or waiting for the next build (a new rolling law).
+    void clearRollingHistory();
     bool keepsRollingHistory() const { return keep_rolling_; }
 
     /// Bits of `state`: the pair overlaps; its Coulomb state is sliding.
