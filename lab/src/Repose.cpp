@@ -185,7 +185,10 @@ ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &opti
             return s;
         });
 
-    // Fill the tube and let the column settle (the tube stands still meanwhile).
+    // Fill the tube and let the column settle (the tube stands still meanwhile), under the
+    // deposition's rolling law if it has its own: one fill for several laws.
+    if (d.rolling)
+        sys->setRolling(*d.rolling);
     dem::Progress fill("repose fill", options.progress_interval_s);
     const auto report = dem::deposit(*sys, d, [&](const dem::DepositionReport &r) {
         fill.update(sys->time(), std::min(1.0, r.settle_time_s / d.max_settle_time_s),
@@ -193,6 +196,8 @@ ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &opti
     });
     std::fprintf(stderr, "[repose] %zu grains settled in the tube (%.3f s simulated)\n",
                  report.inserted, report.settle_time_s);
+    if (d.rolling)
+        sys->setRolling(scenario.soil.law.rolling);
 
     // Lift the tube by its own height: its bottom then clears any column it held.
     *lift_start = sys->time();
