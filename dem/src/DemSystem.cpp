@@ -125,9 +125,24 @@ void DemSystem::initialise() {
     side_.assign(std::size_t(threads), {});
     if (planes_.size() > 64)
         throw std::invalid_argument("at most 64 planes are supported; use a mesh for more");
-    thread_body_force_.assign(threads, std::vector<Vec3>(bodies_.size()));
-    thread_body_torque_.assign(threads, std::vector<Vec3>(bodies_.size()));
-    thread_plane_force_.assign(threads, std::vector<Vec3>(planes_.size()));
+    // Each thread adds into its own wall and body sums at every wall or mesh contact. Separate
+    // small allocations may lie side by side in memory: a cache line of slack after each keeps
+    // two threads off one line (false sharing would bounce it between cores on every contact).
+    const auto perThreadSums = [](std::size_t n) {
+        constexpr std::size_t kSlack = (64 + sizeof(Vec3) - 1) / sizeof(Vec3);
+        std::vector<Vec3> sums;
+        sums.reserve(n + kSlack);
+        sums.resize(n, Vec3::Zero());
+        return sums;
+    };
+    thread_body_force_.resize(std::size_t(threads));
+    thread_body_torque_.resize(std::size_t(threads));
+    thread_plane_force_.resize(std::size_t(threads));
+    for (std::size_t t = 0; t < std::size_t(threads); ++t) {
+        thread_body_force_[t] = perThreadSums(bodies_.size());
+        thread_body_torque_[t] = perThreadSums(bodies_.size());
+        thread_plane_force_[t] = perThreadSums(planes_.size());
+    }
     thread_triangle_force_.assign(threads, {});
     for (auto &per_thread : thread_triangle_force_)
         for (const MeshBody &b : bodies_)
@@ -918,6 +933,8 @@ void DemSystem::meshContacts() {
             MeshContactSlot next[kMeshSlots];
             ContactGeometry g;
             ContactResult r;
+            double max_ratio = thread_max_overlap_[std::size_t(t)]; // the pair pass's
+            std::pair<ParticleId, ParticleId> max_pair = thread_max_overlap_pair_[std::size_t(t)];
             const std::size_t candidates = mesh_particles_.size();
 #pragma omp for schedule(static)
             for (std::size_t c_index = 0; c_index < candidates; ++c_index) {
@@ -1010,9 +1027,9 @@ void DemSystem::meshContacts() {
                     if (!loads.empty())
                         loads[std::size_t(touch.triangle)] -= r.force_on_i_N;
                     const double ratio = g.overlap_m / ri;
-                    if (ratio > thread_max_overlap_[t]) {
-                        thread_max_overlap_[t] = ratio;
-                        thread_max_overlap_pair_[t] = {p.id[i], p.id[i]};
+                    if (ratio > max_ratio) {
+                        max_ratio = ratio;
+                        max_pair = {p.id[i], p.id[i]};
                     }
                     if (used < kMeshSlots)
                         next[used++] = {touch.body, touch.triangle, n_c, h};
@@ -1020,6 +1037,8 @@ void DemSystem::meshContacts() {
                 for (int s = 0; s < kMeshSlots; ++s)
                     slots[s] = s < used ? next[s] : MeshContactSlot{};
             }
+            thread_max_overlap_[std::size_t(t)] = max_ratio;
+            thread_max_overlap_pair_[std::size_t(t)] = max_pair;
         }
     });
     for (std::size_t b = 0; b < nb; ++b) {
