@@ -4,6 +4,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -61,7 +63,8 @@ TEST_CASE("Test centre: centre_m when given, else the middle of the deposition r
 
 TEST_CASE("Lab CSV: header line, 10 significant digits, an unwritable file named",
           "[lab][lab_bed]") {
-    const auto dir = std::filesystem::temp_directory_path() / "grainlink_lab_bed_test";
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("grainlink_lab_bed_test-" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     {
         auto csv = lab::openCsv(dir, "t.csv", "x_m,y_m");

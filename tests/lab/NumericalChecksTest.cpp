@@ -4,6 +4,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -195,7 +197,8 @@ TEST_CASE("Rerun report: every quantity, baseline, rerun, difference, relative d
     CHECK_THAT(text, Contains("10 %"));
     CHECK_THAT(text, Contains("-5 %"));
 
-    const auto dir = std::filesystem::temp_directory_path() / "grainlink_numerical_checks_test";
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("grainlink_numerical_checks_test-" + std::to_string(::getpid()));
     std::filesystem::remove_all(dir);
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "report.txt") << "the test's own report\n";

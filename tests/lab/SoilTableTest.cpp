@@ -7,6 +7,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -103,7 +105,8 @@ TEST_CASE("Soil table inversion: targets outside the table name the file and its
 
 TEST_CASE("Soil table file: written rows read back; a gap in the grid is an error",
           "[lab][soil_table]") {
-    const auto dir = std::filesystem::temp_directory_path() / "grainlink_soil_table_test";
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("grainlink_soil_table_test-" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     const auto path = (dir / "table.csv").string();
     auto rows = syntheticRows();
@@ -154,7 +157,8 @@ TEST_CASE("Soil table generated on the tiny box reads back and inverts", "[lab][
     // as the frictionless spheres of DirectShearTest to 1e-10: without tangential forces the
     // grain-shape law has nothing to resist) and 36.9 deg at phi 30. The inversion of the
     // mean psi must land at the middle phi (psi is linear between two nodes).
-    const auto dir = std::filesystem::temp_directory_path() / "grainlink_soil_table_run";
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("grainlink_soil_table_run-" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "shear.yaml") << kTinyShearBox;
     std::ofstream(dir / "spec.yaml") << "direct_shear: shear.yaml\n"
