@@ -35,7 +35,7 @@ def read(path):
 def repose(run_dir):
     rows = read(f"{run_dir}/heap_profile.csv")
     with open(f"{run_dir}/report.txt") as f:
-        angle = next((l.strip() for l in f if "angle of repose" in l), "")
+        angle = next((l.strip() for l in f if "angle of repose" in l or "no heap" in l), "")
     r = [1e3 * float(x["radius_m"]) for x in rows]
     h = [1e3 * float(x["height_m"]) for x in rows]
     fig, ax = plt.subplots(figsize=(7, 4))

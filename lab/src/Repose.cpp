@@ -133,11 +133,12 @@ void measureHeap(const std::vector<Eigen::Vector3d> &positions, const std::vecto
             y.push_back(it->height_m);
         }
     result.flank_bins = x.size();
-    if (x.size() < 3)
-        throw std::runtime_error("repose: only " + std::to_string(x.size()) +
-                                 " profile bins on the heap's flank (need 3): the heap is too "
-                                 "small for the bin width " +
-                                 std::to_string(bin_width) + " m");
+    if (!result.heapFormed()) {
+        // A result, not a failure: the grains spread out instead of piling (report() says so).
+        result.angle_deg = std::numeric_limits<double>::quiet_NaN();
+        result.angle_half_width_95_deg = std::numeric_limits<double>::quiet_NaN();
+        return;
+    }
     const double n = double(x.size());
     double mx = 0.0, my = 0.0;
     for (std::size_t i = 0; i < x.size(); ++i) {
@@ -244,8 +245,12 @@ std::string ReposeResult::report() const {
     out << "  heap " << heap_height_m * 1e3 << " mm high; "
         << (settled ? "settled" : "NOT settled (time limit)") << " " << settle_time_s
         << " s after the lift, mean KE per grain " << final_kinetic_energy_per_grain_J << " J\n";
-    out << "  angle of repose " << angle_deg << " +- " << angle_half_width_95_deg
-        << " deg (95 %, slope regression over " << flank_bins << " flank bins)\n";
+    if (heapFormed())
+        out << "  angle of repose " << angle_deg << " +- " << angle_half_width_95_deg
+            << " deg (95 %, slope regression over " << flank_bins << " flank bins)\n";
+    else
+        out << "  no heap: the grains spread out; " << flank_bins
+            << " profile bins on a flank (3 needed for an angle), see heap_profile.csv\n";
     out << "  wall time " << wall_s << " s\n";
     return out.str();
 }

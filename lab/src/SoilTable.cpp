@@ -178,15 +178,12 @@ std::vector<SoilTableRow> generateSoilTable(const SoilTableSpec &spec,
                 if (!options.runs_directory.empty())
                     ro.output_directory =
                         (fs::path(options.runs_directory) / ("repose_" + tag.str())).string();
-                try {
-                    const auto heap = runRepose(r, ro);
-                    row.repose_deg = heap.angle_deg;
-                    row.repose_half_width_95_deg = heap.angle_half_width_95_deg;
-                } catch (const std::runtime_error &e) {
-                    // Grains that roll freely spread out instead of forming a heap.
-                    std::fprintf(stderr, "[soil-table] %s: no angle of repose (NaN): %s\n",
-                                 tag.str().c_str(), e.what());
-                }
+                const auto heap = runRepose(r, ro);
+                row.repose_deg = heap.angle_deg;
+                row.repose_half_width_95_deg = heap.angle_half_width_95_deg;
+                if (!heap.heapFormed()) // grains that roll freely spread out
+                    std::fprintf(stderr, "[soil-table] %s: no heap, no angle of repose (NaN)\n",
+                                 tag.str().c_str());
             }
             rows.push_back(row);
             write();

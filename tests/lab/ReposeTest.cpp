@@ -73,6 +73,31 @@ TEST_CASE("Heap measurement recovers the angle of a packed cone", "[lab][repose]
     CHECK(result.flank_bins >= 10);
 }
 
+TEST_CASE("Grains spread flat are no heap: a result with its profile, not an error",
+          "[lab][repose]") {
+    // Two layers of r = 1 mm grains over a 60 mm disc: the top is 4 mm everywhere, so no bin
+    // lies between 20 % and 80 % of it above 3 r_max. Frictionless spheres end like this; the
+    // test must report it (angle NaN) and keep the profile instead of failing.
+    const double r = 0.001;
+    std::vector<Eigen::Vector3d> positions;
+    std::vector<double> radii;
+    for (double x = -0.03; x <= 0.03; x += 2 * r)
+        for (double y = -0.03; y <= 0.03; y += 2 * r)
+            for (double z : {r, 3 * r})
+                if (std::hypot(x, y) <= 0.03) {
+                    positions.emplace_back(x, y, z);
+                    radii.push_back(r);
+                }
+    lab::ReposeResult result;
+    lab::measureHeap(positions, radii, Eigen::Vector2d::Zero(), 2 * r, result);
+    INFO(result.report());
+    CHECK_FALSE(result.heapFormed());
+    CHECK(std::isnan(result.angle_deg));
+    CHECK(result.heap_height_m == Approx(4 * r));
+    CHECK(result.profile.size() >= 15);
+    CHECK_THAT(result.report(), Contains("no heap"));
+}
+
 TEST_CASE("Angle of repose: more rolling resistance builds a steeper heap", "[lab][repose]") {
     // The same 600 grains with rolling resistance 0.3 and 0.1, each filled from three deposition
     // seeds. Grain shape (here its stand-in) is what holds a heap of spheres up, so the 0.3 heaps

@@ -43,9 +43,12 @@ struct ReposeResult {
     std::size_t particles = 0;
     double largest_radius_m = 0.0;
     double heap_height_m = 0.0;           ///< [m] highest grain top near the axis
-    double angle_deg = 0.0;               ///< [deg] atan of the flank slope
+    /// [deg] atan of the flank slope; NaN when no heap formed (fewer than 3 flank bins: the
+    /// grains spread out, as frictionless or freely rolling spheres do)
+    double angle_deg = 0.0;
     double angle_half_width_95_deg = 0.0; ///< [deg] from the slope's regression interval
     std::size_t flank_bins = 0; ///< bins fitted (height in (max(0.2 top, 3 r_max), 0.8 top))
+    bool heapFormed() const { return flank_bins >= 3; }
     double settle_time_s = 0.0; ///< [s] after the tube left the heap
     bool settled = false;
     double final_kinetic_energy_per_grain_J = 0.0;
@@ -61,7 +64,7 @@ struct ReposeOptions {
 
 /// Heap profile and angle from grain positions (exposed for tests): bins of `bin_width_m` around
 /// `centre`; the flank is the bins whose height lies between 20 % and 80 % of the heap's top
-/// and above 3 r_max.
+/// and above 3 r_max. Fewer than 3 such bins is no heap: the angle is then NaN.
 void measureHeap(const std::vector<Eigen::Vector3d> &positions_m,
                  const std::vector<double> &radii_m, const Eigen::Vector2d &centre_m,
                  double bin_width_m, ReposeResult &result);
