@@ -243,11 +243,7 @@ void DemSystem::setRolling(RollingModel rolling) {
     const auto *old_shape = std::get_if<RollingGrainShape>(&law_.rolling);
     const bool had_eq12 = old_shape && old_shape->inertia == RollingGrainShape::Inertia::SeedEq12;
     law_.rolling = std::move(rolling);
-    law_.finalize();
-    const std::size_t nm = materials_.size();
-    for (std::size_t a = 0; a < nm; ++a)
-        for (std::size_t b = 0; b < nm; ++b)
-            pair_props_[a * nm + b] = pairProperties(materials_[a], materials_[b], law_);
+    law_.finalize(); // the pair properties do not depend on the rolling slot
     // Histories of another law mean nothing to this one (a moment against an angle).
     neighbours_.clearRollingHistory();
     for (ContactHistory &h : plane_history_)
