@@ -7,7 +7,23 @@
 #include <CLI/CLI.hpp>
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+
+#ifdef GRAINLINK_REQUIRES_X86_64_V3
+// A build for x86-64-v3 (CMake's GRAINLINK_ARCH) copied to an older processor would die of an
+// illegal instruction: it says why instead. Compiled for the base instruction set, and run
+// before every other initialiser.
+__attribute__((constructor(101), target("arch=x86-64"))) static void requireX86_64_v3() {
+    __builtin_cpu_init();
+    if (!__builtin_cpu_supports("x86-64-v3")) {
+        std::fputs("grainlink: this build needs an x86-64-v3 processor (AVX2, FMA) and this one "
+                   "is older: rebuild here, or configure with -DGRAINLINK_ARCH=x86-64\n",
+                   stderr);
+        std::_Exit(1);
+    }
+}
+#endif
 
 int main(int argc, char **argv) {
     CLI::App app{"grainlink: co-simulation of planetary locomotion on granular soil"};
