@@ -1,0 +1,151 @@
+#pragma once
+// Attribution: how each candidate effect changes the features with its strength (its
+// response, from simulated signatures or from a transform of the base curves), the strength
+// that best explains the calibration experiments, how far two effects' signatures overlap on
+// the design, and how well a fitted model predicts the held-out experiments against the null
+// (docs/gap.md, "Attribution" and "Confirmation").
+#include "grainlink/gap/Features.hpp"
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace grainlink::gap {
+
+/// An effect's strength parameter: its prior range, the value that switches it off (the base
+/// model), and whether it acts on a logarithmic scale (a stiffness factor).
+struct Prior {
+    double lo = 0.0, hi = 1.0;
+    double off = 0.0;
+    bool log_scale = false;
+    double toScale(double s) const;   ///< s or log s
+    double fromScale(double t) const; ///< the inverse
+    bool contains(double s) const { return s >= lo && s <= hi; }
+};
+
+/// The simulated features with an effect at strength s: their mean and that mean's variance
+/// (seed noise).
+class Response {
+public:
+    virtual ~Response() = default;
+    virtual Eigen::VectorXd mean(double s) const = 0;
+    virtual Eigen::VectorXd variance(double s) const = 0;
+};
+
+/// A response simulated at a few strengths (the off value among them) and interpolated
+/// piecewise linearly on the prior's scale; beyond the outermost strengths the last segment is
+/// extended (only as far as the prior allows).
+class TabulatedResponse final : public Response {
+public:
+    TabulatedResponse(const Prior &prior, std::vector<double> strengths,
+                      std::vector<Eigen::VectorXd> means, std::vector<Eigen::VectorXd> variances);
+    Eigen::VectorXd mean(double s) const override;
+    Eigen::VectorXd variance(double s) const override;
+    const std::vector<double> &strengths() const { return strengths_; }
+
+private:
+    Eigen::VectorXd interpolate(const std::vector<Eigen::VectorXd> &table, double s) const;
+    Prior prior_;
+    std::vector<double> strengths_;
+    std::vector<Eigen::VectorXd> means_, variances_;
+};
+
+/// A response computed exactly for any strength (an effect of the measuring chain, applied to
+/// the simulated base curves: a sensor zero offset, a compliant rig).
+class FunctionResponse final : public Response {
+public:
+    FunctionResponse(std::function<Eigen::VectorXd(double)> mean,
+                     std::function<Eigen::VectorXd(double)> variance)
+        : mean_(std::move(mean)), variance_(std::move(variance)) {}
+    Eigen::VectorXd mean(double s) const override { return mean_(s); }
+    Eigen::VectorXd variance(double s) const override { return variance_(s); }
+
+private:
+    std::function<Eigen::VectorXd(double)> mean_, variance_;
+};
+
+/// The features a comparison uses (e.g. the calibration experiments').
+using FeatureSet = std::vector<Eigen::Index>;
+
+/// chi^2 of `mean` against `measured` over `use`, with variance `u2_fixed + variance`.
+double chiSquare(const Eigen::VectorXd &measured, const Eigen::VectorXd &mean,
+                 const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_fixed,
+                 const FeatureSet &use);
+
+/// The strength that minimises chi^2 over `use` (a grid over the prior, then golden section),
+/// with a 95 % interval from the chi^2 profile (delta chi^2 = 3.84, widened by the Birge ratio
+/// chi^2 / dof when the best fit is poor).
+struct StrengthFit {
+    double strength = 0.0, lo = 0.0, hi = 0.0;
+    double chi2 = 0.0, chi2_off = 0.0; ///< at the best strength and with the effect off
+    int features = 0;
+    double birge = 1.0;
+    bool at_bound = false; ///< the best strength is an end of the prior range
+};
+StrengthFit fitStrength(const Response &response, const Prior &prior,
+                        const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
+                        const FeatureSet &use);
+
+/// Two effects together, their changes added to the base (the confirming simulation runs them
+/// together for real).
+class PairResponse final : public Response {
+public:
+    PairResponse(const Response &a, const Response &b, Eigen::VectorXd base_mean,
+                 Eigen::VectorXd base_variance)
+        : a_(a), b_(b), base_mean_(std::move(base_mean)), base_var_(std::move(base_variance)) {}
+    Eigen::VectorXd mean(double) const override { return mean(sa_, sb_); }
+    Eigen::VectorXd variance(double) const override { return variance(sa_, sb_); }
+    Eigen::VectorXd mean(double sa, double sb) const;
+    Eigen::VectorXd variance(double sa, double sb) const;
+    void set(double sa, double sb) { sa_ = sa, sb_ = sb; }
+
+private:
+    const Response &a_, &b_;
+    Eigen::VectorXd base_mean_, base_var_;
+    double sa_ = 0.0, sb_ = 0.0;
+};
+struct PairFit {
+    StrengthFit a, b; ///< each strength with its interval at the other's best value
+    double chi2 = 0.0;
+};
+PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Prior &pb,
+                const Eigen::VectorXd &base_mean, const Eigen::VectorXd &base_variance,
+                const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
+                const FeatureSet &use);
+
+/// How much of effect i's signature (its change from the base at strength s_i, weighted by
+/// 1/u^2) effect j can reproduce at its best strength: 1 = indistinguishable on this design,
+/// 0 = nothing in common. Also the weighted distance left, in chi^2 units.
+struct Overlap {
+    double fraction = 0.0;
+    double distance_chi2 = 0.0;
+    double strength_j = 0.0;
+};
+Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const Prior &pj,
+                         const Eigen::VectorXd &base_mean, const Eigen::VectorXd &u2,
+                         const FeatureSet &use);
+
+/// How well predictions match held-out features. `smse`: mean squared standardised error;
+/// `relative_rmse`: root mean square of (measured - predicted) / measured; `gap`: that
+/// relative error in excess of the validation uncertainty, sqrt(max(0, mean(r^2 - u^2))) in
+/// relative terms (0 when the model is as good as the data can tell).
+struct HeldOutScore {
+    double smse = 0.0, relative_rmse = 0.0, gap = 0.0, log_density = 0.0;
+    int features = 0;
+};
+HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd &predicted,
+                          const Eigen::VectorXd &variance, const FeatureSet &use);
+
+/// The number of independent features `use` is worth: within each experiment, features are
+/// correlated through the bed realisation (Kish's design effect, n / (1 + (k - 1) rho), with
+/// rho the mean correlation between an experiment's features over the seeds `seed_rows`).
+double effectiveCount(const std::vector<FeatureKey> &keys, const FeatureSet &use,
+                      const Eigen::MatrixXd &seed_rows);
+
+/// Sample-split test that a model predicts held-out features better than the null: the
+/// one-sided p of F = SSE_null / SSE_model with (n_eff, n_eff) degrees of freedom.
+double heldOutPValue(double sse_null, double sse_model, double n_eff);
+
+} // namespace grainlink::gap

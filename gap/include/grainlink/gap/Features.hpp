@@ -1,0 +1,53 @@
+#pragma once
+// Curves become features: the mean of a sampled curve over an x-range (a sinkage bin, a slip
+// bin), or a scalar. Measured trials, simulated seeds and effect signatures are all compared
+// feature by feature on the same bins (docs/gap.md, "Features").
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlink::gap {
+
+/// A sampled curve y(x) with x increasing; a scalar observable is a curve of one point.
+struct Curve {
+    std::vector<double> x, y;
+    bool empty() const { return y.empty(); }
+    bool scalar() const { return y.size() == 1; }
+};
+
+/// Mean of the piecewise-linear interpolant of `curve` over [a, b] (the integral over the
+/// range divided by its width); nullopt when the curve's samples do not cover [a, b].
+/// For a scalar curve (one point) the value itself.
+std::optional<double> binMean(const Curve &curve, double a, double b);
+
+/// Which feature: the experiment, its observable, and the x-range averaged over.
+struct FeatureKey {
+    std::string experiment; ///< experiment id in experiments.yaml
+    std::string observable; ///< e.g. "pressure_Pa", "angle_deg"
+    std::string kind;       ///< what is compared with what across experiments, e.g.
+                            ///< "plate_sinkage/pressure_Pa" (the discrepancy model's unit)
+    double x_lo = 0.0, x_hi = 0.0; ///< bin [x unit]; equal for a scalar
+    bool scalar() const { return x_lo == x_hi; }
+    double centre() const { return 0.5 * (x_lo + x_hi); }
+};
+
+/// Bin edges shared by every experiment of one observable kind: `count` equal bins from
+/// `start` with a round width (1, 2, 2.5 or 5 times a power of ten) chosen so that `count`
+/// bins span about `typical_end` - `start`.
+std::vector<double> roundBinEdges(double start, double typical_end, int count);
+
+/// Features of a set of curves (trials or seeds) on `edges`: one row per curve, one column
+/// per bin; NaN where a curve does not cover the bin. A scalar curve gives one column.
+Eigen::MatrixXd featureRows(const std::vector<Curve> &curves, const std::vector<double> &edges);
+
+/// Column statistics of `rows` ignoring NaN: mean, sample standard deviation (NaN below two
+/// values) and the count of values.
+struct ColumnStats {
+    Eigen::VectorXd mean, sd;
+    Eigen::VectorXi count;
+};
+ColumnStats columnStats(const Eigen::MatrixXd &rows);
+
+} // namespace grainlink::gap

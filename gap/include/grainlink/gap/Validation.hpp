@@ -1,0 +1,99 @@
+#pragma once
+// Numerical uncertainty first (ASME V&V 20): the validation uncertainty u_val of every feature
+// from the simulation's bed realisations, its numerical checks (resolution, time step, domain,
+// loading rate) and the measurement, then the standardised residuals, the gap test and the
+// words that say where the gap lies (docs/gap.md, "Validation uncertainty").
+#include "grainlink/gap/Features.hpp"
+
+#include <Eigen/Core>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace grainlink::gap {
+
+/// The measured side of every feature.
+struct Measured {
+    std::vector<FeatureKey> keys;
+    Eigen::VectorXd value; ///< mean over the trials
+    Eigen::VectorXd u_D;   ///< standard uncertainty of that mean: repeats, stated sigma, zero
+    Eigen::VectorXi trials;
+    /// True where u_D comes from repeats on re-prepared beds (and so holds the bed-to-bed
+    /// scatter); where false the simulation's single-bed scatter is added (one real bed is one
+    /// realisation too).
+    std::vector<bool> from_repeats;
+    std::size_t size() const { return keys.size(); }
+};
+
+/// One numerical check: the same features simulated with one numerical choice changed.
+struct NumericalCheck {
+    std::string name;     ///< "resolution", "time_step", "domain", "rate"
+    Eigen::MatrixXd rows; ///< seeds x features
+};
+
+/// Every part of u_val, per feature, and the residuals it standardises.
+struct ValidationResult {
+    Eigen::VectorXd simulated;  ///< base mean over seeds
+    Eigen::VectorXd seed_sd;    ///< scatter of one bed realisation (sd over seeds)
+    Eigen::VectorXd u_seed;     ///< seed_sd / sqrt(seeds): the simulated mean's own scatter
+    Eigen::VectorXd u_bed;      ///< seed_sd where the measurement has no repeats, else 0
+    std::vector<std::pair<std::string, Eigen::VectorXd>> u_checks; ///< systematic part per check
+    Eigen::VectorXd u_num;      ///< sqrt(u_seed^2 + sum u_check^2)
+    Eigen::VectorXd u_D;        ///< measurement
+    Eigen::VectorXd u_val;      ///< sqrt(u_num^2 + u_bed^2 + u_D^2)
+    Eigen::VectorXd residual;   ///< measured - simulated
+    Eigen::VectorXd standardised; ///< residual / u_val
+    Eigen::VectorXd ratio;      ///< simulated / measured
+};
+
+/// u_val and the residuals of `base` (seeds x features) against `measured`. A check's
+/// systematic part is its mean difference from the base with the seed noise of that difference
+/// removed in quadrature: u_k = sqrt(max(0, d^2 - var d)). Throws if the shapes differ.
+ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
+                          const std::vector<NumericalCheck> &checks);
+
+/// The gap test. Two tests, each at half the family-wise level alpha, valid under any
+/// correlation between features: (a) some |e| above the Bonferroni bound over all features;
+/// (b) some experiment's root-mean-square |e| above the Bonferroni bound over experiments (a
+/// consistent gap of moderate size). A feature beyond `flag_at` (2 u_val) is flagged either way.
+struct GapVerdict {
+    bool gap = false;
+    double max_abs = 0.0, feature_bound = 0.0;
+    std::string worst_experiment;
+    double worst_rms = 0.0, experiment_bound = 0.0;
+    int flagged = 0, features = 0;
+    std::string summary; ///< one sentence
+};
+GapVerdict testGap(const std::vector<FeatureKey> &keys, const Eigen::VectorXd &standardised,
+                   double alpha = 0.05, double flag_at = 2.0);
+
+/// Two-sided standard normal quantile bound: |z| exceeded with probability p.
+double normalBound(double p);
+
+/// Where the gap lies, in words: for each kind, the x-ranges where the experiments agree that
+/// the simulation is too high or too low (beyond `flag_at` u_val), with the range of the
+/// simulated/measured ratio, the experiments concerned (named by a condition they alone share
+/// when there is one), and the ranges within uncertainty.
+struct RegimeFinding {
+    std::string kind;
+    double x_lo = 0.0, x_hi = 0.0;
+    int sign = 0;          ///< +1 simulation too high, -1 too low, 0 within uncertainty
+    int experiments = 0;   ///< flagged with this sign
+    int covering = 0;      ///< experiments with a feature in this range
+    double ratio_min = 0.0, ratio_max = 0.0;
+    std::string text;
+};
+using Conditions = std::map<std::string, std::string>;
+/// How a kind's x axis is written: "sinkage", "mm", 1000 (x is in m).
+struct AxisLabel {
+    std::string name, unit;
+    double scale = 1.0;
+};
+std::vector<RegimeFinding> localise(const std::vector<FeatureKey> &keys,
+                                    const ValidationResult &validation,
+                                    const std::map<std::string, Conditions> &conditions,
+                                    const std::map<std::string, AxisLabel> &axes,
+                                    double flag_at = 2.0);
+
+} // namespace grainlink::gap

@@ -1,0 +1,307 @@
+#include "grainlink/gap/Attribution.hpp"
+
+#include <boost/math/distributions/fisher_f.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <stdexcept>
+
+namespace grainlink::gap {
+
+namespace {
+
+constexpr int kGrid = 201;
+constexpr double kDeltaChi2_95 = 3.841458820694124; // chi^2_1 at 95 %
+
+template <class F> double goldenMinimum(F f, double a, double b) {
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    double c = b - g * (b - a), d = a + g * (b - a);
+    double fc = f(c), fd = f(d);
+    for (int i = 0; i < 60 && std::abs(b - a) > 1e-10 * (1.0 + std::abs(a)); ++i) {
+        if (fc < fd) {
+            b = d, d = c, fd = fc;
+            c = b - g * (b - a), fc = f(c);
+        } else {
+            a = c, c = d, fc = fd;
+            d = a + g * (b - a), fd = f(d);
+        }
+    }
+    return 0.5 * (a + b);
+}
+
+/// Best point of f on a grid over [t0, t1], refined by golden section; the profile's interval.
+struct Profile {
+    double t_best, chi2, t_lo, t_hi;
+    bool at_bound;
+};
+template <class F> Profile minimiseProfile(F chi2, double t0, double t1, double threshold_scale) {
+    std::vector<double> t(kGrid), c(kGrid);
+    int best = 0;
+    for (int k = 0; k < kGrid; ++k) {
+        t[std::size_t(k)] = t0 + (t1 - t0) * k / double(kGrid - 1);
+        c[std::size_t(k)] = chi2(t[std::size_t(k)]);
+        if (c[std::size_t(k)] < c[std::size_t(best)])
+            best = k;
+    }
+    Profile p;
+    const double a = t[std::size_t(std::max(0, best - 1))];
+    const double b = t[std::size_t(std::min(kGrid - 1, best + 1))];
+    p.t_best = goldenMinimum(chi2, a, b);
+    p.chi2 = chi2(p.t_best);
+    if (p.chi2 > c[std::size_t(best)]) { // flat or noisy: keep the grid point
+        p.t_best = t[std::size_t(best)];
+        p.chi2 = c[std::size_t(best)];
+    }
+    p.at_bound = best == 0 || best == kGrid - 1;
+    const double limit = p.chi2 + kDeltaChi2_95 * threshold_scale;
+    // Walk out from the best grid point to where the profile crosses the limit.
+    int lo = best, hi = best;
+    while (lo > 0 && c[std::size_t(lo - 1)] <= limit)
+        --lo;
+    while (hi < kGrid - 1 && c[std::size_t(hi + 1)] <= limit)
+        ++hi;
+    const auto cross = [&](int inside, int outside) {
+        const double ci = c[std::size_t(inside)], co = c[std::size_t(outside)];
+        const double w = co > ci ? (limit - ci) / (co - ci) : 0.0;
+        return t[std::size_t(inside)] + w * (t[std::size_t(outside)] - t[std::size_t(inside)]);
+    };
+    p.t_lo = lo > 0 ? cross(lo, lo - 1) : t.front();
+    p.t_hi = hi < kGrid - 1 ? cross(hi, hi + 1) : t.back();
+    p.t_lo = std::min(p.t_lo, p.t_best);
+    p.t_hi = std::max(p.t_hi, p.t_best);
+    return p;
+}
+
+} // namespace
+
+double Prior::toScale(double s) const {
+    if (!log_scale)
+        return s;
+    if (!(s > 0.0))
+        throw std::invalid_argument("Prior: a logarithmic strength must be > 0, got " +
+                                    std::to_string(s));
+    return std::log(s);
+}
+
+double Prior::fromScale(double t) const { return log_scale ? std::exp(t) : t; }
+
+TabulatedResponse::TabulatedResponse(const Prior &prior, std::vector<double> strengths,
+                                     std::vector<Eigen::VectorXd> means,
+                                     std::vector<Eigen::VectorXd> variances)
+    : prior_(prior) {
+    if (strengths.size() < 2 || means.size() != strengths.size() ||
+        variances.size() != strengths.size())
+        throw std::invalid_argument("TabulatedResponse: need >= 2 strengths, each with a mean "
+                                    "and a variance");
+    std::vector<std::size_t> order(strengths.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    std::sort(order.begin(), order.end(),
+              [&](std::size_t a, std::size_t b) { return strengths[a] < strengths[b]; });
+    for (std::size_t i : order) {
+        strengths_.push_back(strengths[i]);
+        means_.push_back(means[i]);
+        variances_.push_back(variances[i]);
+    }
+}
+
+Eigen::VectorXd TabulatedResponse::interpolate(const std::vector<Eigen::VectorXd> &table,
+                                               double s) const {
+    const double t = prior_.toScale(s);
+    std::size_t seg = 0;
+    while (seg + 2 < strengths_.size() && t > prior_.toScale(strengths_[seg + 1]))
+        ++seg;
+    const double t0 = prior_.toScale(strengths_[seg]), t1 = prior_.toScale(strengths_[seg + 1]);
+    const double w = (t - t0) / (t1 - t0);
+    return (1.0 - w) * table[seg] + w * table[seg + 1];
+}
+
+Eigen::VectorXd TabulatedResponse::mean(double s) const { return interpolate(means_, s); }
+
+Eigen::VectorXd TabulatedResponse::variance(double s) const {
+    // Noise does not extrapolate: beyond the table, the nearest strength's.
+    const double clamped = std::clamp(s, strengths_.front(), strengths_.back());
+    return interpolate(variances_, clamped).cwiseMax(0.0);
+}
+
+double chiSquare(const Eigen::VectorXd &measured, const Eigen::VectorXd &mean,
+                 const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_fixed,
+                 const FeatureSet &use) {
+    double sum = 0.0;
+    for (Eigen::Index k : use) {
+        const double v = u2_fixed[k] + variance[k];
+        const double r = measured[k] - mean[k];
+        if (std::isfinite(r) && v > 0.0)
+            sum += r * r / v;
+    }
+    return sum;
+}
+
+StrengthFit fitStrength(const Response &response, const Prior &prior,
+                        const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
+                        const FeatureSet &use) {
+    const auto chi2 = [&](double t) {
+        const double s = prior.fromScale(t);
+        return chiSquare(measured, response.mean(s), response.variance(s), u2_fixed, use);
+    };
+    StrengthFit fit;
+    fit.features = int(use.size());
+    // A first pass gives the Birge ratio that widens the interval of a poor best fit.
+    const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi);
+    const Profile first = minimiseProfile(chi2, t0, t1, 1.0);
+    const int dof = std::max(1, fit.features - 1);
+    fit.birge = std::max(1.0, first.chi2 / dof);
+    const Profile p = fit.birge > 1.0 ? minimiseProfile(chi2, t0, t1, fit.birge) : first;
+    fit.strength = prior.fromScale(p.t_best);
+    fit.lo = prior.fromScale(p.t_lo);
+    fit.hi = prior.fromScale(p.t_hi);
+    fit.chi2 = p.chi2;
+    fit.at_bound = p.at_bound;
+    fit.chi2_off = chi2(prior.toScale(prior.off));
+    return fit;
+}
+
+Eigen::VectorXd PairResponse::mean(double sa, double sb) const {
+    return a_.mean(sa) + b_.mean(sb) - base_mean_;
+}
+
+Eigen::VectorXd PairResponse::variance(double sa, double sb) const {
+    // Each simulated response carries the base's noise once; their sum, twice.
+    return (a_.variance(sa) + b_.variance(sb) - base_var_).cwiseMax(0.0);
+}
+
+PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Prior &pb,
+                const Eigen::VectorXd &base_mean, const Eigen::VectorXd &base_variance,
+                const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
+                const FeatureSet &use) {
+    PairResponse pair(a, b, base_mean, base_variance);
+    const auto chi2 = [&](double ta, double tb) {
+        const double sa = pa.fromScale(ta), sb = pb.fromScale(tb);
+        return chiSquare(measured, pair.mean(sa, sb), pair.variance(sa, sb), u2_fixed, use);
+    };
+    const double a0 = pa.toScale(pa.lo), a1 = pa.toScale(pa.hi);
+    const double b0 = pb.toScale(pb.lo), b1 = pb.toScale(pb.hi);
+    constexpr int n = 41;
+    double best = std::numeric_limits<double>::infinity(), ta = a0, tb = b0;
+    for (int i = 0; i < n; ++i)
+        for (int j = 0; j < n; ++j) {
+            const double x = a0 + (a1 - a0) * i / (n - 1.0), y = b0 + (b1 - b0) * j / (n - 1.0);
+            const double c = chi2(x, y);
+            if (c < best)
+                best = c, ta = x, tb = y;
+        }
+    // Coordinate refinement, then each strength's profile at the other's best value.
+    for (int round = 0; round < 3; ++round) {
+        ta = minimiseProfile([&](double t) { return chi2(t, tb); }, a0, a1, 1.0).t_best;
+        tb = minimiseProfile([&](double t) { return chi2(ta, t); }, b0, b1, 1.0).t_best;
+    }
+    PairFit fit;
+    fit.chi2 = chi2(ta, tb);
+    const int dof = std::max(1, int(use.size()) - 2);
+    const double birge = std::max(1.0, fit.chi2 / dof);
+    const Profile qa = minimiseProfile([&](double t) { return chi2(t, tb); }, a0, a1, birge);
+    const Profile qb = minimiseProfile([&](double t) { return chi2(ta, t); }, b0, b1, birge);
+    const auto fill = [&](StrengthFit &f, const Profile &q, const Prior &p) {
+        f.strength = p.fromScale(q.t_best);
+        f.lo = p.fromScale(q.t_lo);
+        f.hi = p.fromScale(q.t_hi);
+        f.chi2 = q.chi2;
+        f.at_bound = q.at_bound;
+        f.features = int(use.size());
+        f.birge = birge;
+    };
+    fill(fit.a, qa, pa);
+    fill(fit.b, qb, pb);
+    fit.chi2 = std::min({fit.chi2, qa.chi2, qb.chi2});
+    fit.a.chi2_off = fit.b.chi2_off = chi2(pa.toScale(pa.off), pb.toScale(pb.off));
+    return fit;
+}
+
+Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const Prior &pj,
+                         const Eigen::VectorXd &base_mean, const Eigen::VectorXd &u2,
+                         const FeatureSet &use) {
+    const Eigen::VectorXd di = i.mean(s_i) - base_mean;
+    double norm = 0.0;
+    for (Eigen::Index k : use)
+        if (u2[k] > 0.0 && std::isfinite(di[k]))
+            norm += di[k] * di[k] / u2[k];
+    const auto distance = [&](double t) {
+        const Eigen::VectorXd dj = j.mean(pj.fromScale(t)) - base_mean;
+        double d = 0.0;
+        for (Eigen::Index k : use)
+            if (u2[k] > 0.0 && std::isfinite(di[k]) && std::isfinite(dj[k]))
+                d += (di[k] - dj[k]) * (di[k] - dj[k]) / u2[k];
+        return d;
+    };
+    const Profile p = minimiseProfile(distance, pj.toScale(pj.lo), pj.toScale(pj.hi), 1.0);
+    Overlap o;
+    o.distance_chi2 = p.chi2;
+    o.strength_j = pj.fromScale(p.t_best);
+    o.fraction = norm > 0.0 ? std::clamp(1.0 - p.chi2 / norm, 0.0, 1.0) : 1.0;
+    return o;
+}
+
+HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd &predicted,
+                          const Eigen::VectorXd &variance, const FeatureSet &use) {
+    HeldOutScore s;
+    double se = 0.0, rel = 0.0, excess = 0.0;
+    for (Eigen::Index k : use) {
+        const double r = measured[k] - predicted[k], v = variance[k], y = measured[k];
+        if (!std::isfinite(r) || !(v > 0.0) || y == 0.0)
+            continue;
+        ++s.features;
+        se += r * r / v;
+        rel += (r / y) * (r / y);
+        excess += (r * r - v) / (y * y);
+        s.log_density += -0.5 * (r * r / v + std::log(2.0 * M_PI * v));
+    }
+    if (s.features == 0)
+        return s;
+    s.smse = se / s.features;
+    s.relative_rmse = std::sqrt(rel / s.features);
+    s.gap = std::sqrt(std::max(0.0, excess / s.features));
+    return s;
+}
+
+double effectiveCount(const std::vector<FeatureKey> &keys, const FeatureSet &use,
+                      const Eigen::MatrixXd &seed_rows) {
+    std::map<std::string, std::vector<Eigen::Index>> groups;
+    for (Eigen::Index k : use)
+        groups[keys[std::size_t(k)].experiment].push_back(k);
+    double n_eff = 0.0;
+    for (const auto &[id, idx] : groups) {
+        const double k = double(idx.size());
+        double rho = 0.5; // too few seeds to tell: halfway between independent and one
+        if (seed_rows.rows() >= 3 && idx.size() >= 2) {
+            double sum = 0.0;
+            int pairs = 0;
+            for (std::size_t a = 0; a < idx.size(); ++a)
+                for (std::size_t b = a + 1; b < idx.size(); ++b) {
+                    const Eigen::VectorXd x = seed_rows.col(idx[a]), y = seed_rows.col(idx[b]);
+                    if (!x.allFinite() || !y.allFinite())
+                        continue;
+                    const Eigen::VectorXd dx = x.array() - x.mean(), dy = y.array() - y.mean();
+                    const double den = std::sqrt(dx.squaredNorm() * dy.squaredNorm());
+                    if (den <= 0.0)
+                        continue;
+                    sum += std::clamp(dx.dot(dy) / den, 0.0, 1.0);
+                    ++pairs;
+                }
+            if (pairs > 0)
+                rho = sum / pairs;
+        }
+        n_eff += k / (1.0 + (k - 1.0) * rho);
+    }
+    return n_eff;
+}
+
+double heldOutPValue(double sse_null, double sse_model, double n_eff) {
+    if (!(n_eff > 0.0) || !(sse_model > 0.0))
+        return sse_null > 0.0 && sse_model == 0.0 ? 0.0 : 1.0;
+    const boost::math::fisher_f f(n_eff, n_eff);
+    return boost::math::cdf(boost::math::complement(f, sse_null / sse_model));
+}
+
+} // namespace grainlink::gap

@@ -1,0 +1,133 @@
+#include "grainlink/gap/Discrepancy.hpp"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <limits>
+#include <set>
+#include <stdexcept>
+
+namespace grainlink::gap {
+
+namespace {
+
+double kernel(const Discrepancy::Hyper &h, const Eigen::VectorXd &a, const Eigen::VectorXd &b) {
+    const double d2 = (a - b).squaredNorm();
+    return h.constant_sd * h.constant_sd +
+           h.smooth_sd * h.smooth_sd * std::exp(-0.5 * d2 / (h.length * h.length));
+}
+
+} // namespace
+
+Discrepancy Discrepancy::fit(const std::vector<RegimePoint> &points, const Eigen::VectorXd &rho,
+                             const Eigen::VectorXd &noise_sd) {
+    if (Eigen::Index(points.size()) != rho.size() || rho.size() != noise_sd.size())
+        throw std::invalid_argument("Discrepancy::fit: points, residuals and noise differ in size");
+    std::map<std::string, std::vector<Eigen::Index>> by_kind;
+    for (std::size_t i = 0; i < points.size(); ++i)
+        if (std::isfinite(rho[Eigen::Index(i)]) && noise_sd[Eigen::Index(i)] > 0.0)
+            by_kind[points[i].kind].push_back(Eigen::Index(i));
+
+    // Grid of hyperparameters: relative biases from none to 80 %, length scales from a fifth
+    // to twice the coordinates' range.
+    const double sds[] = {0.0, 0.02, 0.05, 0.1, 0.2, 0.4, 0.8, 1.6};
+    const double lengths[] = {0.2, 0.5, 1.0, 2.0};
+    Discrepancy d;
+    for (const auto &[kind, idx] : by_kind) {
+        const Eigen::Index n = Eigen::Index(idx.size());
+        Eigen::VectorXd y(n), noise2(n);
+        std::vector<Eigen::VectorXd> x;
+        for (Eigen::Index i = 0; i < n; ++i) {
+            y[i] = rho[idx[std::size_t(i)]];
+            noise2[i] = noise_sd[idx[std::size_t(i)]] * noise_sd[idx[std::size_t(i)]];
+            x.push_back(points[std::size_t(idx[std::size_t(i)])].x);
+        }
+        KindFit best;
+        best.hyper.log_marginal = -std::numeric_limits<double>::infinity();
+        for (double c : sds)
+            for (double s : sds)
+                for (double l : lengths) {
+                    if (s == 0.0 && l != lengths[0])
+                        continue; // the length scale is irrelevant without a smooth part
+                    Hyper h{c, s, l, 0.0};
+                    Eigen::MatrixXd K(n, n);
+                    for (Eigen::Index i = 0; i < n; ++i)
+                        for (Eigen::Index j = 0; j < n; ++j)
+                            K(i, j) = kernel(h, x[std::size_t(i)], x[std::size_t(j)]) +
+                                      (i == j ? noise2[i] : 0.0);
+                    Eigen::LLT<Eigen::MatrixXd> llt(K);
+                    if (llt.info() != Eigen::Success)
+                        continue;
+                    const Eigen::VectorXd alpha = llt.solve(y);
+                    const double logdet =
+                        2.0 * llt.matrixL().toDenseMatrix().diagonal().array().log().sum();
+                    h.log_marginal = -0.5 * y.dot(alpha) - 0.5 * logdet -
+                                     0.5 * double(n) * std::log(2.0 * M_PI);
+                    if (h.log_marginal > best.hyper.log_marginal) {
+                        best.hyper = h;
+                        best.alpha = alpha;
+                        best.k_inv = llt.solve(Eigen::MatrixXd::Identity(n, n));
+                        best.x = x;
+                    }
+                }
+        if (!std::isfinite(best.hyper.log_marginal))
+            continue;
+        d.hyper_[kind] = best.hyper;
+        d.fits_[kind] = std::move(best);
+    }
+    return d;
+}
+
+DiscrepancyPrediction Discrepancy::predict(const std::vector<RegimePoint> &points) const {
+    DiscrepancyPrediction p;
+    const Eigen::Index n = Eigen::Index(points.size());
+    p.mean = Eigen::VectorXd::Zero(n);
+    p.variance = Eigen::VectorXd::Zero(n);
+    for (Eigen::Index i = 0; i < n; ++i) {
+        const auto it = fits_.find(points[std::size_t(i)].kind);
+        if (it == fits_.end())
+            continue;
+        const KindFit &f = it->second;
+        Eigen::VectorXd k(Eigen::Index(f.x.size()));
+        for (std::size_t j = 0; j < f.x.size(); ++j)
+            k[Eigen::Index(j)] = kernel(f.hyper, points[std::size_t(i)].x, f.x[j]);
+        const double prior = kernel(f.hyper, points[std::size_t(i)].x, points[std::size_t(i)].x);
+        p.mean[i] = k.dot(f.alpha);
+        p.variance[i] = std::max(0.0, prior - k.dot(f.k_inv * k));
+    }
+    return p;
+}
+
+std::vector<RegimePoint>
+regimeCoordinates(const std::vector<std::string> &kinds,
+                  const std::vector<std::map<std::string, double>> &coordinates) {
+    if (kinds.size() != coordinates.size())
+        throw std::invalid_argument("regimeCoordinates: kinds and coordinates differ in size");
+    // Range of every coordinate within each kind.
+    std::map<std::string, std::map<std::string, std::pair<double, double>>> range;
+    for (std::size_t i = 0; i < kinds.size(); ++i)
+        for (const auto &[name, v] : coordinates[i]) {
+            auto [it, fresh] = range[kinds[i]].try_emplace(name, v, v);
+            it->second.first = std::min(it->second.first, v);
+            it->second.second = std::max(it->second.second, v);
+        }
+    std::vector<RegimePoint> points;
+    for (std::size_t i = 0; i < kinds.size(); ++i) {
+        RegimePoint p;
+        p.kind = kinds[i];
+        std::vector<double> x;
+        for (const auto &[name, r] : range[kinds[i]]) {
+            const double width = r.second - r.first;
+            if (!(width > 0.0))
+                continue;
+            const auto it = coordinates[i].find(name);
+            x.push_back(it == coordinates[i].end() ? 0.0 : (it->second - r.first) / width);
+        }
+        p.x = Eigen::Map<Eigen::VectorXd>(x.data(), Eigen::Index(x.size()));
+        points.push_back(std::move(p));
+    }
+    return points;
+}
+
+} // namespace grainlink::gap

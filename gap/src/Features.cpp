@@ -1,0 +1,98 @@
+#include "grainlink/gap/Features.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace grainlink::gap {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}
+
+std::optional<double> binMean(const Curve &curve, double a, double b) {
+    const auto &x = curve.x;
+    const auto &y = curve.y;
+    if (y.empty() || x.size() != y.size())
+        return std::nullopt;
+    if (y.size() == 1)
+        return y[0];
+    if (!(b > a) || x.front() > a || x.back() < b)
+        return std::nullopt;
+    // Trapezoid rule on the interpolant clipped to [a, b].
+    const auto interpolate = [&](std::size_t i, double t) {
+        const double w = (t - x[i]) / (x[i + 1] - x[i]);
+        return y[i] + w * (y[i + 1] - y[i]);
+    };
+    double integral = 0.0;
+    for (std::size_t i = 0; i + 1 < x.size(); ++i) {
+        const double lo = std::max(a, x[i]), hi = std::min(b, x[i + 1]);
+        if (hi <= lo || x[i + 1] <= x[i])
+            continue;
+        integral += 0.5 * (interpolate(i, lo) + interpolate(i, hi)) * (hi - lo);
+    }
+    return integral / (b - a);
+}
+
+std::vector<double> roundBinEdges(double start, double typical_end, int count) {
+    if (count < 1 || !(typical_end > start))
+        throw std::invalid_argument("roundBinEdges: need count >= 1 and end > start");
+    const double raw = (typical_end - start) / count;
+    const double decade = std::pow(10.0, std::floor(std::log10(raw)));
+    double width = decade;
+    for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
+        if (m * decade <= raw * 1.0000001)
+            width = m * decade;
+    std::vector<double> edges;
+    for (int k = 0; k <= count; ++k)
+        edges.push_back(start + k * width);
+    return edges;
+}
+
+Eigen::MatrixXd featureRows(const std::vector<Curve> &curves, const std::vector<double> &edges) {
+    const bool scalar = !curves.empty() && curves.front().scalar();
+    const int bins = scalar ? 1 : int(edges.size()) - 1;
+    Eigen::MatrixXd rows = Eigen::MatrixXd::Constant(Eigen::Index(curves.size()), bins, kNaN);
+    for (std::size_t r = 0; r < curves.size(); ++r) {
+        if (scalar) {
+            rows(Eigen::Index(r), 0) = curves[r].empty() ? kNaN : curves[r].y[0];
+            continue;
+        }
+        for (int k = 0; k < bins; ++k)
+            if (const auto m = binMean(curves[r], edges[std::size_t(k)], edges[std::size_t(k) + 1]))
+                rows(Eigen::Index(r), k) = *m;
+    }
+    return rows;
+}
+
+ColumnStats columnStats(const Eigen::MatrixXd &rows) {
+    ColumnStats s;
+    const Eigen::Index n = rows.cols();
+    s.mean = Eigen::VectorXd::Constant(n, kNaN);
+    s.sd = Eigen::VectorXd::Constant(n, kNaN);
+    s.count = Eigen::VectorXi::Zero(n);
+    for (Eigen::Index c = 0; c < n; ++c) {
+        double sum = 0.0;
+        int k = 0;
+        for (Eigen::Index r = 0; r < rows.rows(); ++r)
+            if (std::isfinite(rows(r, c))) {
+                sum += rows(r, c);
+                ++k;
+            }
+        s.count[c] = k;
+        if (k == 0)
+            continue;
+        s.mean[c] = sum / k;
+        if (k < 2)
+            continue;
+        double ss = 0.0;
+        for (Eigen::Index r = 0; r < rows.rows(); ++r)
+            if (std::isfinite(rows(r, c)))
+                ss += (rows(r, c) - s.mean[c]) * (rows(r, c) - s.mean[c]);
+        s.sd[c] = std::sqrt(ss / (k - 1));
+    }
+    return s;
+}
+
+} // namespace grainlink::gap

@@ -1,0 +1,272 @@
+#include "grainlink/gap/Validation.hpp"
+
+#include <boost/math/distributions/normal.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace grainlink::gap {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+double sq(double v) { return v * v; }
+
+/// "pressure" from "pressure_Pa": the observable's name without its unit suffix.
+std::string observableName(const std::string &observable) {
+    const auto cut = observable.find('_');
+    return cut == std::string::npos ? observable : observable.substr(0, cut);
+}
+
+std::string format(double v, int digits = 2) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return buf;
+}
+
+/// "2.1-2.9", or "2.5" when both ends print the same.
+std::string range(double a, double b, int digits = 2) {
+    const std::string lo = format(a, digits), hi = format(b, digits);
+    return lo == hi ? lo : lo + "-" + hi;
+}
+
+} // namespace
+
+double normalBound(double p) {
+    if (!(p > 0.0 && p < 1.0))
+        throw std::invalid_argument("normalBound: p must be in (0, 1)");
+    return boost::math::quantile(boost::math::complement(boost::math::normal(), 0.5 * p));
+}
+
+ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
+                          const std::vector<NumericalCheck> &checks) {
+    const Eigen::Index n = Eigen::Index(measured.size());
+    if (base.cols() != n)
+        throw std::invalid_argument("validate: " + std::to_string(base.cols()) +
+                                    " simulated features against " + std::to_string(n) +
+                                    " measured ones");
+    ValidationResult v;
+    const ColumnStats b = columnStats(base);
+    v.simulated = b.mean;
+    v.seed_sd = b.sd;
+    v.u_seed.resize(n);
+    v.u_bed.resize(n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+        // One seed gives no scatter: the feature's uncertainty is then unknown, not zero.
+        const double sd = b.count[k] >= 2 ? b.sd[k] : kNaN;
+        v.seed_sd[k] = sd;
+        v.u_seed[k] = sd / std::sqrt(double(std::max(1, b.count[k])));
+        v.u_bed[k] = measured.from_repeats[std::size_t(k)] ? 0.0 : sd;
+    }
+    Eigen::VectorXd num2 = v.u_seed.array().square();
+    for (const NumericalCheck &check : checks) {
+        if (check.rows.cols() != n)
+            throw std::invalid_argument("validate: check '" + check.name + "' has " +
+                                        std::to_string(check.rows.cols()) + " features, not " +
+                                        std::to_string(n));
+        const ColumnStats c = columnStats(check.rows);
+        Eigen::VectorXd u(n);
+        for (Eigen::Index k = 0; k < n; ++k) {
+            if (c.count[k] == 0 || !std::isfinite(b.mean[k])) {
+                u[k] = 0.0; // the check did not reach this feature: nothing to add
+                continue;
+            }
+            const double d = c.mean[k] - b.mean[k];
+            // The difference of two seed means carries their noise; remove it in quadrature.
+            const double sd_c = c.count[k] >= 2 ? c.sd[k] : v.seed_sd[k];
+            const double noise = sq(sd_c) / std::max(1, c.count[k]) + sq(v.u_seed[k]);
+            u[k] = std::sqrt(std::max(0.0, sq(d) - (std::isfinite(noise) ? noise : 0.0)));
+        }
+        num2 += u.array().square().matrix();
+        v.u_checks.emplace_back(check.name, u);
+    }
+    v.u_num = num2.array().sqrt();
+    v.u_D = measured.u_D;
+    v.u_val = (num2.array() + v.u_bed.array().square() + v.u_D.array().square()).sqrt();
+    v.residual = measured.value - v.simulated;
+    v.standardised = v.residual.array() / v.u_val.array();
+    v.ratio = v.simulated.array() / measured.value.array();
+    return v;
+}
+
+GapVerdict testGap(const std::vector<FeatureKey> &keys, const Eigen::VectorXd &standardised,
+                   double alpha, double flag_at) {
+    GapVerdict g;
+    std::map<std::string, std::pair<double, int>> per_experiment; // sum e^2, count
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+        const double e = standardised[Eigen::Index(k)];
+        if (!std::isfinite(e))
+            continue;
+        ++g.features;
+        if (std::abs(e) > flag_at)
+            ++g.flagged;
+        g.max_abs = std::max(g.max_abs, std::abs(e));
+        auto &acc = per_experiment[keys[k].experiment];
+        acc.first += e * e;
+        ++acc.second;
+    }
+    if (g.features == 0) {
+        g.summary = "no feature could be compared";
+        return g;
+    }
+    g.feature_bound = std::max(flag_at, normalBound(0.5 * alpha / g.features));
+    g.experiment_bound = std::max(flag_at, normalBound(0.5 * alpha / double(per_experiment.size())));
+    for (const auto &[id, acc] : per_experiment) {
+        const double rms = std::sqrt(acc.first / acc.second);
+        if (rms > g.worst_rms) {
+            g.worst_rms = rms;
+            g.worst_experiment = id;
+        }
+    }
+    g.gap = g.max_abs > g.feature_bound || g.worst_rms > g.experiment_bound;
+    std::ostringstream s;
+    if (g.gap)
+        s << "gap: ";
+    else
+        s << "no gap: ";
+    s << g.flagged << " of " << g.features << " features beyond " << format(flag_at)
+      << " u_val; largest |e| " << format(g.max_abs, 3) << " (bound " << format(g.feature_bound, 3)
+      << "), largest experiment rms " << format(g.worst_rms, 3) << " in " << g.worst_experiment
+      << " (bound " << format(g.experiment_bound, 3) << ")";
+    g.summary = s.str();
+    return g;
+}
+
+std::vector<RegimeFinding> localise(const std::vector<FeatureKey> &keys,
+                                    const ValidationResult &v,
+                                    const std::map<std::string, Conditions> &conditions,
+                                    const std::map<std::string, AxisLabel> &axes,
+                                    double flag_at) {
+    // kind -> bin (x_lo, x_hi) -> feature indices
+    std::map<std::string, std::map<std::pair<double, double>, std::vector<std::size_t>>> bins;
+    for (std::size_t k = 0; k < keys.size(); ++k)
+        if (std::isfinite(v.standardised[Eigen::Index(k)]))
+            bins[keys[k].kind][{keys[k].x_lo, keys[k].x_hi}].push_back(k);
+
+    // The condition (key = value) that the flagged experiments alone share, if any.
+    const auto sharedCondition = [&](const std::set<std::string> &flagged,
+                                     const std::set<std::string> &all) -> std::string {
+        if (flagged.size() == all.size() || flagged.empty())
+            return "";
+        const auto first = conditions.find(*flagged.begin());
+        if (first == conditions.end())
+            return "";
+        for (const auto &[key, value] : first->second) {
+            bool ok = true;
+            for (const std::string &id : all) {
+                const auto c = conditions.find(id);
+                const bool has = c != conditions.end() && c->second.count(key) &&
+                                 c->second.at(key) == value;
+                if (has != (flagged.count(id) > 0)) {
+                    ok = false;
+                    break;
+                }
+            }
+            if (ok)
+                return key + " " + value;
+        }
+        return "";
+    };
+
+    std::vector<RegimeFinding> findings;
+    for (const auto &[kind, by_bin] : bins) {
+        const auto axis_it = axes.find(kind);
+        const AxisLabel axis = axis_it != axes.end() ? axis_it->second : AxisLabel{"x", "", 1.0};
+        const std::string observable = observableName(keys[by_bin.begin()->second.front()].observable);
+        // Per bin: the verdict most experiments share (too high, too low, within).
+        struct Bin {
+            double lo, hi;
+            int sign;
+            std::set<std::string> flagged, covering;
+            double rmin, rmax;
+        };
+        std::vector<Bin> row;
+        for (const auto &[range, indices] : by_bin) {
+            int high = 0, low = 0;
+            Bin b{range.first, range.second, 0, {}, {}, 1e300, -1e300};
+            for (std::size_t k : indices) {
+                const double e = v.standardised[Eigen::Index(k)];
+                b.covering.insert(keys[k].experiment);
+                high += e < -flag_at; // measured below simulated: simulation too high
+                low += e > flag_at;
+            }
+            const int n = int(indices.size());
+            b.sign = (2 * high > n) ? +1 : (2 * low > n) ? -1 : 0;
+            if (b.sign == 0 && (high > 0 || low > 0))
+                b.sign = high >= low ? +1 : -1; // a minority: reported with its count
+            for (std::size_t k : indices) {
+                const double e = v.standardised[Eigen::Index(k)];
+                if ((b.sign > 0 && e < -flag_at) || (b.sign < 0 && e > flag_at)) {
+                    b.flagged.insert(keys[k].experiment);
+                    b.rmin = std::min(b.rmin, v.ratio[Eigen::Index(k)]);
+                    b.rmax = std::max(b.rmax, v.ratio[Eigen::Index(k)]);
+                }
+            }
+            row.push_back(b);
+        }
+        // Merge neighbouring bins with the same verdict and the same flagged experiments.
+        for (std::size_t i = 0; i < row.size();) {
+            std::size_t j = i + 1;
+            while (j < row.size() && row[j].sign == row[i].sign &&
+                   row[j].flagged == row[i].flagged && row[j].lo <= row[j - 1].hi * 1.000001 +
+                   1e-300)
+                ++j;
+            RegimeFinding f;
+            f.kind = kind;
+            f.x_lo = row[i].lo;
+            f.x_hi = row[j - 1].hi;
+            f.sign = row[i].sign;
+            std::set<std::string> covering, flagged = row[i].flagged;
+            double rmin = 1e300, rmax = -1e300;
+            for (std::size_t m = i; m < j; ++m) {
+                covering.insert(row[m].covering.begin(), row[m].covering.end());
+                rmin = std::min(rmin, row[m].rmin);
+                rmax = std::max(rmax, row[m].rmax);
+            }
+            f.experiments = int(flagged.size());
+            f.covering = int(covering.size());
+            std::ostringstream t;
+            t << observable;
+            if (f.sign == 0) {
+                t << " within uncertainty";
+            } else {
+                f.ratio_min = rmin;
+                f.ratio_max = rmax;
+                const bool high = f.sign > 0;
+                // Ratios far from 1 read best as "2-3x"; near 1 as a percentage.
+                if (high && rmin >= 1.5)
+                    t << ' ' << range(rmin, rmax) << "x too high";
+                else if (!high && rmax <= 1.0 / 1.5)
+                    t << ' ' << range(1.0 / rmax, 1.0 / rmin) << "x too low";
+                else
+                    t << ' '
+                      << range(100.0 * std::abs(high ? rmin - 1.0 : 1.0 - rmax),
+                               100.0 * std::abs(high ? rmax - 1.0 : 1.0 - rmin))
+                      << " % too " << (high ? "high" : "low");
+            }
+            if (!keys.empty() && f.x_lo != f.x_hi)
+                t << " at " << axis.name << ' ' << range(f.x_lo * axis.scale, f.x_hi * axis.scale, 3)
+                  << (axis.unit.empty() ? "" : " " + axis.unit);
+            if (f.sign != 0) {
+                const std::string shared = sharedCondition(flagged, covering);
+                if (f.experiments == f.covering)
+                    t << " on every experiment (" << f.covering << ")";
+                else
+                    t << " on " << f.experiments << " of " << f.covering << " experiments"
+                      << (shared.empty() ? "" : " (those with " + shared + ")");
+            }
+            f.text = t.str();
+            findings.push_back(f);
+            i = j;
+        }
+    }
+    return findings;
+}
+
+} // namespace grainlink::gap

@@ -1,0 +1,146 @@
+#include "grainlink/gap/Attribution.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+using namespace grainlink::gap;
+
+namespace {
+
+/// A response linear in s: base + s J, simulated (tabulated) at three strengths, no noise.
+TabulatedResponse linear(const Prior &prior, const Eigen::VectorXd &base,
+                         const Eigen::VectorXd &J, std::vector<double> at) {
+    std::vector<Eigen::VectorXd> means, vars;
+    for (double s : at) {
+        means.push_back(base + s * J);
+        vars.push_back(Eigen::VectorXd::Zero(base.size()));
+    }
+    return TabulatedResponse(prior, at, means, vars);
+}
+
+FeatureSet all(int n) {
+    FeatureSet f;
+    for (int i = 0; i < n; ++i)
+        f.push_back(i);
+    return f;
+}
+
+} // namespace
+
+TEST_CASE("the fitted strength's 95 % interval covers the true strength about 95 % of the time",
+          "[gap][attribution]") {
+    const Prior prior{0.0, 1.0, 0.0, false};
+    const Eigen::VectorXd base = Eigen::VectorXd::Constant(5, 10.0);
+    Eigen::VectorXd J(5);
+    J << 1, 2, 3, 4, 5;
+    const auto r = linear(prior, base, J, {0.0, 0.5, 1.0});
+    const double u = 0.2, truth = 0.4;
+    const Eigen::VectorXd u2 = Eigen::VectorXd::Constant(5, u * u);
+    std::mt19937 rng(1);
+    std::normal_distribution<double> noise(0.0, u);
+    int covered = 0;
+    const int draws = 400;
+    for (int d = 0; d < draws; ++d) {
+        Eigen::VectorXd y = base + truth * J;
+        for (int k = 0; k < 5; ++k)
+            y[k] += noise(rng);
+        const auto fit = fitStrength(r, prior, y, u2, all(5));
+        covered += fit.lo <= truth && truth <= fit.hi;
+        if (d == 0) {
+            // Least squares on a linear model: s = J.(y - base) / J.J exactly.
+            CHECK(fit.strength == Approx(J.dot(y - base) / J.dot(J)).margin(1e-6));
+            CHECK(fit.chi2_off > fit.chi2);
+        }
+    }
+    // The Birge widening makes the interval slightly conservative.
+    CHECK(double(covered) / draws > 0.91);
+    CHECK(double(covered) / draws < 0.995);
+}
+
+TEST_CASE("a logarithmic strength is found on its own scale", "[gap][attribution]") {
+    // m(s) = 10 s^0.5, tabulated at 0.3, 1, 3 (linear in log s only piecewise): data at s = 2.
+    const Prior prior{0.2, 5.0, 1.0, true};
+    std::vector<Eigen::VectorXd> means, vars;
+    for (double s : {0.3, 1.0, 3.0}) {
+        means.push_back(Eigen::VectorXd::Constant(3, 10.0 * std::sqrt(s)));
+        vars.push_back(Eigen::VectorXd::Zero(3));
+    }
+    const TabulatedResponse r(prior, {0.3, 1.0, 3.0}, means, vars);
+    const Eigen::VectorXd y = Eigen::VectorXd::Constant(3, 10.0 * std::sqrt(2.0));
+    const auto fit = fitStrength(r, prior, y, Eigen::VectorXd::Constant(3, 0.01), all(3));
+    CHECK(fit.strength == Approx(2.0).epsilon(0.08));
+}
+
+TEST_CASE("two effects with different signatures are both recovered by the pair fit",
+          "[gap][attribution]") {
+    const Prior pa{0.0, 1.0, 0.0, false}, pb{0.0, 2.0, 0.0, false};
+    const Eigen::VectorXd base = Eigen::VectorXd::Constant(6, 5.0);
+    Eigen::VectorXd Ja(6), Jb(6);
+    Ja << 1, 1, 1, 0, 0, 0;
+    Jb << 0, 0, 1, 1, 1, 1;
+    const auto ra = linear(pa, base, Ja, {0.0, 1.0});
+    const auto rb = linear(pb, base, Jb, {0.0, 2.0});
+    const Eigen::VectorXd y = base + 0.3 * Ja + 1.2 * Jb;
+    const auto fit = fitPair(ra, pa, rb, pb, base, Eigen::VectorXd::Zero(6), y,
+                             Eigen::VectorXd::Constant(6, 1e-4), all(6));
+    CHECK(fit.a.strength == Approx(0.3).margin(0.01));
+    CHECK(fit.b.strength == Approx(1.2).margin(0.01));
+    CHECK(fit.chi2 < 1e-3);
+}
+
+TEST_CASE("signature overlap: proportional signatures overlap fully, orthogonal ones not at all",
+          "[gap][attribution]") {
+    const Prior p{0.0, 1.0, 0.0, false};
+    const Eigen::VectorXd base = Eigen::VectorXd::Zero(4);
+    Eigen::VectorXd J1(4), J2(4), J3(4);
+    J1 << 1, 2, 3, 4;
+    J2 << 2, 4, 6, 8;
+    J3 << 4, -3, 2, -1.25; // J1 . J3 = 0
+    const auto r1 = linear(p, base, J1, {0.0, 1.0}), r2 = linear(p, base, J2, {0.0, 1.0}),
+               r3 = linear(p, base, J3, {0.0, 1.0});
+    const Eigen::VectorXd u2 = Eigen::VectorXd::Ones(4);
+    const auto same = signatureOverlap(r1, 0.8, r2, p, base, u2, all(4));
+    CHECK(same.fraction == Approx(1.0).margin(1e-6));
+    CHECK(same.strength_j == Approx(0.4).margin(1e-4));
+    CHECK(signatureOverlap(r1, 0.8, r3, p, base, u2, all(4)).fraction == Approx(0.0).margin(1e-6));
+}
+
+TEST_CASE("held-out scores: a perfect model has no gap; a 10 % error is a 10 % relative rmse",
+          "[gap][attribution]") {
+    const Eigen::VectorXd y = Eigen::VectorXd::Constant(4, 100.0);
+    const auto perfect = scoreHeldOut(y, y, Eigen::VectorXd::Constant(4, 4.0), all(4));
+    CHECK(perfect.gap == 0.0);
+    CHECK(perfect.smse == 0.0);
+    const auto off = scoreHeldOut(y, y * 0.9, Eigen::VectorXd::Constant(4, 1e-6), all(4));
+    CHECK(off.relative_rmse == Approx(0.1));
+    CHECK(off.gap == Approx(0.1).epsilon(1e-6));
+}
+
+TEST_CASE("effective count: one per experiment when its features move together, about k when "
+          "independent",
+          "[gap][attribution]") {
+    std::vector<FeatureKey> keys;
+    for (int b = 0; b < 5; ++b)
+        keys.push_back({"e", "p", "k", double(b), double(b + 1)});
+    std::mt19937 rng(2);
+    std::normal_distribution<double> z;
+    Eigen::MatrixXd together(40, 5), apart(40, 5);
+    for (int s = 0; s < 40; ++s) {
+        const double shared = z(rng);
+        for (int b = 0; b < 5; ++b) {
+            together(s, b) = shared;
+            apart(s, b) = z(rng);
+        }
+    }
+    CHECK(effectiveCount(keys, all(5), together) == Approx(1.0));
+    CHECK(effectiveCount(keys, all(5), apart) > 3.5);
+}
+
+TEST_CASE("the sample-split F test: equal errors give p = 1/2, a tenfold smaller error a small p",
+          "[gap][attribution]") {
+    CHECK(heldOutPValue(10.0, 10.0, 6.0) == Approx(0.5));
+    CHECK(heldOutPValue(100.0, 10.0, 6.0) < 0.01);
+    CHECK(heldOutPValue(10.0, 100.0, 6.0) > 0.99);
+}

@@ -1,0 +1,64 @@
+#include "grainlink/gap/Features.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace grainlink::gap;
+
+namespace {
+Curve sampled(double (*f)(double), double a, double b, int n) {
+    Curve c;
+    for (int i = 0; i <= n; ++i) {
+        const double x = a + (b - a) * i / n;
+        c.x.push_back(x);
+        c.y.push_back(f(x));
+    }
+    return c;
+}
+} // namespace
+
+TEST_CASE("a bin mean is the integral of the curve over the bin divided by its width",
+          "[gap][features]") {
+    // y = x^2: the mean over [a, b] is (b^3 - a^3) / (3 (b - a)); the trapezoid rule with
+    // h = 1e-3 errs by h^2 f'' / 12 = 1.7e-7 (1.3e-6 relative).
+    const Curve c = sampled([](double x) { return x * x; }, 0.0, 1.0, 1000);
+    const double a = 0.2, b = 0.5;
+    REQUIRE(binMean(c, a, b).has_value());
+    CHECK(*binMean(c, a, b) == Approx((b * b * b - a * a * a) / (3.0 * (b - a))).epsilon(2e-6));
+    // A linear curve's bin mean is exact, even with the bin edges between samples.
+    const Curve line{{0.0, 0.3, 1.0}, {1.0, 1.6, 3.0}};
+    CHECK(*binMean(line, 0.1, 0.9) == Approx(1.0 + 2.0 * 0.5).epsilon(1e-12));
+}
+
+TEST_CASE("a bin the curve does not cover has no mean; a scalar is its own value",
+          "[gap][features]") {
+    const Curve c{{0.0, 0.01}, {0.0, 1.0}};
+    CHECK_FALSE(binMean(c, 0.005, 0.02).has_value());
+    CHECK_FALSE(binMean(c, -0.001, 0.005).has_value());
+    CHECK(*binMean(Curve{{0.0}, {31.5}}, 0.0, 0.0) == 31.5);
+}
+
+TEST_CASE("bin edges have a round width", "[gap][features]") {
+    const auto e = roundBinEdges(0.0, 0.02, 6); // 3.33 mm raw -> 2.5 mm
+    REQUIRE(e.size() == 7);
+    CHECK(e[1] == Approx(0.0025));
+    CHECK(e.back() == Approx(0.015));
+    const auto f = roundBinEdges(1.0, 2.0, 5); // 0.2 exactly
+    CHECK(f[1] == Approx(1.2));
+}
+
+TEST_CASE("feature rows and their column statistics skip what a curve does not reach",
+          "[gap][features]") {
+    const std::vector<Curve> curves{{{0.0, 2.0}, {0.0, 2.0}}, {{0.0, 1.0}, {0.0, 2.0}}};
+    const Eigen::MatrixXd rows = featureRows(curves, {0.0, 1.0, 2.0});
+    CHECK(rows(0, 0) == Approx(0.5));
+    CHECK(rows(1, 0) == Approx(1.0));
+    CHECK(std::isnan(rows(1, 1)));
+    const ColumnStats s = columnStats(rows);
+    CHECK(s.mean[0] == Approx(0.75));
+    CHECK(s.sd[0] == Approx(std::sqrt(0.125)));
+    CHECK(s.count[1] == 1);
+    CHECK(s.mean[1] == Approx(1.5));
+    CHECK(std::isnan(s.sd[1]));
+}

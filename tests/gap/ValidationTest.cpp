@@ -1,0 +1,143 @@
+#include "grainlink/gap/Validation.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <random>
+
+using namespace grainlink::gap;
+
+namespace {
+
+Measured oneFeature(double value, double u_D, bool repeats) {
+    Measured m;
+    m.keys = {{"e1", "pressure_Pa", "plate/pressure_Pa", 0.0, 0.002}};
+    m.value = Eigen::VectorXd::Constant(1, value);
+    m.u_D = Eigen::VectorXd::Constant(1, u_D);
+    m.trials = Eigen::VectorXi::Constant(1, 1);
+    m.from_repeats = {repeats};
+    return m;
+}
+
+} // namespace
+
+TEST_CASE("u_val combines the seeds, one bed's scatter, the checks and the measurement",
+          "[gap][validation]") {
+    // Hand calculation (docs/gap.md, V&V 20): seeds 1.0 1.2 0.8 1.0 -> mean 1, sd 0.1633,
+    // u_seed = sd/2; no repeats -> u_bed = sd; a resolution check at 1.3 (two seeds, no spread)
+    // -> d = 0.3, its noise u_seed^2 removed: u_res = sqrt(0.09 - 0.02667/4).
+    Eigen::MatrixXd base(4, 1);
+    base << 1.0, 1.2, 0.8, 1.0;
+    Eigen::MatrixXd check(2, 1);
+    check << 1.3, 1.3;
+    const auto v = validate(oneFeature(1.5, 0.1, false), base, {{"resolution", check}});
+    const double sd = std::sqrt(0.08 / 3.0);
+    CHECK(v.seed_sd[0] == Approx(sd));
+    CHECK(v.u_seed[0] == Approx(sd / 2.0));
+    CHECK(v.u_bed[0] == Approx(sd));
+    CHECK(v.u_checks.at(0).second[0] == Approx(std::sqrt(0.09 - sd * sd / 4.0)));
+    CHECK(v.u_num[0] == Approx(0.3));
+    CHECK(v.u_val[0] == Approx(std::sqrt(0.09 + sd * sd + 0.01)));
+    CHECK(v.standardised[0] == Approx(0.5 / std::sqrt(0.09 + sd * sd + 0.01)));
+    CHECK(v.ratio[0] == Approx(1.0 / 1.5));
+    // With repeats the measured scatter already holds the bed's: no u_bed.
+    CHECK(validate(oneFeature(1.5, 0.1, true), base, {}).u_bed[0] == 0.0);
+}
+
+TEST_CASE("standardised residuals of a matching model are about unit normal",
+          "[gap][validation]") {
+    // Monte Carlo: the truth and the simulation are the same process (bed scatter 1), the
+    // simulation has 4 seeds, the measurement one bed plus instrument noise 0.5 (stated).
+    // If u_val is right, |e| <= 2 about 92-95 % of the time (a little less than the normal's
+    // 95.4 % because the scatter is estimated from 4 seeds).
+    std::mt19937 rng(7);
+    std::normal_distribution<double> bed(10.0, 1.0), instrument(0.0, 0.5);
+    int within = 0;
+    const int draws = 4000;
+    for (int d = 0; d < draws; ++d) {
+        Eigen::MatrixXd base(4, 1);
+        for (int s = 0; s < 4; ++s)
+            base(s, 0) = bed(rng);
+        const double meas = bed(rng) + instrument(rng);
+        const auto v = validate(oneFeature(meas, 0.5, false), base, {});
+        within += std::abs(v.standardised[0]) <= 2.0;
+    }
+    const double share = double(within) / draws;
+    CHECK(share > 0.88);
+    CHECK(share < 0.97);
+}
+
+TEST_CASE("the gap test holds its false-alarm rate with independent or fully correlated features",
+          "[gap][validation]") {
+    std::vector<FeatureKey> keys;
+    for (int e = 0; e < 6; ++e)
+        for (int b = 0; b < 5; ++b)
+            keys.push_back({"exp" + std::to_string(e), "p", "plate/p", 0.002 * b, 0.002 * (b + 1)});
+    std::mt19937 rng(11);
+    std::normal_distribution<double> z;
+    int alarms_independent = 0, alarms_correlated = 0;
+    const int draws = 3000;
+    for (int d = 0; d < draws; ++d) {
+        Eigen::VectorXd ind(30), cor(30);
+        for (int e = 0; e < 6; ++e) {
+            const double shared = z(rng);
+            for (int b = 0; b < 5; ++b) {
+                ind[5 * e + b] = z(rng);
+                cor[5 * e + b] = shared;
+            }
+        }
+        alarms_independent += testGap(keys, ind).gap;
+        alarms_correlated += testGap(keys, cor).gap;
+    }
+    // Family-wise level 5 %: Bonferroni is conservative, so the rate is at most about that.
+    CHECK(double(alarms_independent) / draws < 0.06);
+    CHECK(double(alarms_correlated) / draws < 0.06);
+
+    // A consistent 3 u_val gap on every feature, and one feature 6 u_val out, are gaps; a
+    // consistent 1.5 is not.
+    CHECK(testGap(keys, Eigen::VectorXd::Constant(30, 3.0)).gap);
+    Eigen::VectorXd one = Eigen::VectorXd::Zero(30);
+    one[7] = 6.0;
+    CHECK(testGap(keys, one).gap);
+    CHECK_FALSE(testGap(keys, Eigen::VectorXd::Constant(30, 1.5)).gap);
+}
+
+TEST_CASE("localise says where the simulation is too high, on which experiments, and where it "
+          "agrees",
+          "[gap][validation]") {
+    // Two boxes x two plates, four sinkage bins. Every plate 2.5x too high in the first two
+    // bins; in the last two only the small box is 30 % too low.
+    std::vector<FeatureKey> keys;
+    std::map<std::string, Conditions> conditions;
+    ValidationResult v;
+    std::vector<double> e, ratio;
+    for (const std::string box : {"large", "small"})
+        for (const std::string plate : {"60", "100"}) {
+            const std::string id = box + "_" + plate;
+            conditions[id] = {{"box", box}, {"plate_diameter_mm", plate}};
+            for (int b = 0; b < 4; ++b) {
+                keys.push_back({id, "pressure_Pa", "plate_sinkage/pressure_Pa", 0.004 * b,
+                                0.004 * (b + 1)});
+                if (b < 2) {
+                    e.push_back(-6.0), ratio.push_back(b == 0 ? 2.9 : 2.1);
+                } else if (box == "small") {
+                    e.push_back(4.0), ratio.push_back(0.7);
+                } else {
+                    e.push_back(0.5), ratio.push_back(1.02);
+                }
+            }
+        }
+    v.standardised = Eigen::Map<Eigen::VectorXd>(e.data(), Eigen::Index(e.size()));
+    v.ratio = Eigen::Map<Eigen::VectorXd>(ratio.data(), Eigen::Index(ratio.size()));
+    const auto findings =
+        localise(keys, v, conditions, {{"plate_sinkage/pressure_Pa", {"sinkage", "mm", 1000.0}}});
+    REQUIRE(findings.size() == 2);
+    CHECK(findings[0].sign == +1);
+    CHECK(findings[0].x_hi == Approx(0.008));
+    CHECK(findings[0].experiments == 4);
+    CHECK(findings[0].text == "pressure 2.1-2.9x too high at sinkage 0-8 mm on every experiment (4)");
+    CHECK(findings[1].sign == -1);
+    CHECK(findings[1].text.find("30 % too low at sinkage 8-16 mm") != std::string::npos);
+    CHECK(findings[1].text.find("on 2 of 4 experiments (those with box small)") !=
+          std::string::npos);
+}
