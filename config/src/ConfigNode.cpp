@@ -1,6 +1,7 @@
 #include "grainlink/config/ConfigNode.hpp"
 
 #include <cmath>
+#include <cstdlib>
 #include <sstream>
 
 namespace grainlink::config {
@@ -73,6 +74,24 @@ ConfigNode ConfigNode::operator[](const std::string &key) const {
         throw ConfigError(out.str());
     }
     return ConfigNode(child, file_, child_path);
+}
+
+std::vector<std::string> ConfigNode::keys() const {
+    if (!node_.IsMap())
+        fail("expected a mapping");
+    std::vector<std::string> out;
+    for (const auto &entry : node_)
+        out.push_back(entry.first.as<std::string>());
+    return out;
+}
+
+bool ConfigNode::isNumber() const {
+    if (!node_.IsScalar())
+        return false;
+    const std::string s = node_.Scalar();
+    char *end = nullptr;
+    const double v = std::strtod(s.c_str(), &end);
+    return !s.empty() && end == s.c_str() + s.size() && std::isfinite(v);
 }
 
 std::optional<ConfigNode> ConfigNode::optional(const std::string &key) const {

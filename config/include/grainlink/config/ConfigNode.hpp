@@ -38,6 +38,8 @@ public:
     ConfigNode operator[](const std::string &key) const;              ///< required
     std::optional<ConfigNode> optional(const std::string &key) const; ///< may be absent
     std::vector<ConfigNode> items() const;                            ///< a sequence
+    std::vector<std::string> keys() const; ///< a mapping's keys in file order (none are marked read)
+    bool isNumber() const;                 ///< a scalar that reads as a finite number
 
     double number() const;
     double positive() const;

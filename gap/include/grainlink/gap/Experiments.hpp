@@ -1,0 +1,101 @@
+#pragma once
+// Measured experiments: a folder with experiments.yaml and data files (docs/gap.md, "The
+// measurements folder"). Each experiment is one test condition (a plate size in a box, a normal
+// stress, a wheel at a slip angle) with its repeats, the columns and units of its data, the zero
+// convention of its x axis and its measurement uncertainty. Everything is converted to SI on
+// reading; the same zero convention is later applied to the simulated curves.
+#include "grainlink/gap/Features.hpp"
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlink::gap {
+
+enum class ExperimentType {
+    PlateSinkage,     ///< x sinkage [m] -> pressure [Pa]
+    BevameterShear,   ///< x shear displacement [m] -> shear stress [Pa]
+    DirectShear,      ///< x shear displacement [m] -> shear stress [Pa]
+    AngleOfRepose,    ///< scalar angle [deg]
+    WheelSteadyState, ///< x slip [-] -> drawbar pull / traction [N], sinkage [m], torque [N m], ...
+    Mole,             ///< x stroke [-] -> depth [m]
+};
+const char *typeName(ExperimentType type);
+ExperimentType parseType(const std::string &name); ///< throws std::invalid_argument
+
+/// The SI factor of a unit name ("kPa" -> 1000, "mm" -> 0.001, "deg" -> 1); throws naming the
+/// unit when it is unknown or not of `dimension` ("length", "pressure", "force", ...).
+double unitFactor(const std::string &unit, const std::string &dimension);
+
+/// Where an experiment's x is zero.
+struct ZeroConvention {
+    enum class Method {
+        AsRecorded,     ///< the data's own zero (e.g. a hand-picked first contact)
+        FirstSample,    ///< x - x of the first sample
+        ForceThreshold, ///< x - x of the first sample whose y reaches `threshold` (SI)
+    };
+    Method method = Method::AsRecorded;
+    double threshold = 0.0; ///< [SI unit of the experiment's first observable]
+};
+
+/// The measurement's own uncertainty (docs/gap.md, "Uncertainty of the measurement").
+struct MeasurementUncertainty {
+    double y_sigma = 0.0;      ///< [SI] standard uncertainty of one trial's level, independent between trials
+    double y_relative = 0.0;   ///< [-] the same as a fraction of the value
+    double y_systematic = 0.0; ///< [SI] common to every trial (a calibration)
+    double x_zero_sigma = 0.0; ///< [SI of x] uncertainty of the x zero; enters as |dy/dx| sigma
+    bool rebuilt_bed = true;   ///< repeats on re-prepared beds (their scatter holds the bed's)
+};
+
+/// One trial: a curve per observable over the experiment's x (or one point of a scatter).
+struct Trial {
+    std::string source; ///< file (and row) it came from
+    std::map<std::string, Curve> curves;
+};
+
+struct Experiment {
+    std::string id;
+    ExperimentType type = ExperimentType::PlateSinkage;
+    std::string x_name = "sinkage_m";         ///< SI name of x; empty for a scalar
+    std::vector<std::string> observables;     ///< SI names, e.g. "pressure_Pa"
+    std::map<std::string, double> numbers;    ///< numeric conditions, SI (plate_diameter_m, ...)
+    std::map<std::string, std::string> labels; ///< text conditions (box, preparation, ...)
+    bool scatter = false; ///< each trial is one point (x, y): wheel tests, one row per run
+    std::vector<Trial> trials;
+    ZeroConvention zero;
+    MeasurementUncertainty uncertainty;
+    std::vector<double> bin_edges; ///< [SI of x] optional; empty: shared automatic bins
+    std::string source;            ///< experiments.yaml:line
+    /// "plate_sinkage/pressure_Pa": features of one kind are compared across experiments.
+    std::string kind(const std::string &observable) const;
+    /// Conditions as text, for the report and for localise().
+    std::map<std::string, std::string> conditionText() const;
+};
+
+struct ExperimentSet {
+    std::string name;
+    std::string directory;
+    std::vector<Experiment> experiments;
+    const Experiment &find(const std::string &id) const;
+};
+
+/// Reads DIR/experiments.yaml and every data file it names, strictly: an unknown key, a
+/// missing column, a unit of the wrong kind or an unreadable file stops with the file, the key
+/// and the line.
+ExperimentSet loadExperiments(const std::string &directory);
+
+/// A curve sorted by x with equal x merged (their mean), then shifted by the zero convention;
+/// used for measured and simulated curves alike.
+Curve applyZero(const Curve &curve, const ZeroConvention &zero);
+
+/// The SI dimension an observable's name implies by its unit suffix ("pressure_Pa" ->
+/// "pressure", "sinkage_m" -> "length", "slip" -> "dimensionless").
+std::string dimensionOf(const std::string &si_name);
+
+/// Turns a scatter of single points (x, y) into bin means: the feature for a scatter
+/// experiment is the mean of the points in each bin.
+std::vector<double> scatterBinMeans(const std::vector<std::pair<double, double>> &points,
+                                    const std::vector<double> &edges, std::vector<int> &counts);
+
+} // namespace grainlink::gap

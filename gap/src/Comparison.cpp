@@ -1,0 +1,241 @@
+#include "grainlink/gap/Comparison.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace grainlink::gap {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string slot(const std::string &id, const std::string &observable) {
+    return id + "/" + observable;
+}
+
+/// Each trial's curve of `observable` with the experiment's zero applied.
+std::vector<Curve> zeroedTrials(const Experiment &e, const std::string &observable) {
+    std::vector<Curve> out;
+    for (const Trial &t : e.trials) {
+        const auto it = t.curves.find(observable);
+        if (it != t.curves.end())
+            out.push_back(applyZero(it->second, e.zero));
+    }
+    return out;
+}
+
+double lowerMedian(std::vector<double> v) {
+    if (v.empty())
+        return kNaN;
+    std::sort(v.begin(), v.end());
+    return v[(v.size() - 1) / 2];
+}
+
+std::vector<std::pair<double, double>> scatterPoints(const Experiment &e,
+                                                     const std::string &observable) {
+    std::vector<std::pair<double, double>> p;
+    for (const Trial &t : e.trials) {
+        const auto it = t.curves.find(observable);
+        if (it != t.curves.end() && !it->second.empty())
+            p.emplace_back(it->second.x[0], it->second.y[0]);
+    }
+    return p;
+}
+
+} // namespace
+
+FeatureDesign designFeatures(const ExperimentSet &set, int bins) {
+    FeatureDesign d;
+    // Per kind: where its curves start and how far they typically reach.
+    std::map<std::string, std::vector<double>> reaches, starts;
+    for (const Experiment &e : set.experiments)
+        for (const auto &o : e.observables) {
+            if (e.x_name.empty())
+                continue;
+            if (e.scatter) {
+                for (const auto &[x, y] : scatterPoints(e, o)) {
+                    reaches[e.kind(o)].push_back(x);
+                    starts[e.kind(o)].push_back(x);
+                }
+                d.x_reach[slot(e.id, o)] = kNaN;
+                continue;
+            }
+            std::vector<double> maxima;
+            for (const Curve &c : zeroedTrials(e, o))
+                if (!c.empty())
+                    maxima.push_back(c.x.back());
+            // The reach of at least half of the trials: the lower median of their maxima.
+            const double reach = lowerMedian(maxima);
+            d.x_reach[slot(e.id, o)] = reach;
+            reaches[e.kind(o)].push_back(reach);
+        }
+    std::map<std::string, std::vector<double>> kind_edges;
+    for (const auto &[kind, r] : reaches) {
+        const bool scatter_kind = starts.count(kind) > 0;
+        const double start =
+            scatter_kind ? *std::min_element(starts[kind].begin(), starts[kind].end()) : 0.0;
+        const double end = scatter_kind ? *std::max_element(r.begin(), r.end()) : lowerMedian(r);
+        if (end > start)
+            kind_edges[kind] = roundBinEdges(start, end, bins);
+    }
+    for (const Experiment &e : set.experiments)
+        for (const auto &o : e.observables) {
+            const std::string s = slot(e.id, o);
+            if (e.x_name.empty()) {
+                d.by_experiment[e.id].push_back(Eigen::Index(d.keys.size()));
+                d.keys.push_back({e.id, o, e.kind(o), 0.0, 0.0});
+                d.edges[s] = {};
+                continue;
+            }
+            std::vector<double> edges = !e.bin_edges.empty() ? e.bin_edges : kind_edges[e.kind(o)];
+            // Scatter bins extend to the data's last point; curve bins stop at their reach.
+            std::vector<double> kept;
+            if (e.scatter) {
+                std::vector<int> counts;
+                scatterBinMeans(scatterPoints(e, o), edges, counts);
+                for (std::size_t b = 0; b + 1 < edges.size(); ++b)
+                    if (counts[b] > 0) {
+                        d.by_experiment[e.id].push_back(Eigen::Index(d.keys.size()));
+                        d.keys.push_back({e.id, o, e.kind(o), edges[b], edges[b + 1]});
+                    }
+            } else {
+                const double reach = d.x_reach[s];
+                for (std::size_t b = 0; b + 1 < edges.size(); ++b)
+                    if (edges[b + 1] <= reach * (1.0 + 1e-12)) {
+                        d.by_experiment[e.id].push_back(Eigen::Index(d.keys.size()));
+                        d.keys.push_back({e.id, o, e.kind(o), edges[b], edges[b + 1]});
+                    }
+            }
+            d.edges[s] = edges;
+        }
+    return d;
+}
+
+Measured measure(const ExperimentSet &set, const FeatureDesign &design) {
+    Measured m;
+    m.keys = design.keys;
+    const Eigen::Index n = Eigen::Index(design.size());
+    m.value = Eigen::VectorXd::Constant(n, kNaN);
+    m.u_D = Eigen::VectorXd::Zero(n);
+    m.trials = Eigen::VectorXi::Zero(n);
+    m.from_repeats.assign(std::size_t(n), false);
+    for (const auto &[id, idx] : design.by_experiment) {
+        const Experiment &e = set.find(id);
+        const MeasurementUncertainty &u = e.uncertainty;
+        for (Eigen::Index k : idx) {
+            const FeatureKey &key = design.keys[std::size_t(k)];
+            std::vector<double> values;
+            if (e.x_name.empty()) {
+                for (const Trial &t : e.trials)
+                    values.push_back(t.curves.at(key.observable).y[0]);
+            } else if (e.scatter) {
+                for (const auto &[x, y] : scatterPoints(e, key.observable))
+                    if (x >= key.x_lo && x <= key.x_hi)
+                        values.push_back(y);
+            } else {
+                for (const Curve &c : zeroedTrials(e, key.observable))
+                    if (const auto v = binMean(c, key.x_lo, key.x_hi))
+                        values.push_back(*v);
+            }
+            const int count = int(values.size());
+            m.trials[k] = count;
+            if (count == 0)
+                continue;
+            double mean = 0.0;
+            for (double v : values)
+                mean += v;
+            mean /= count;
+            double var_repeats = 0.0;
+            if (count >= 2) {
+                for (double v : values)
+                    var_repeats += (v - mean) * (v - mean);
+                var_repeats /= (count - 1);
+            }
+            m.value[k] = mean;
+            m.from_repeats[std::size_t(k)] = count >= 2 && u.rebuilt_bed;
+            const double per_trial = u.y_sigma * u.y_sigma + std::pow(u.y_relative * mean, 2);
+            m.u_D[k] = std::sqrt(var_repeats / count + per_trial / count +
+                                 u.y_systematic * u.y_systematic);
+        }
+        // The x zero's uncertainty moves a bin's mean by the curve's slope times it.
+        if (u.x_zero_sigma > 0.0 && !e.x_name.empty())
+            for (std::size_t i = 0; i < idx.size(); ++i) {
+                const Eigen::Index k = idx[i];
+                const Eigen::Index a = idx[i > 0 ? i - 1 : i];
+                const Eigen::Index b = idx[i + 1 < idx.size() ? i + 1 : i];
+                const double dx = design.keys[std::size_t(b)].centre() -
+                                  design.keys[std::size_t(a)].centre();
+                if (a == b || dx <= 0.0 || design.keys[std::size_t(a)].observable !=
+                                               design.keys[std::size_t(b)].observable)
+                    continue;
+                const double slope = (m.value[b] - m.value[a]) / dx;
+                const double zero = slope * u.x_zero_sigma / std::sqrt(std::max(1, m.trials[k]));
+                if (std::isfinite(zero))
+                    m.u_D[k] = std::sqrt(m.u_D[k] * m.u_D[k] + zero * zero);
+            }
+    }
+    return m;
+}
+
+Eigen::VectorXd simulatedFeatures(const ExperimentSet &set, const FeatureDesign &design,
+                                  const SimulatedCurves &curves) {
+    Eigen::VectorXd row = Eigen::VectorXd::Constant(Eigen::Index(design.size()), kNaN);
+    for (const auto &[id, idx] : design.by_experiment) {
+        const auto exp_it = curves.find(id);
+        if (exp_it == curves.end())
+            continue;
+        const Experiment &e = set.find(id);
+        for (Eigen::Index k : idx) {
+            const FeatureKey &key = design.keys[std::size_t(k)];
+            const auto it = exp_it->second.find(key.observable);
+            if (it == exp_it->second.end() || it->second.empty())
+                continue;
+            if (e.x_name.empty()) {
+                row[k] = it->second.y[0];
+            } else if (e.scatter) {
+                std::vector<std::pair<double, double>> pts;
+                for (std::size_t i = 0; i < it->second.x.size(); ++i)
+                    pts.emplace_back(it->second.x[i], it->second.y[i]);
+                std::vector<int> counts;
+                const auto means = scatterBinMeans(pts, {key.x_lo, key.x_hi}, counts);
+                row[k] = means[0];
+            } else if (const auto v = binMean(applyZero(it->second, e.zero), key.x_lo, key.x_hi)) {
+                row[k] = *v;
+            }
+        }
+    }
+    return row;
+}
+
+std::vector<RegimePoint> regimePoints(const ExperimentSet &set, const FeatureDesign &design) {
+    std::vector<std::string> kinds;
+    std::vector<std::map<std::string, double>> coords;
+    for (const FeatureKey &key : design.keys) {
+        const Experiment &e = set.find(key.experiment);
+        std::map<std::string, double> c = e.numbers;
+        if (!key.scalar())
+            c["x"] = key.centre();
+        kinds.push_back(key.kind);
+        coords.push_back(std::move(c));
+    }
+    return regimeCoordinates(kinds, coords);
+}
+
+std::map<std::string, AxisLabel> axisLabels(const ExperimentSet &set) {
+    std::map<std::string, AxisLabel> out;
+    for (const Experiment &e : set.experiments)
+        for (const auto &o : e.observables) {
+            AxisLabel a{e.x_name, "", 1.0};
+            if (e.x_name == "sinkage_m")
+                a = {"sinkage", "mm", 1000.0};
+            else if (e.x_name == "shear_displacement_m")
+                a = {"shear displacement", "mm", 1000.0};
+            else if (e.x_name == "slip")
+                a = {"slip", "", 1.0};
+            out[e.kind(o)] = a;
+        }
+    return out;
+}
+
+} // namespace grainlink::gap

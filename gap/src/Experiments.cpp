@@ -1,0 +1,474 @@
+#include "grainlink/gap/Experiments.hpp"
+
+#include "grainlink/config/ConfigNode.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace grainlink::gap {
+
+namespace fs = std::filesystem;
+using config::ConfigNode;
+
+namespace {
+
+struct TypeInfo {
+    ExperimentType type;
+    const char *name;
+    const char *x_name; ///< SI name of x; "" for a scalar
+    std::vector<std::string> observables;
+};
+
+const std::vector<TypeInfo> &types() {
+    static const std::vector<TypeInfo> t{
+        {ExperimentType::PlateSinkage, "plate_sinkage", "sinkage_m", {"pressure_Pa"}},
+        {ExperimentType::BevameterShear, "bevameter_shear", "shear_displacement_m",
+         {"shear_stress_Pa"}},
+        {ExperimentType::DirectShear, "direct_shear", "shear_displacement_m", {"shear_stress_Pa"}},
+        {ExperimentType::AngleOfRepose, "angle_of_repose", "", {"angle_deg"}},
+        {ExperimentType::WheelSteadyState, "wheel_steady_state", "slip",
+         {"traction_N", "drawbar_pull_N", "vertical_load_N", "side_force_N", "sinkage_m",
+          "torque_N_m"}},
+        {ExperimentType::Mole, "mole", "stroke", {"depth_m"}},
+    };
+    return t;
+}
+
+const TypeInfo &info(ExperimentType type) {
+    for (const auto &t : types())
+        if (t.type == type)
+            return t;
+    throw std::logic_error("unknown experiment type");
+}
+
+struct Unit {
+    const char *name, *dimension;
+    double factor;
+};
+
+const std::vector<Unit> &units() {
+    static const std::vector<Unit> u{
+        {"m", "length", 1.0},          {"mm", "length", 1e-3},      {"cm", "length", 1e-2},
+        {"um", "length", 1e-6},        {"Pa", "pressure", 1.0},     {"kPa", "pressure", 1e3},
+        {"MPa", "pressure", 1e6},      {"N", "force", 1.0},         {"kN", "force", 1e3},
+        {"N_m", "torque", 1.0},        {"N m", "torque", 1.0},      {"Nm", "torque", 1.0},
+        {"deg", "angle", 1.0},         {"rad", "angle", 180.0 / M_PI},
+        {"-", "dimensionless", 1.0},   {"1", "dimensionless", 1.0}, {"%", "dimensionless", 0.01},
+        {"m_s", "speed", 1.0},         {"mm_s", "speed", 1e-3},     {"m/s", "speed", 1.0},
+        {"mm/s", "speed", 1e-3},       {"kg", "mass", 1.0},         {"g", "mass", 1e-3},
+        {"s", "time", 1.0},            {"m_s2", "acceleration", 1.0},
+        {"kg_m3", "density", 1.0},     {"g_cm3", "density", 1e3},
+    };
+    return u;
+}
+
+/// Suffix -> dimension of grainlink's SI names (`plate_diameter_m`, `normal_stress_Pa`).
+const std::vector<std::pair<std::string, std::string>> &suffixes() {
+    static const std::vector<std::pair<std::string, std::string>> s{
+        {"_N_m", "torque"}, {"_m_s2", "acceleration"}, {"_m_s", "speed"}, {"_kg_m3", "density"},
+        {"_Pa", "pressure"}, {"_N", "force"},         {"_m", "length"},  {"_deg", "angle"},
+        {"_kg", "mass"},     {"_s", "time"},
+    };
+    return s;
+}
+
+bool endsWith(const std::string &s, const std::string &tail) {
+    return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
+}
+
+std::vector<std::string> splitCsv(const std::string &line) {
+    std::vector<std::string> out;
+    std::string cell;
+    std::istringstream in(line);
+    while (std::getline(in, cell, ',')) {
+        while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' '))
+            cell.pop_back();
+        while (!cell.empty() && cell.front() == ' ')
+            cell.erase(cell.begin());
+        out.push_back(cell);
+    }
+    return out;
+}
+
+/// A CSV table: header names and rows of text cells, with the file line of every row.
+struct Table {
+    std::string file;
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+    std::vector<int> lines;
+    std::size_t column(const std::string &name, const ConfigNode &where) const {
+        const auto it = std::find(header.begin(), header.end(), name);
+        if (it == header.end()) {
+            std::string have;
+            for (const auto &h : header)
+                have += (have.empty() ? "" : ", ") + h;
+            where.fail("column '" + name + "' is not in " + file + " (its columns: " + have + ")");
+        }
+        return std::size_t(it - header.begin());
+    }
+    double number(std::size_t row, std::size_t col) const {
+        const std::string &cell = col < rows[row].size() ? rows[row][col] : std::string();
+        char *end = nullptr;
+        const double v = std::strtod(cell.c_str(), &end);
+        if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v))
+            throw config::ConfigError(file + ":" + std::to_string(lines[row]) + ": column '" +
+                                      header[col] + "': '" + cell + "' is not a finite number");
+        return v;
+    }
+};
+
+Table readTable(const fs::path &path, char comment, const ConfigNode &where) {
+    std::ifstream in(path);
+    if (!in)
+        where.fail("cannot read data file " + path.string());
+    Table t;
+    t.file = path.string();
+    std::string line;
+    int number = 0;
+    while (std::getline(in, line)) {
+        ++number;
+        if (line.empty() || line[0] == comment || line == "\r")
+            continue;
+        if (t.header.empty()) {
+            t.header = splitCsv(line);
+            continue;
+        }
+        t.rows.push_back(splitCsv(line));
+        t.lines.push_back(number);
+    }
+    if (t.header.empty())
+        where.fail("data file " + t.file + " has no header line");
+    if (t.rows.empty())
+        where.fail("data file " + t.file + " has no data rows");
+    return t;
+}
+
+/// `{column, unit}` of one axis: the column index in `table` and the factor to SI.
+std::pair<std::size_t, double> axisColumn(const ConfigNode &node, const Table &table,
+                                          const std::string &si_name) {
+    const std::size_t col = table.column(node["column"].text(), node["column"]);
+    const std::string unit = node["unit"].text();
+    double factor = 1.0;
+    try {
+        factor = unitFactor(unit, dimensionOf(si_name));
+    } catch (const std::invalid_argument &e) {
+        node["unit"].fail(e.what());
+    }
+    node.finish();
+    return {col, factor};
+}
+
+double siValue(const ConfigNode &parent, const std::string &value_key, const std::string &unit_key,
+               const std::string &dimension) {
+    const double v = parent[value_key].number();
+    const ConfigNode u = parent[unit_key];
+    try {
+        return v * unitFactor(u.text(), dimension);
+    } catch (const std::invalid_argument &e) {
+        u.fail(e.what());
+    }
+}
+
+} // namespace
+
+const char *typeName(ExperimentType type) { return info(type).name; }
+
+ExperimentType parseType(const std::string &name) {
+    std::string known;
+    for (const auto &t : types()) {
+        if (name == t.name)
+            return t.type;
+        known += (known.empty() ? "" : ", ") + std::string(t.name);
+    }
+    throw std::invalid_argument("unknown experiment type '" + name + "' (known: " + known + ")");
+}
+
+double unitFactor(const std::string &unit, const std::string &dimension) {
+    std::string same;
+    for (const auto &u : units()) {
+        if (u.dimension != dimension)
+            continue;
+        if (unit == u.name)
+            return u.factor;
+        same += (same.empty() ? "" : ", ") + std::string(u.name);
+    }
+    for (const auto &u : units())
+        if (unit == u.name)
+            throw std::invalid_argument("unit '" + unit + "' is a " + u.dimension + ", not a " +
+                                        dimension + " (use one of: " + same + ")");
+    throw std::invalid_argument("unknown unit '" + unit + "' for a " + dimension +
+                                " (use one of: " + same + ")");
+}
+
+std::string dimensionOf(const std::string &si_name) {
+    for (const auto &[tail, dim] : suffixes())
+        if (endsWith(si_name, tail))
+            return dim;
+    return "dimensionless";
+}
+
+std::string Experiment::kind(const std::string &observable) const {
+    return std::string(typeName(type)) + "/" + observable;
+}
+
+std::map<std::string, std::string> Experiment::conditionText() const {
+    std::map<std::string, std::string> c = labels;
+    for (const auto &[k, v] : numbers) {
+        std::ostringstream s;
+        s << v;
+        c[k] = s.str();
+    }
+    return c;
+}
+
+const Experiment &ExperimentSet::find(const std::string &id) const {
+    for (const auto &e : experiments)
+        if (e.id == id)
+            return e;
+    throw std::invalid_argument("no experiment '" + id + "' in " + directory);
+}
+
+Curve applyZero(const Curve &curve, const ZeroConvention &zero) {
+    std::vector<std::size_t> order(curve.x.size());
+    for (std::size_t i = 0; i < order.size(); ++i)
+        order[i] = i;
+    std::stable_sort(order.begin(), order.end(),
+                     [&](std::size_t a, std::size_t b) { return curve.x[a] < curve.x[b]; });
+    Curve out;
+    for (std::size_t k = 0; k < order.size();) {
+        std::size_t j = k;
+        double sum = 0.0;
+        while (j < order.size() && curve.x[order[j]] == curve.x[order[k]])
+            sum += curve.y[order[j++]];
+        out.x.push_back(curve.x[order[k]]);
+        out.y.push_back(sum / double(j - k));
+        k = j;
+    }
+    if (out.x.empty() || zero.method == ZeroConvention::Method::AsRecorded)
+        return out;
+    double x0 = out.x.front();
+    if (zero.method == ZeroConvention::Method::ForceThreshold) {
+        // The first sample in the original order that reaches the threshold: a loading curve's
+        // first contact.
+        bool found = false;
+        for (std::size_t i = 0; i < curve.y.size() && !found; ++i)
+            if (curve.y[i] >= zero.threshold) {
+                x0 = curve.x[i];
+                found = true;
+            }
+        if (!found)
+            return Curve{}; // never reaches the threshold: nothing to compare
+    }
+    for (double &x : out.x)
+        x -= x0;
+    return out;
+}
+
+std::vector<double> scatterBinMeans(const std::vector<std::pair<double, double>> &points,
+                                    const std::vector<double> &edges, std::vector<int> &counts) {
+    const std::size_t bins = edges.size() < 2 ? 0 : edges.size() - 1;
+    std::vector<double> sum(bins, 0.0);
+    counts.assign(bins, 0);
+    for (const auto &[x, y] : points)
+        for (std::size_t b = 0; b < bins; ++b)
+            if (x >= edges[b] && (x < edges[b + 1] || (b + 1 == bins && x == edges[b + 1]))) {
+                sum[b] += y;
+                ++counts[b];
+                break;
+            }
+    for (std::size_t b = 0; b < bins; ++b)
+        sum[b] = counts[b] > 0 ? sum[b] / counts[b] : std::nan("");
+    return sum;
+}
+
+ExperimentSet loadExperiments(const std::string &directory) {
+    const fs::path dir(directory);
+    const fs::path file = dir / "experiments.yaml";
+    if (!fs::is_regular_file(file))
+        throw config::ConfigError(file.string() + ": no such file (a measurements folder holds "
+                                                  "experiments.yaml; docs/gap.md)");
+    const ConfigNode root = ConfigNode::loadFile(file.string());
+    ExperimentSet set;
+    set.directory = directory;
+    set.name = root.text("name", dir.filename().string());
+    const ConfigNode list = root["experiments"];
+    if (!list.isSequence())
+        list.fail("must be a list of experiments");
+    std::set<std::string> ids;
+    for (const ConfigNode &node : list.items()) {
+        Experiment e;
+        e.source = file.string() + ":" + std::to_string(node.line());
+        e.id = node["id"].text();
+        if (e.id.empty() || e.id.find_first_of(" /\\\t\n") != std::string::npos)
+            node["id"].fail("an id is one word without spaces or slashes");
+        if (!ids.insert(e.id).second)
+            node["id"].fail("experiment id '" + e.id + "' is used twice");
+        try {
+            e.type = parseType(node["type"].text());
+        } catch (const std::invalid_argument &ex) {
+            node["type"].fail(ex.what());
+        }
+        const TypeInfo &ti = info(e.type);
+        e.x_name = ti.x_name;
+
+        if (const auto cond = node.optional("conditions")) {
+            for (const auto &key : cond->keys()) {
+                const ConfigNode c = (*cond)[key];
+                if (dimensionOf(key) == "dimensionless" && !c.isNumber())
+                    e.labels[key] = c.text();
+                else
+                    e.numbers[key] = c.number();
+            }
+            cond->finish();
+        }
+
+        const ConfigNode data = node["data"];
+        if (e.x_name.empty()) {
+            // A scalar: values (repeats) with a unit.
+            const std::string &obs = ti.observables.front();
+            const ConfigNode values = data["values"];
+            double factor = 1.0;
+            try {
+                factor = unitFactor(data["unit"].text(), dimensionOf(obs));
+            } catch (const std::invalid_argument &ex) {
+                data["unit"].fail(ex.what());
+            }
+            int row = 0;
+            for (double v : values.numbers()) {
+                Trial t;
+                t.source = e.source + " value " + std::to_string(++row);
+                t.curves[obs] = Curve{{0.0}, {v * factor}};
+                e.trials.push_back(std::move(t));
+            }
+            if (e.trials.empty())
+                values.fail("give at least one value");
+            e.observables = {obs};
+            data.finish();
+        } else {
+            const std::string comment = data.text("comment", "#");
+            e.scatter = data.boolean("scatter", false);
+            const ConfigNode files = data["files"];
+            const ConfigNode y = data["y"];
+            std::vector<std::string> obs_names = y.keys();
+            for (const auto &o : obs_names)
+                if (std::find(ti.observables.begin(), ti.observables.end(), o) ==
+                    ti.observables.end()) {
+                    std::string allowed;
+                    for (const auto &a : ti.observables)
+                        allowed += (allowed.empty() ? "" : ", ") + a;
+                    y[o].fail("'" + o + "' is not an observable of " + ti.name + " (" + allowed +
+                              ")");
+                }
+            if (obs_names.empty())
+                y.fail("name at least one observable");
+            e.observables = obs_names;
+            const auto filter = data.optional("filter");
+            for (const ConfigNode &f : files.items()) {
+                const fs::path path = dir / f.text();
+                const Table table = readTable(path, comment.empty() ? '#' : comment[0], f);
+                const auto [xcol, xfac] = axisColumn(data["x"], table, e.x_name);
+                std::vector<std::tuple<std::string, std::size_t, double>> ycols;
+                for (const auto &o : obs_names) {
+                    const auto [c, fac] = axisColumn(y[o], table, o);
+                    ycols.emplace_back(o, c, fac);
+                }
+                std::vector<std::pair<std::size_t, double>> keep;
+                if (filter)
+                    for (const auto &key : filter->keys())
+                        keep.emplace_back(table.column(key, (*filter)[key]),
+                                          (*filter)[key].number());
+                Trial whole;
+                whole.source = path.string();
+                for (std::size_t r = 0; r < table.rows.size(); ++r) {
+                    bool selected = true;
+                    for (const auto &[c, v] : keep)
+                        selected = selected && std::abs(table.number(r, c) - v) <= 1e-9 * (1 + std::abs(v));
+                    if (!selected)
+                        continue;
+                    const double x = table.number(r, xcol) * xfac;
+                    if (e.scatter) {
+                        Trial t;
+                        t.source = path.string() + ":" + std::to_string(table.lines[r]);
+                        for (const auto &[o, c, fac] : ycols)
+                            t.curves[o] = Curve{{x}, {table.number(r, c) * fac}};
+                        e.trials.push_back(std::move(t));
+                    } else {
+                        for (const auto &[o, c, fac] : ycols) {
+                            whole.curves[o].x.push_back(x);
+                            whole.curves[o].y.push_back(table.number(r, c) * fac);
+                        }
+                    }
+                }
+                if (!e.scatter) {
+                    if (whole.curves.begin()->second.empty())
+                        f.fail("no rows of " + path.string() + " pass the filter");
+                    e.trials.push_back(std::move(whole));
+                }
+            }
+            if (e.trials.empty())
+                files.fail("no data: give at least one file (and rows that pass the filter)");
+            if (filter)
+                filter->finish();
+            data.finish();
+        }
+
+        if (const auto zero = node.optional("zero")) {
+            const std::string method =
+                (*zero)["method"].choice({"as_recorded", "first_sample", "force_threshold"});
+            if (method == "first_sample")
+                e.zero.method = ZeroConvention::Method::FirstSample;
+            if (method == "force_threshold") {
+                e.zero.method = ZeroConvention::Method::ForceThreshold;
+                e.zero.threshold =
+                    siValue(*zero, "threshold", "unit", dimensionOf(e.observables.front()));
+            }
+            zero->finish();
+        }
+        if (const auto u = node.optional("uncertainty")) {
+            const std::string dim = dimensionOf(e.observables.front());
+            if (u->has("y_sigma"))
+                e.uncertainty.y_sigma = siValue(*u, "y_sigma", "unit", dim);
+            if (u->has("y_systematic"))
+                e.uncertainty.y_systematic = siValue(*u, "y_systematic", "unit", dim);
+            e.uncertainty.y_relative = u->number("y_relative", 0.0);
+            if (u->has("x_zero_sigma"))
+                e.uncertainty.x_zero_sigma =
+                    siValue(*u, "x_zero_sigma", "x_unit", dimensionOf(e.x_name));
+            if (u->has("repeats"))
+                e.uncertainty.rebuilt_bed =
+                    (*u)["repeats"].choice({"rebuilt_bed", "same_bed"}) == "rebuilt_bed";
+            if (e.uncertainty.y_sigma < 0 || e.uncertainty.y_relative < 0 ||
+                e.uncertainty.y_systematic < 0 || e.uncertainty.x_zero_sigma < 0)
+                u->fail("uncertainties must be >= 0");
+            u->finish();
+        }
+        if (const auto bins = node.optional("bins")) {
+            const double f = [&] {
+                try {
+                    return unitFactor((*bins)["unit"].text(), dimensionOf(e.x_name));
+                } catch (const std::invalid_argument &ex) {
+                    (*bins)["unit"].fail(ex.what());
+                }
+            }();
+            for (double v : (*bins)["edges"].numbers())
+                e.bin_edges.push_back(v * f);
+            if (e.bin_edges.size() < 2 ||
+                !std::is_sorted(e.bin_edges.begin(), e.bin_edges.end()))
+                (*bins)["edges"].fail("give at least two increasing edges");
+            bins->finish();
+        }
+        node.finish();
+        set.experiments.push_back(std::move(e));
+    }
+    root.finish();
+    if (set.experiments.empty())
+        list.fail("no experiments");
+    return set;
+}
+
+} // namespace grainlink::gap

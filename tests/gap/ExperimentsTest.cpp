@@ -1,0 +1,168 @@
+#include "grainlink/gap/Comparison.hpp"
+#include "grainlink/gap/Experiments.hpp"
+
+#include "grainlink/config/ConfigNode.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+using namespace grainlink::gap;
+namespace fs = std::filesystem;
+
+namespace {
+
+/// A fresh folder for one test's measurements (the process id keeps parallel runs apart).
+fs::path folder(const std::string &name) {
+    const fs::path p = fs::temp_directory_path() /
+                       ("grainlink-gap-" + name + "-" + std::to_string(::getpid()));
+    fs::remove_all(p);
+    fs::create_directories(p);
+    return p;
+}
+
+void write(const fs::path &p, const std::string &text) { std::ofstream(p) << text; }
+
+/// p = a z (kPa, z in mm) sampled every 0.5 mm to 12 mm.
+void linearTrial(const fs::path &p, double a) {
+    std::ofstream out(p);
+    out << "# a comment line\nsinkage_mm,pressure_kPa\n";
+    for (int i = 0; i <= 24; ++i)
+        out << 0.5 * i << ',' << a * 0.5 * i << '\n';
+}
+
+std::string plateYaml(const std::string &extra = "") {
+    return "name: test\nexperiments:\n"
+           "  - id: p60\n    type: plate_sinkage\n"
+           "    conditions: {plate_diameter_m: 0.06, box: large}\n"
+           "    data:\n      files: [a1.csv, a2.csv, a3.csv]\n"
+           "      x: {column: sinkage_mm, unit: mm}\n"
+           "      y: {pressure_Pa: {column: pressure_kPa, unit: kPa}}\n" +
+           extra;
+}
+
+} // namespace
+
+TEST_CASE("experiments.yaml: repeats in SI, and their mean and scatter per bin",
+          "[gap][experiments]") {
+    const fs::path dir = folder("repeats");
+    linearTrial(dir / "a1.csv", 1.0);
+    linearTrial(dir / "a2.csv", 2.0);
+    linearTrial(dir / "a3.csv", 3.0);
+    write(dir / "experiments.yaml", plateYaml());
+    const ExperimentSet set = loadExperiments(dir.string());
+    REQUIRE(set.experiments.size() == 1);
+    const Experiment &e = set.experiments[0];
+    CHECK(e.trials.size() == 3);
+    CHECK(e.trials[1].curves.at("pressure_Pa").y.back() == Approx(2.0 * 12.0 * 1000.0));
+    CHECK(e.trials[1].curves.at("pressure_Pa").x.back() == Approx(0.012));
+    CHECK(e.labels.at("box") == "large");
+    CHECK(e.numbers.at("plate_diameter_m") == 0.06);
+
+    const FeatureDesign d = designFeatures(set, 6); // 12 mm / 6 -> 2 mm bins
+    REQUIRE(d.keys.size() == 6);
+    CHECK(d.keys[0].x_hi == Approx(0.002));
+    const Measured m = measure(set, d);
+    // Bin [4, 6] mm: trial a gives a * 5 mm -> 5, 10, 15 kPa: mean 10 kPa, sd 5 kPa, u = sd/sqrt 3.
+    CHECK(m.value[2] == Approx(10000.0));
+    CHECK(m.u_D[2] == Approx(5000.0 / std::sqrt(3.0)));
+    CHECK(m.from_repeats[2]);
+    CHECK(m.trials[2] == 3);
+
+    // A simulated curve equal to the mean trial gives the measured features exactly.
+    Curve mean_trial;
+    for (int i = 0; i <= 30; ++i) {
+        mean_trial.x.push_back(0.0005 * i);
+        mean_trial.y.push_back(2.0 * 0.5 * i * 1000.0);
+    }
+    const Eigen::VectorXd sim = simulatedFeatures(set, d, {{"p60", {{"pressure_Pa", mean_trial}}}});
+    CHECK((sim - m.value).cwiseAbs().maxCoeff() < 1e-6);
+}
+
+TEST_CASE("experiments.yaml: a force-threshold zero moves x to the first sample reaching it",
+          "[gap][experiments]") {
+    // p = 0 until 3 mm, then rises: with a 0.5 kPa threshold the zero is at 3.5 mm.
+    Curve c{{0.0, 0.001, 0.002, 0.003, 0.0035, 0.004}, {0.0, 0.0, 0.0, 0.0, 600.0, 1200.0}};
+    ZeroConvention z;
+    z.method = ZeroConvention::Method::ForceThreshold;
+    z.threshold = 500.0;
+    const Curve zeroed = applyZero(c, z);
+    CHECK(zeroed.x.front() == Approx(-0.0035));
+    CHECK(zeroed.x[4] == Approx(0.0));
+    z.method = ZeroConvention::Method::FirstSample;
+    const Curve shifted = applyZero(Curve{{0.002, 0.001, 0.003}, {2.0, 1.0, 3.0}}, z);
+    CHECK(shifted.x.front() == 0.0);
+    CHECK(shifted.y.front() == 1.0); // sorted by x
+}
+
+TEST_CASE("experiments.yaml: stated uncertainty and the zero's uncertainty enter u_D",
+          "[gap][experiments]") {
+    const fs::path dir = folder("stated");
+    linearTrial(dir / "a1.csv", 2.0);
+    write(dir / "experiments.yaml",
+          "experiments:\n  - id: one\n    type: plate_sinkage\n"
+          "    conditions: {plate_diameter_m: 0.06}\n"
+          "    data:\n      files: [a1.csv]\n      x: {column: sinkage_mm, unit: mm}\n"
+          "      y: {pressure_Pa: {column: pressure_kPa, unit: kPa}}\n"
+          "    uncertainty: {y_sigma: 0.3, unit: kPa, x_zero_sigma: 0.5, x_unit: mm}\n");
+    const ExperimentSet set = loadExperiments(dir.string());
+    const Measured m = measure(set, designFeatures(set, 6));
+    // One trial: sigma 300 Pa and the slope 2 kPa/mm x 0.5 mm = 1 kPa, in quadrature.
+    CHECK_FALSE(m.from_repeats[2]);
+    CHECK(m.u_D[2] == Approx(std::sqrt(300.0 * 300.0 + 1000.0 * 1000.0)));
+}
+
+TEST_CASE("experiments.yaml: scalars and scatters", "[gap][experiments]") {
+    const fs::path dir = folder("scatter");
+    write(dir / "wheel.csv", "slip,F,beta\n0.1,10,0\n0.12,12,0\n0.5,30,0\n0.1,99,45\n");
+    write(dir / "experiments.yaml",
+          "experiments:\n"
+          "  - id: repose\n    type: angle_of_repose\n    data: {values: [29, 31], unit: deg}\n"
+          "  - id: w0\n    type: wheel_steady_state\n    conditions: {slip_angle_deg: 0}\n"
+          "    data:\n      files: [wheel.csv]\n      scatter: true\n      filter: {beta: 0}\n"
+          "      x: {column: slip, unit: '-'}\n      y: {traction_N: {column: F, unit: N}}\n"
+          "    bins: {edges: [0, 0.2, 0.4, 0.6], unit: '-'}\n");
+    const ExperimentSet set = loadExperiments(dir.string());
+    CHECK(set.experiments[1].trials.size() == 3); // the beta = 45 row filtered out
+    const FeatureDesign d = designFeatures(set);
+    REQUIRE(d.keys.size() == 3); // repose + two slip bins with points
+    const Measured m = measure(set, d);
+    CHECK(m.value[0] == Approx(30.0));
+    CHECK(m.u_D[0] == Approx(1.0)); // sd sqrt 2 over sqrt 2
+    CHECK(m.value[1] == Approx(11.0));
+    CHECK(m.value[2] == Approx(30.0));
+}
+
+TEST_CASE("experiments.yaml: bad input names the file, the key and the line",
+          "[gap][experiments]") {
+    const fs::path dir = folder("bad");
+    linearTrial(dir / "a1.csv", 1.0);
+    linearTrial(dir / "a2.csv", 1.0);
+    linearTrial(dir / "a3.csv", 1.0);
+    const auto fails = [&](const std::string &yaml, const std::string &what) {
+        write(dir / "experiments.yaml", yaml);
+        try {
+            loadExperiments(dir.string());
+            FAIL("accepted: " << yaml);
+        } catch (const grainlink::config::ConfigError &e) {
+            INFO(e.what());
+            CHECK(std::string(e.what()).find(what) != std::string::npos);
+        }
+    };
+    fails(plateYaml("    colour: red\n"), "experiments.yaml:");
+    fails(plateYaml("    colour: red\n"), "colour");
+    std::string wrong_unit = plateYaml();
+    wrong_unit.replace(wrong_unit.find("unit: kPa"), 9, "unit: mm");
+    fails(wrong_unit, "is a length, not a pressure");
+    std::string wrong_column = plateYaml();
+    wrong_column.replace(wrong_column.find("column: pressure_kPa"), 20, "column: pressure_Pa");
+    fails(wrong_column, "column 'pressure_Pa' is not in");
+    std::string wrong_type = plateYaml();
+    wrong_type.replace(wrong_type.find("plate_sinkage"), 13, "plate_test");
+    fails(wrong_type, "unknown experiment type 'plate_test'");
+    fails(plateYaml() + "  - id: p60\n    type: angle_of_repose\n    data: {values: [1], unit: deg}\n",
+          "used twice");
+}
