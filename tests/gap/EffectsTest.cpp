@@ -1,0 +1,139 @@
+#include "grainlink/gap/Effects.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+
+using namespace grainlink::gap;
+
+namespace {
+
+const char *kScenario = R"(name: plates
+soil:
+  simulation: {time_step_s: 4.0e-5, threads: 1}
+  material: {youngs_modulus_Pa: 1.0e7, poisson_ratio: 0.2, density_kg_m3: 2400}
+  contact:
+    damping: {model: viscous, coefficient_N_s_m: 0.1}
+    rolling: {model: epsd, coefficient: 0.3}
+    tangential: {model: linear, stiffness_N_m: 200, stick_angle_deg: 32, slip_angle_deg: 30}
+  walls:
+    - {name: bin, type: box, lower_m: [0, 0, 0], upper_m: [0.1, 0.08, 0.2]}
+  deposition:
+    region: {lower_m: [0, 0, 0], upper_m: [0.1, 0.08, 0.05]}
+    count: 2000
+    radius: {distribution: uniform, min_m: 0.0018, max_m: 0.0022}
+    seed: 3
+bevameter:
+  plate_radii_m: [0.02]
+  speed_m_s: 0.05
+  max_sinkage_m: 0.01
+)";
+
+EffectCatalogue catalogue() { return loadEffects(GRAINLINK_SOURCE_DIR "/data/effects.yaml"); }
+
+} // namespace
+
+TEST_CASE("the default catalogue holds the issue's effects, each with a prior and a signature",
+          "[gap][effects]") {
+    const EffectCatalogue c = catalogue();
+    for (const char *name : {"rolling_resistance", "grain_shape", "cohesion", "polydispersity",
+                             "grain_stiffness", "grain_density", "wall_friction", "domain_size",
+                             "tool_friction", "rig_compliance", "sensor_zero_offset"}) {
+        INFO(name);
+        const Effect &e = c.find(name);
+        CHECK(e.signature.size() >= 2);
+        CHECK(e.prior.lo < e.prior.hi);
+        CHECK_FALSE(e.description.empty());
+    }
+    CHECK_THROWS_WITH(c.find("gravity"), Catch::Contains("unknown effect 'gravity'"));
+}
+
+TEST_CASE("effects resolve their off value against the base", "[gap][effects]") {
+    const YAML::Node base = YAML::Load(kScenario);
+    const EffectCatalogue c = catalogue();
+    CHECK(resolveAgainst(c.find("rolling_resistance"), base).prior.off == Approx(0.3));
+    CHECK(resolveAgainst(c.find("cohesion"), base).prior.off == 0.0);
+    // Walls without their own friction use the grains': tan 32 deg.
+    CHECK(resolveAgainst(c.find("wall_friction"), base).prior.off ==
+          Approx(std::tan(32.0 * M_PI / 180.0)));
+    CHECK(resolveAgainst(c.find("polydispersity"), base).prior.off == Approx(0.1));
+    CHECK(resolveAgainst(c.find("grain_stiffness"), base).prior.off == 1.0);
+    CHECK(inapplicable(c.find("grain_shape"), base).find("the base has 'epsd'") !=
+          std::string::npos);
+    CHECK(inapplicable(c.find("rolling_resistance"), base).empty());
+}
+
+TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off", "[gap][effects]") {
+    const YAML::Node base = YAML::Load(kScenario);
+    const EffectCatalogue c = catalogue();
+    const YAML::Node stiff = applyEffect(c.find("grain_stiffness"), 4.0, base, ExperimentType::PlateSinkage);
+    CHECK(stiff["soil"]["material"]["youngs_modulus_Pa"].as<double>() == Approx(4.0e7));
+    CHECK(stiff["soil"]["contact"]["tangential"]["stiffness_N_m"].as<double>() == Approx(800.0));
+    CHECK(stiff["soil"]["contact"]["damping"]["coefficient_N_s_m"].as<double>() == Approx(0.2));
+    CHECK(stiff["soil"]["simulation"]["time_step_s"].as<double>() == Approx(2.0e-5));
+    // The base itself is untouched (a deep copy).
+    CHECK(base["soil"]["material"]["youngs_modulus_Pa"].as<double>() == Approx(1.0e7));
+
+    const YAML::Node coh = applyEffect(c.find("cohesion"), 5e4, base, ExperimentType::PlateSinkage);
+    CHECK(coh["soil"]["contact"]["cohesion"]["model"].as<std::string>() == "linear");
+    CHECK(coh["soil"]["contact"]["cohesion"]["energy_density_J_m3"].as<double>() == Approx(5e4));
+
+    const YAML::Node none = applyEffect(c.find("rolling_resistance"), 0.0, base, ExperimentType::PlateSinkage);
+    CHECK(none["soil"]["contact"]["rolling"]["model"].as<std::string>() == "none");
+    CHECK_FALSE(none["soil"]["contact"]["rolling"]["coefficient"]);
+
+    const YAML::Node wall = applyEffect(c.find("wall_friction"), 0.25, base, ExperimentType::PlateSinkage);
+    CHECK(wall["soil"]["walls"][0]["friction_coefficient"].as<double>() == Approx(0.25));
+    const YAML::Node tool = applyEffect(c.find("tool_friction"), 0.5, base, ExperimentType::DirectShear);
+    CHECK_FALSE(tool["bevameter"]["plate_friction_coefficient"]); // only for plate tests
+}
+
+TEST_CASE("polydispersity keeps the mean radius and the solid volume; domain size the depth",
+          "[gap][effects]") {
+    const YAML::Node base = YAML::Load(kScenario);
+    const EffectCatalogue c = catalogue();
+    const YAML::Node wide = applyEffect(c.find("polydispersity"), 0.3, base, ExperimentType::PlateSinkage);
+    const YAML::Node r = wide["soil"]["deposition"]["radius"];
+    const double lo = r["min_m"].as<double>(), hi = r["max_m"].as<double>();
+    CHECK(0.5 * (lo + hi) == Approx(0.002));
+    CHECK((hi - lo) / (hi + lo) == Approx(0.3));
+    // Solid volume: count x E[r^3]; E[r^3] of a uniform r on [a, b] is (b^4 - a^4) / (4 (b - a)).
+    const auto volume = [](const YAML::Node &s) {
+        const YAML::Node rr = s["soil"]["deposition"]["radius"];
+        const double a = rr["min_m"].as<double>(), b = rr["max_m"].as<double>();
+        return s["soil"]["deposition"]["count"].as<double>() *
+               (std::pow(b, 4) - std::pow(a, 4)) / (4.0 * (b - a));
+    };
+    CHECK(volume(wide) == Approx(volume(base)).epsilon(1e-3));
+    CHECK(wide["soil"]["simulation"]["time_step_s"].as<double>() ==
+          Approx(4.0e-5 * 0.7 / 0.9));
+
+    const YAML::Node big = applyEffect(c.find("domain_size"), 1.5, base, ExperimentType::PlateSinkage);
+    const auto upper = big["soil"]["walls"][0]["upper_m"].as<std::vector<double>>();
+    const auto lower = big["soil"]["walls"][0]["lower_m"].as<std::vector<double>>();
+    CHECK(upper[0] - lower[0] == Approx(0.15));
+    CHECK(upper[1] - lower[1] == Approx(0.12));
+    CHECK(upper[2] == Approx(0.2)); // height unchanged
+    CHECK(big["soil"]["deposition"]["count"].as<double>() == Approx(4500));
+}
+
+TEST_CASE("measurement effects shift the simulated sinkage: a constant offset, or compliance x force",
+          "[gap][effects]") {
+    const EffectCatalogue c = catalogue();
+    Experiment e;
+    e.type = ExperimentType::PlateSinkage;
+    e.numbers["plate_diameter_m"] = 0.1;
+    const Curve curve{{0.0, 0.01}, {0.0, 40000.0}};
+    const Curve zero = applyMeasurementEffect(c.find("sensor_zero_offset"), 0.001, e, "pressure_Pa", curve);
+    CHECK(zero.x[1] == Approx(0.011));
+    // 40 kPa on a 100 mm plate is 314 N; at 1e-5 m/N the rig adds 3.14 mm.
+    const Curve rig = applyMeasurementEffect(c.find("rig_compliance"), 1e-5, e, "pressure_Pa", curve);
+    CHECK(rig.x[1] == Approx(0.01 + 1e-5 * 40000.0 * M_PI * 0.0025));
+    CHECK(rig.x[0] == 0.0);
+}
+
+TEST_CASE("an effects file with a bad expression or no signature is refused with its line",
+          "[gap][effects]") {
+    CHECK_THROWS_WITH(evaluate("2 * s +", 1.0, 0.0), Catch::Contains("expression '2 * s +'"));
+    CHECK(evaluate("min(1, 1 / sqrt(s))", 4.0, 0.0) == Approx(0.5));
+}
