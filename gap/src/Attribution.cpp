@@ -1,6 +1,6 @@
 #include "grainlink/gap/Attribution.hpp"
 
-#include <boost/math/distributions/fisher_f.hpp>
+#include <boost/math/distributions/students_t.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -13,6 +13,7 @@ namespace grainlink::gap {
 namespace {
 
 constexpr int kGrid = 201;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDeltaChi2_95 = 3.841458820694124; // chi^2_1 at 95 %
 
 template <class F> double goldenMinimum(F f, double a, double b) {
@@ -118,6 +119,19 @@ Eigen::VectorXd TabulatedResponse::interpolate(const std::vector<Eigen::VectorXd
     return (1.0 - w) * table[seg] + w * table[seg + 1];
 }
 
+void TabulatedResponse::add(double s, const Eigen::VectorXd &mean, const Eigen::VectorXd &variance) {
+    const auto at = std::lower_bound(strengths_.begin(), strengths_.end(), s);
+    const std::size_t i = std::size_t(at - strengths_.begin());
+    if (at != strengths_.end() && *at == s) {
+        means_[i] = mean;
+        variances_[i] = variance;
+        return;
+    }
+    strengths_.insert(at, s);
+    means_.insert(means_.begin() + std::ptrdiff_t(i), mean);
+    variances_.insert(variances_.begin() + std::ptrdiff_t(i), variance);
+}
+
 Eigen::VectorXd TabulatedResponse::mean(double s) const { return interpolate(means_, s); }
 
 Eigen::VectorXd TabulatedResponse::variance(double s) const {
@@ -126,25 +140,98 @@ Eigen::VectorXd TabulatedResponse::variance(double s) const {
     return interpolate(variances_, clamped).cwiseMax(0.0);
 }
 
+BlockCorrelation::BlockCorrelation(const std::vector<FeatureKey> &keys, const Eigen::MatrixXd &rows) {
+    for (const FeatureKey &k : keys)
+        experiment_of_.push_back(k.experiment);
+    std::map<std::string, std::vector<Eigen::Index>> by;
+    for (std::size_t i = 0; i < keys.size(); ++i)
+        by[keys[i].experiment].push_back(Eigen::Index(i));
+    for (const auto &[id, idx] : by) {
+        double rho = 0.5; // too few seeds to tell: halfway between independent and one
+        if (rows.rows() >= 3 && idx.size() >= 2) {
+            double sum = 0.0;
+            int pairs = 0;
+            for (std::size_t a = 0; a < idx.size(); ++a)
+                for (std::size_t b = a + 1; b < idx.size(); ++b) {
+                    const Eigen::VectorXd x = rows.col(idx[a]), y = rows.col(idx[b]);
+                    if (!x.allFinite() || !y.allFinite())
+                        continue;
+                    const Eigen::VectorXd dx = x.array() - x.mean(), dy = y.array() - y.mean();
+                    const double den = std::sqrt(dx.squaredNorm() * dy.squaredNorm());
+                    if (den <= 0.0)
+                        continue;
+                    sum += dx.dot(dy) / den;
+                    ++pairs;
+                }
+            if (pairs > 0)
+                rho = sum / pairs;
+        }
+        // Capped below one: a block is never a single number, and R stays invertible.
+        rho_[id] = std::clamp(rho, 0.0, 0.95);
+    }
+}
+
+double BlockCorrelation::rho(const std::string &experiment) const {
+    const auto it = rho_.find(experiment);
+    return it == rho_.end() ? 0.0 : it->second;
+}
+
+std::map<std::string, std::vector<Eigen::Index>>
+BlockCorrelation::groups(const FeatureSet &use) const {
+    std::map<std::string, std::vector<Eigen::Index>> g;
+    for (Eigen::Index k : use)
+        g[experiment_of_.empty() ? std::to_string(k) : experiment_of_[std::size_t(k)]].push_back(k);
+    return g;
+}
+
+double BlockCorrelation::chiSquare(const Eigen::VectorXd &e, const FeatureSet &use) const {
+    double total = 0.0;
+    for (const auto &[id, idx] : groups(use)) {
+        const double r = experiment_of_.empty() ? 0.0 : rho(id);
+        double sum = 0.0, sum2 = 0.0;
+        int k = 0;
+        for (Eigen::Index i : idx)
+            if (std::isfinite(e[i])) {
+                sum += e[i];
+                sum2 += e[i] * e[i];
+                ++k;
+            }
+        // R = (1 - r) I + r 1 1^T:  e^T R^-1 e = (sum2 - r sum^2 / (1 + (k - 1) r)) / (1 - r).
+        total += (sum2 - r * sum * sum / (1.0 + (k - 1) * r)) / (1.0 - r);
+    }
+    return total;
+}
+
+double BlockCorrelation::effectiveCount(const FeatureSet &use) const {
+    double n = 0.0;
+    for (const auto &[id, idx] : groups(use)) {
+        const double r = experiment_of_.empty() ? 0.0 : rho(id);
+        const double k = double(idx.size());
+        n += k / (1.0 + (k - 1.0) * r);
+    }
+    return n;
+}
+
 double chiSquare(const Eigen::VectorXd &measured, const Eigen::VectorXd &mean,
                  const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_fixed,
-                 const FeatureSet &use) {
-    double sum = 0.0;
+                 const FeatureSet &use, const BlockCorrelation &correlation) {
+    Eigen::VectorXd e = Eigen::VectorXd::Constant(measured.size(), kNaN);
     for (Eigen::Index k : use) {
         const double v = u2_fixed[k] + variance[k];
         const double r = measured[k] - mean[k];
         if (std::isfinite(r) && v > 0.0)
-            sum += r * r / v;
+            e[k] = r / std::sqrt(v);
     }
-    return sum;
+    return correlation.chiSquare(e, use);
 }
 
 StrengthFit fitStrength(const Response &response, const Prior &prior,
                         const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
-                        const FeatureSet &use) {
+                        const FeatureSet &use, const BlockCorrelation &correlation) {
     const auto chi2 = [&](double t) {
         const double s = prior.fromScale(t);
-        return chiSquare(measured, response.mean(s), response.variance(s), u2_fixed, use);
+        return chiSquare(measured, response.mean(s), response.variance(s), u2_fixed, use,
+                         correlation);
     };
     StrengthFit fit;
     fit.features = int(use.size());
@@ -175,11 +262,12 @@ Eigen::VectorXd PairResponse::variance(double sa, double sb) const {
 PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Prior &pb,
                 const Eigen::VectorXd &base_mean, const Eigen::VectorXd &base_variance,
                 const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
-                const FeatureSet &use) {
+                const FeatureSet &use, const BlockCorrelation &correlation) {
     PairResponse pair(a, b, base_mean, base_variance);
     const auto chi2 = [&](double ta, double tb) {
         const double sa = pa.fromScale(ta), sb = pb.fromScale(tb);
-        return chiSquare(measured, pair.mean(sa, sb), pair.variance(sa, sb), u2_fixed, use);
+        return chiSquare(measured, pair.mean(sa, sb), pair.variance(sa, sb), u2_fixed, use,
+                         correlation);
     };
     const double a0 = pa.toScale(pa.lo), a1 = pa.toScale(pa.hi);
     const double b0 = pb.toScale(pb.lo), b1 = pb.toScale(pb.hi);
@@ -221,19 +309,14 @@ PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Pri
 
 Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const Prior &pj,
                          const Eigen::VectorXd &base_mean, const Eigen::VectorXd &u2,
-                         const FeatureSet &use) {
+                         const FeatureSet &use, const BlockCorrelation &correlation) {
     const Eigen::VectorXd di = i.mean(s_i) - base_mean;
-    double norm = 0.0;
-    for (Eigen::Index k : use)
-        if (u2[k] > 0.0 && std::isfinite(di[k]))
-            norm += di[k] * di[k] / u2[k];
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(di.size());
+    // Signatures are differences from the base; their distance is a chi^2 like a residual's.
+    const double norm = chiSquare(di, zero, zero, u2, use, correlation);
     const auto distance = [&](double t) {
         const Eigen::VectorXd dj = j.mean(pj.fromScale(t)) - base_mean;
-        double d = 0.0;
-        for (Eigen::Index k : use)
-            if (u2[k] > 0.0 && std::isfinite(di[k]) && std::isfinite(dj[k]))
-                d += (di[k] - dj[k]) * (di[k] - dj[k]) / u2[k];
-        return d;
+        return chiSquare(di, dj, zero, u2, use, correlation);
     };
     const Profile p = minimiseProfile(distance, pj.toScale(pj.lo), pj.toScale(pj.hi), 1.0);
     Overlap o;
@@ -265,43 +348,45 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
     return s;
 }
 
-double effectiveCount(const std::vector<FeatureKey> &keys, const FeatureSet &use,
-                      const Eigen::MatrixXd &seed_rows) {
-    std::map<std::string, std::vector<Eigen::Index>> groups;
-    for (Eigen::Index k : use)
-        groups[keys[std::size_t(k)].experiment].push_back(k);
-    double n_eff = 0.0;
-    for (const auto &[id, idx] : groups) {
-        const double k = double(idx.size());
-        double rho = 0.5; // too few seeds to tell: halfway between independent and one
-        if (seed_rows.rows() >= 3 && idx.size() >= 2) {
-            double sum = 0.0;
-            int pairs = 0;
-            for (std::size_t a = 0; a < idx.size(); ++a)
-                for (std::size_t b = a + 1; b < idx.size(); ++b) {
-                    const Eigen::VectorXd x = seed_rows.col(idx[a]), y = seed_rows.col(idx[b]);
-                    if (!x.allFinite() || !y.allFinite())
-                        continue;
-                    const Eigen::VectorXd dx = x.array() - x.mean(), dy = y.array() - y.mean();
-                    const double den = std::sqrt(dx.squaredNorm() * dy.squaredNorm());
-                    if (den <= 0.0)
-                        continue;
-                    sum += std::clamp(dx.dot(dy) / den, 0.0, 1.0);
-                    ++pairs;
-                }
-            if (pairs > 0)
-                rho = sum / pairs;
-        }
-        n_eff += k / (1.0 + (k - 1.0) * rho);
+DensityComparison compareDensities(const Eigen::VectorXd &measured,
+                                   const Eigen::VectorXd &model_mean,
+                                   const Eigen::VectorXd &model_variance,
+                                   const Eigen::VectorXd &null_mean,
+                                   const Eigen::VectorXd &null_variance, const FeatureSet &use,
+                                   double n_eff) {
+    const auto logDensity = [](double r, double v) {
+        return -0.5 * (r * r / v + std::log(2.0 * M_PI * v));
+    };
+    std::vector<double> d;
+    for (Eigen::Index k : use) {
+        const double rm = measured[k] - model_mean[k], rn = measured[k] - null_mean[k];
+        const double vm = model_variance[k], vn = null_variance[k];
+        if (std::isfinite(rm) && std::isfinite(rn) && vm > 0.0 && vn > 0.0)
+            d.push_back(logDensity(rm, vm) - logDensity(rn, vn));
     }
-    return n_eff;
-}
-
-double heldOutPValue(double sse_null, double sse_model, double n_eff) {
-    if (!(n_eff > 0.0) || !(sse_model > 0.0))
-        return sse_null > 0.0 && sse_model == 0.0 ? 0.0 : 1.0;
-    const boost::math::fisher_f f(n_eff, n_eff);
-    return boost::math::cdf(boost::math::complement(f, sse_null / sse_model));
+    DensityComparison c;
+    c.features = int(d.size());
+    if (d.empty())
+        return c;
+    double mean = 0.0;
+    for (double x : d)
+        mean += x;
+    mean /= double(d.size());
+    double ss = 0.0;
+    for (double x : d)
+        ss += (x - mean) * (x - mean);
+    const double sd = d.size() > 1 ? std::sqrt(ss / double(d.size() - 1)) : 0.0;
+    c.mean_gain = mean;
+    // The features of one experiment move together: the mean is worth n_eff of them.
+    const double n = std::clamp(n_eff, 1.0, double(d.size()));
+    if (sd <= 0.0) {
+        c.p_value = mean > 0.0 ? 0.0 : 1.0;
+        return c;
+    }
+    const double t = mean / (sd / std::sqrt(n));
+    const boost::math::students_t dist(std::max(1.0, n - 1.0));
+    c.p_value = boost::math::cdf(boost::math::complement(dist, t));
+    return c;
 }
 
 } // namespace grainlink::gap

@@ -118,6 +118,7 @@ Measured measure(const ExperimentSet &set, const FeatureDesign &design) {
     const Eigen::Index n = Eigen::Index(design.size());
     m.value = Eigen::VectorXd::Constant(n, kNaN);
     m.u_D = Eigen::VectorXd::Zero(n);
+    m.u_repeats = Eigen::VectorXd::Zero(n);
     m.trials = Eigen::VectorXi::Zero(n);
     m.from_repeats.assign(std::size_t(n), false);
     for (const auto &[id, idx] : design.by_experiment) {
@@ -155,6 +156,7 @@ Measured measure(const ExperimentSet &set, const FeatureDesign &design) {
             m.value[k] = mean;
             m.from_repeats[std::size_t(k)] = count >= 2 && u.rebuilt_bed;
             const double per_trial = u.y_sigma * u.y_sigma + std::pow(u.y_relative * mean, 2);
+            m.u_repeats[k] = std::sqrt(var_repeats / count);
             m.u_D[k] = std::sqrt(var_repeats / count + per_trial / count +
                                  u.y_systematic * u.y_systematic);
         }
@@ -208,9 +210,11 @@ Eigen::VectorXd simulatedFeatures(const ExperimentSet &set, const FeatureDesign 
     return row;
 }
 
-std::vector<RegimePoint> regimePoints(const ExperimentSet &set, const FeatureDesign &design) {
+std::vector<RegimePoint> regimePoints(const ExperimentSet &set, const FeatureDesign &design,
+                                      const std::vector<bool> &reference) {
     std::vector<std::string> kinds;
     std::vector<std::map<std::string, double>> coords;
+    std::vector<std::map<std::string, std::string>> labels;
     for (const FeatureKey &key : design.keys) {
         const Experiment &e = set.find(key.experiment);
         std::map<std::string, double> c = e.numbers;
@@ -218,8 +222,9 @@ std::vector<RegimePoint> regimePoints(const ExperimentSet &set, const FeatureDes
             c["x"] = key.centre();
         kinds.push_back(key.kind);
         coords.push_back(std::move(c));
+        labels.push_back(e.labels);
     }
-    return regimeCoordinates(kinds, coords);
+    return regimeCoordinates(kinds, coords, labels, reference);
 }
 
 std::map<std::string, AxisLabel> axisLabels(const ExperimentSet &set) {

@@ -14,8 +14,7 @@ namespace {
 
 double kernel(const Discrepancy::Hyper &h, const Eigen::VectorXd &a, const Eigen::VectorXd &b) {
     const double d2 = (a - b).squaredNorm();
-    return h.constant_sd * h.constant_sd +
-           h.smooth_sd * h.smooth_sd * std::exp(-0.5 * d2 / (h.length * h.length));
+    return h.sd * h.sd * std::exp(-0.5 * d2 / (h.length * h.length));
 }
 
 } // namespace
@@ -29,10 +28,10 @@ Discrepancy Discrepancy::fit(const std::vector<RegimePoint> &points, const Eigen
         if (std::isfinite(rho[Eigen::Index(i)]) && noise_sd[Eigen::Index(i)] > 0.0)
             by_kind[points[i].kind].push_back(Eigen::Index(i));
 
-    // Grid of hyperparameters: relative biases from none to 80 %, length scales from a fifth
-    // to twice the coordinates' range.
+    // Grid of hyperparameters: relative discrepancies from none to 160 %, length scales from a
+    // quarter of the calibration's range to all of it.
     const double sds[] = {0.0, 0.02, 0.05, 0.1, 0.2, 0.4, 0.8, 1.6};
-    const double lengths[] = {0.2, 0.5, 1.0, 2.0};
+    const double lengths[] = {0.25, 0.5, 1.0};
     Discrepancy d;
     for (const auto &[kind, idx] : by_kind) {
         const Eigen::Index n = Eigen::Index(idx.size());
@@ -45,12 +44,11 @@ Discrepancy Discrepancy::fit(const std::vector<RegimePoint> &points, const Eigen
         }
         KindFit best;
         best.hyper.log_marginal = -std::numeric_limits<double>::infinity();
-        for (double c : sds)
-            for (double s : sds)
-                for (double l : lengths) {
+        for (double s : sds)
+            for (double l : lengths) {
                     if (s == 0.0 && l != lengths[0])
-                        continue; // the length scale is irrelevant without a smooth part
-                    Hyper h{c, s, l, 0.0};
+                        continue; // the length scale is irrelevant without a discrepancy
+                    Hyper h{s, l, 0.0};
                     Eigen::MatrixXd K(n, n);
                     for (Eigen::Index i = 0; i < n; ++i)
                         for (Eigen::Index j = 0; j < n; ++j)
@@ -70,7 +68,7 @@ Discrepancy Discrepancy::fit(const std::vector<RegimePoint> &points, const Eigen
                         best.k_inv = llt.solve(Eigen::MatrixXd::Identity(n, n));
                         best.x = x;
                     }
-                }
+            }
         if (!std::isfinite(best.hyper.log_marginal))
             continue;
         d.hyper_[kind] = best.hyper;
@@ -101,28 +99,53 @@ DiscrepancyPrediction Discrepancy::predict(const std::vector<RegimePoint> &point
 
 std::vector<RegimePoint>
 regimeCoordinates(const std::vector<std::string> &kinds,
-                  const std::vector<std::map<std::string, double>> &coordinates) {
-    if (kinds.size() != coordinates.size())
-        throw std::invalid_argument("regimeCoordinates: kinds and coordinates differ in size");
-    // Range of every coordinate within each kind.
-    std::map<std::string, std::map<std::string, std::pair<double, double>>> range;
-    for (std::size_t i = 0; i < kinds.size(); ++i)
+                  const std::vector<std::map<std::string, double>> &coordinates,
+                  const std::vector<std::map<std::string, std::string>> &labels,
+                  const std::vector<bool> &reference) {
+    if (kinds.size() != coordinates.size() || (!labels.empty() && labels.size() != kinds.size()) ||
+        (!reference.empty() && reference.size() != kinds.size()))
+        throw std::invalid_argument("regimeCoordinates: inputs differ in size");
+    using Range = std::pair<double, double>;
+    const auto widen = [](std::map<std::string, Range> &m, const std::string &name, double v) {
+        auto [it, fresh] = m.try_emplace(name, v, v);
+        it->second.first = std::min(it->second.first, v);
+        it->second.second = std::max(it->second.second, v);
+    };
+    // Per kind: every coordinate's range over all features and over the reference ones, and
+    // every label's values.
+    std::map<std::string, std::map<std::string, Range>> all, ref;
+    std::map<std::string, std::map<std::string, std::set<std::string>>> values;
+    for (std::size_t i = 0; i < kinds.size(); ++i) {
         for (const auto &[name, v] : coordinates[i]) {
-            auto [it, fresh] = range[kinds[i]].try_emplace(name, v, v);
-            it->second.first = std::min(it->second.first, v);
-            it->second.second = std::max(it->second.second, v);
+            widen(all[kinds[i]], name, v);
+            if (reference.empty() || reference[i])
+                widen(ref[kinds[i]], name, v);
         }
+        if (!labels.empty())
+            for (const auto &[name, v] : labels[i])
+                values[kinds[i]][name].insert(v);
+    }
     std::vector<RegimePoint> points;
     for (std::size_t i = 0; i < kinds.size(); ++i) {
         RegimePoint p;
         p.kind = kinds[i];
         std::vector<double> x;
-        for (const auto &[name, r] : range[kinds[i]]) {
-            const double width = r.second - r.first;
-            if (!(width > 0.0))
+        for (const auto &[name, r] : all[kinds[i]]) {
+            if (!(r.second > r.first))
                 continue;
+            const auto rr = ref[kinds[i]].find(name);
+            const bool ref_wide = rr != ref[kinds[i]].end() && rr->second.second > rr->second.first;
+            const Range scale = ref_wide ? rr->second : r;
             const auto it = coordinates[i].find(name);
-            x.push_back(it == coordinates[i].end() ? 0.0 : (it->second - r.first) / width);
+            const double v = it == coordinates[i].end() ? scale.first : it->second;
+            x.push_back((v - scale.first) / (scale.second - scale.first));
+        }
+        for (const auto &[name, vals] : values[kinds[i]]) {
+            if (vals.size() < 2)
+                continue;
+            const auto it = labels[i].find(name);
+            for (const std::string &v : vals)
+                x.push_back(it != labels[i].end() && it->second == v ? std::sqrt(0.5) : 0.0);
         }
         p.x = Eigen::Map<Eigen::VectorXd>(x.data(), Eigen::Index(x.size()));
         points.push_back(std::move(p));

@@ -1,6 +1,7 @@
 #include "grainlink/gap/Validation.hpp"
 
 #include <boost/math/distributions/normal.hpp>
+#include <boost/math/distributions/students_t.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -42,6 +43,17 @@ double normalBound(double p) {
     if (!(p > 0.0 && p < 1.0))
         throw std::invalid_argument("normalBound: p must be in (0, 1)");
     return boost::math::quantile(boost::math::complement(boost::math::normal(), 0.5 * p));
+}
+
+double normalEquivalent(double t, double dof) {
+    if (!std::isfinite(t) || !std::isfinite(dof) || dof > 1e6)
+        return t;
+    const double tail = boost::math::cdf(boost::math::complement(
+        boost::math::students_t(std::max(dof, 0.5)), std::abs(t)));
+    if (tail <= 0.0)
+        return t;
+    const double z = boost::math::quantile(boost::math::complement(boost::math::normal(), tail));
+    return t < 0 ? -z : z;
 }
 
 ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
@@ -91,6 +103,21 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
     v.u_val = (num2.array() + v.u_bed.array().square() + v.u_D.array().square()).sqrt();
     v.residual = measured.value - v.simulated;
     v.standardised = v.residual.array() / v.u_val.array();
+    v.dof.resize(n);
+    v.z.resize(n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+        const double nu_seed = b.count[k] - 1.0;
+        const double nu_rep = measured.trials[k] - 1.0;
+        const double u_rep = measured.u_repeats.size() == n ? measured.u_repeats[k] : 0.0;
+        double den = 0.0;
+        if (nu_seed > 0.0)
+            den += (std::pow(v.u_seed[k], 4) + std::pow(v.u_bed[k], 4)) / nu_seed;
+        if (nu_rep > 0.0 && u_rep > 0.0)
+            den += std::pow(u_rep, 4) / nu_rep;
+        v.dof[k] = den > 0.0 ? std::pow(v.u_val[k], 4) / den
+                             : std::numeric_limits<double>::infinity();
+        v.z[k] = normalEquivalent(v.standardised[k], v.dof[k]);
+    }
     v.ratio = v.simulated.array() / measured.value.array();
     return v;
 }
@@ -143,10 +170,12 @@ std::vector<RegimeFinding> localise(const std::vector<FeatureKey> &keys,
                                     const std::map<std::string, Conditions> &conditions,
                                     const std::map<std::string, AxisLabel> &axes,
                                     double flag_at) {
+    // The normal-equivalent deviates where validate() made them (they allow for the few seeds).
+    const Eigen::VectorXd &z = v.z.size() == v.standardised.size() ? v.z : v.standardised;
     // kind -> bin (x_lo, x_hi) -> feature indices
     std::map<std::string, std::map<std::pair<double, double>, std::vector<std::size_t>>> bins;
     for (std::size_t k = 0; k < keys.size(); ++k)
-        if (std::isfinite(v.standardised[Eigen::Index(k)]))
+        if (std::isfinite(z[Eigen::Index(k)]))
             bins[keys[k].kind][{keys[k].x_lo, keys[k].x_hi}].push_back(k);
 
     // The condition (key = value) that the flagged experiments alone share, if any.
@@ -191,7 +220,7 @@ std::vector<RegimeFinding> localise(const std::vector<FeatureKey> &keys,
             int high = 0, low = 0;
             Bin b{range.first, range.second, 0, {}, {}, 1e300, -1e300};
             for (std::size_t k : indices) {
-                const double e = v.standardised[Eigen::Index(k)];
+                const double e = z[Eigen::Index(k)];
                 b.covering.insert(keys[k].experiment);
                 high += e < -flag_at; // measured below simulated: simulation too high
                 low += e > flag_at;
@@ -201,7 +230,7 @@ std::vector<RegimeFinding> localise(const std::vector<FeatureKey> &keys,
             if (b.sign == 0 && (high > 0 || low > 0))
                 b.sign = high >= low ? +1 : -1; // a minority: reported with its count
             for (std::size_t k : indices) {
-                const double e = v.standardised[Eigen::Index(k)];
+                const double e = z[Eigen::Index(k)];
                 if ((b.sign > 0 && e < -flag_at) || (b.sign < 0 && e > flag_at)) {
                     b.flagged.insert(keys[k].experiment);
                     b.rmin = std::min(b.rmin, v.ratio[Eigen::Index(k)]);

@@ -2,6 +2,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <Eigen/Dense>
+
 #include <cmath>
 #include <random>
 
@@ -118,8 +120,8 @@ TEST_CASE("held-out scores: a perfect model has no gap; a 10 % error is a 10 % r
     CHECK(off.gap == Approx(0.1).epsilon(1e-6));
 }
 
-TEST_CASE("effective count: one per experiment when its features move together, about k when "
-          "independent",
+TEST_CASE("block correlation: one per experiment when its features move together, about k when "
+          "independent; its chi^2 is the generalised least squares form",
           "[gap][attribution]") {
     std::vector<FeatureKey> keys;
     for (int b = 0; b < 5; ++b)
@@ -130,17 +132,42 @@ TEST_CASE("effective count: one per experiment when its features move together, 
     for (int s = 0; s < 40; ++s) {
         const double shared = z(rng);
         for (int b = 0; b < 5; ++b) {
-            together(s, b) = shared;
+            together(s, b) = shared + 0.01 * z(rng);
             apart(s, b) = z(rng);
         }
     }
-    CHECK(effectiveCount(keys, all(5), together) == Approx(1.0));
-    CHECK(effectiveCount(keys, all(5), apart) > 3.5);
+    const BlockCorrelation t(keys, together), a(keys, apart);
+    CHECK(t.rho("e") == Approx(0.95)); // capped
+    CHECK(t.effectiveCount(all(5)) == Approx(5.0 / (1.0 + 4.0 * 0.95)));
+    CHECK(a.effectiveCount(all(5)) > 3.5);
+    // e^T R^-1 e against the dense inverse of R = (1 - r) I + r 1 1^T.
+    Eigen::VectorXd e(5);
+    e << 1.0, -0.5, 2.0, 0.3, -1.2;
+    const double r = t.rho("e");
+    const Eigen::MatrixXd R = (1.0 - r) * Eigen::MatrixXd::Identity(5, 5) +
+                              r * Eigen::MatrixXd::Ones(5, 5);
+    CHECK(t.chiSquare(e, all(5)) == Approx(e.dot(R.inverse() * e)).epsilon(1e-10));
 }
 
-TEST_CASE("the sample-split F test: equal errors give p = 1/2, a tenfold smaller error a small p",
+TEST_CASE("the held-out density test: a model as good as the null is not better; a precise "
+          "right prediction beats a vague one",
           "[gap][attribution]") {
-    CHECK(heldOutPValue(10.0, 10.0, 6.0) == Approx(0.5));
-    CHECK(heldOutPValue(100.0, 10.0, 6.0) < 0.01);
-    CHECK(heldOutPValue(10.0, 100.0, 6.0) > 0.99);
+    const Eigen::VectorXd y = Eigen::VectorXd::Constant(6, 10.0);
+    Eigen::VectorXd off(6);
+    off << 0.1, -0.1, 0.2, -0.2, 0.05, -0.05;
+    const Eigen::VectorXd v = Eigen::VectorXd::Constant(6, 0.04);
+    // The same predictions: no gain, p about one half.
+    const auto same = compareDensities(y, y + off, v, y + off, v, all(6), 6.0);
+    CHECK(same.mean_gain == Approx(0.0).margin(1e-12));
+    CHECK(same.p_value >= 0.5);
+    // Right and precise against right but ten times as spread: the model wins, and by
+    // log(sqrt(10)) less the (small) cost of its residuals per feature.
+    const auto sharp = compareDensities(y, y + off, v, y + off, v * 10.0, all(6), 6.0);
+    CHECK(sharp.mean_gain > 0.9);
+    CHECK(sharp.p_value < 0.01);
+    // A confident miss loses to a vague hit.
+    const auto miss = compareDensities(y, y + Eigen::VectorXd::Constant(6, 1.0), v, y, v * 10.0,
+                                       all(6), 6.0);
+    CHECK(miss.mean_gain < 0.0);
+    CHECK(miss.p_value > 0.99);
 }

@@ -19,18 +19,17 @@ TEST_CASE("one calibration point: the posterior is the closed form of a one-poin
     const Eigen::VectorXd noise = Eigen::VectorXd::Constant(1, 0.1);
     const auto d = Discrepancy::fit({at("A", 0.0)}, rho, noise);
     const auto h = d.hyperparameters().at("A");
-    // k(x, x') = c^2 + s^2 exp(-(x - x')^2 / (2 l^2)); mean = k* rho / (k00 + n^2),
+    // k(x, x') = s^2 exp(-(x - x')^2 / (2 l^2)); mean = k* rho / (k00 + n^2),
     // variance = k** - k*^2 / (k00 + n^2).
     const double x = 0.4;
-    const double kstar = h.constant_sd * h.constant_sd +
-                         h.smooth_sd * h.smooth_sd * std::exp(-0.5 * x * x / (h.length * h.length));
-    const double k00 = h.constant_sd * h.constant_sd + h.smooth_sd * h.smooth_sd;
+    const double kstar = h.sd * h.sd * std::exp(-0.5 * x * x / (h.length * h.length));
+    const double k00 = h.sd * h.sd;
     const auto p = d.predict({at("A", x)});
     CHECK(p.mean[0] == Approx(kstar * 0.3 / (k00 + 0.01)).margin(1e-12));
     CHECK(p.variance[0] == Approx(k00 - kstar * kstar / (k00 + 0.01)).margin(1e-12));
 }
 
-TEST_CASE("a constant bias seen in calibration carries over to a far regime of the same kind",
+TEST_CASE("a bias seen in calibration carries over nearby and fades far from it",
           "[gap][discrepancy]") {
     std::mt19937 rng(3);
     std::normal_distribution<double> noise(0.0, 0.02);
@@ -41,11 +40,15 @@ TEST_CASE("a constant bias seen in calibration carries over to a far regime of t
         rho[i] = -0.4 + noise(rng);
     }
     const auto d = Discrepancy::fit(pts, rho, sd);
-    const auto p = d.predict({at("plate", 3.0), at("shear", 0.5)});
-    CHECK(p.mean[0] == Approx(-0.4).margin(0.05));
+    const auto p = d.predict({at("plate", 1.1), at("plate", 8.0), at("shear", 0.5)});
+    CHECK(p.mean[0] == Approx(-0.4).margin(0.06)); // just beyond the calibration
+    // Far beyond it (eight calibration widths) the null is the base model again, with the
+    // discrepancy's full spread.
+    CHECK(std::abs(p.mean[1]) < 0.01);
+    CHECK(std::sqrt(p.variance[1]) == Approx(d.hyperparameters().at("plate").sd).epsilon(0.01));
     // A kind never calibrated gets no discrepancy: the null is the base model there.
-    CHECK(p.mean[1] == 0.0);
-    CHECK(p.variance[1] == 0.0);
+    CHECK(p.mean[2] == 0.0);
+    CHECK(p.variance[2] == 0.0);
 }
 
 TEST_CASE("no discrepancy in calibration predicts none", "[gap][discrepancy]") {
@@ -76,11 +79,16 @@ TEST_CASE("a smooth discrepancy is interpolated between calibration regimes",
     CHECK(p.mean[1] == Approx(0.3 * std::sin(2.0 * M_PI * 0.625)).margin(0.03));
 }
 
-TEST_CASE("regime coordinates are scaled per kind and constant ones dropped",
+TEST_CASE("regime coordinates are scaled by the calibration's range; labels one unit apart",
           "[gap][discrepancy]") {
     const auto pts = regimeCoordinates(
-        {"a", "a", "b"}, {{{"z", 0.0}, {"d", 0.06}}, {{"z", 0.02}, {"d", 0.06}}, {{"z", 5.0}}});
-    REQUIRE(pts[0].x.size() == 1); // d is constant within kind a
+        {"a", "a", "a", "b"},
+        {{{"z", 0.0}, {"d", 0.06}}, {{"z", 0.02}, {"d", 0.06}}, {{"z", 0.04}, {"d", 0.06}}, {{"z", 5.0}}},
+        {{{"box", "large"}}, {{"box", "large"}}, {{"box", "small"}}, {}},
+        {true, true, false, true});
+    REQUIRE(pts[0].x.size() == 3); // z, and one coordinate per box; d is constant
     CHECK(pts[1].x[0] == Approx(1.0));
-    CHECK(pts[2].x.size() == 0);
+    CHECK(pts[2].x[0] == Approx(2.0)); // held out: twice the calibration's range
+    CHECK((pts[2].x.tail(2) - pts[0].x.tail(2)).norm() == Approx(1.0));
+    CHECK(pts[3].x.size() == 0);
 }

@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include <functional>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,8 @@ public:
     Eigen::VectorXd mean(double s) const override;
     Eigen::VectorXd variance(double s) const override;
     const std::vector<double> &strengths() const { return strengths_; }
+    /// Adds a simulated strength (a confirming run), keeping the table sorted.
+    void add(double s, const Eigen::VectorXd &mean, const Eigen::VectorXd &variance);
 
 private:
     Eigen::VectorXd interpolate(const std::vector<Eigen::VectorXd> &table, double s) const;
@@ -69,10 +72,33 @@ private:
 /// The features a comparison uses (e.g. the calibration experiments').
 using FeatureSet = std::vector<Eigen::Index>;
 
-/// chi^2 of `mean` against `measured` over `use`, with variance `u2_fixed + variance`.
+/// The features of one experiment share its bed realisation, in the simulation and in every
+/// measured trial: their residuals are correlated. Modelled as one correlation coefficient rho
+/// per experiment between any two of its features (compound symmetry), estimated from the
+/// base model's seeds; experiments are independent of each other.
+class BlockCorrelation {
+public:
+    BlockCorrelation() = default; ///< every feature independent
+    /// rho of each experiment: the mean correlation of its features over the seeds `rows`
+    /// (clipped to [0, 0.95]; 0.5 where fewer than three seeds tell).
+    BlockCorrelation(const std::vector<FeatureKey> &keys, const Eigen::MatrixXd &rows);
+    /// e^T R^-1 e of standardised residuals e over `use` (generalised least squares).
+    double chiSquare(const Eigen::VectorXd &e, const FeatureSet &use) const;
+    /// How many independent features `use` is worth (Kish: k / (1 + (k - 1) rho) each).
+    double effectiveCount(const FeatureSet &use) const;
+    double rho(const std::string &experiment) const;
+
+private:
+    std::map<std::string, std::vector<Eigen::Index>> groups(const FeatureSet &use) const;
+    std::vector<std::string> experiment_of_;
+    std::map<std::string, double> rho_;
+};
+
+/// chi^2 of `mean` against `measured` over `use`, with variance `u2_fixed + variance`,
+/// correlated within experiments as `correlation` says.
 double chiSquare(const Eigen::VectorXd &measured, const Eigen::VectorXd &mean,
                  const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_fixed,
-                 const FeatureSet &use);
+                 const FeatureSet &use, const BlockCorrelation &correlation = {});
 
 /// The strength that minimises chi^2 over `use` (a grid over the prior, then golden section),
 /// with a 95 % interval from the chi^2 profile (delta chi^2 = 3.84, widened by the Birge ratio
@@ -86,7 +112,7 @@ struct StrengthFit {
 };
 StrengthFit fitStrength(const Response &response, const Prior &prior,
                         const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
-                        const FeatureSet &use);
+                        const FeatureSet &use, const BlockCorrelation &correlation = {});
 
 /// Two effects together, their changes added to the base (the confirming simulation runs them
 /// together for real).
@@ -113,7 +139,7 @@ struct PairFit {
 PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Prior &pb,
                 const Eigen::VectorXd &base_mean, const Eigen::VectorXd &base_variance,
                 const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
-                const FeatureSet &use);
+                const FeatureSet &use, const BlockCorrelation &correlation = {});
 
 /// How much of effect i's signature (its change from the base at strength s_i, weighted by
 /// 1/u^2) effect j can reproduce at its best strength: 1 = indistinguishable on this design,
@@ -125,7 +151,7 @@ struct Overlap {
 };
 Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const Prior &pj,
                          const Eigen::VectorXd &base_mean, const Eigen::VectorXd &u2,
-                         const FeatureSet &use);
+                         const FeatureSet &use, const BlockCorrelation &correlation = {});
 
 /// How well predictions match held-out features. `smse`: mean squared standardised error;
 /// `relative_rmse`: root mean square of (measured - predicted) / measured; `gap`: that
@@ -138,14 +164,21 @@ struct HeldOutScore {
 HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd &predicted,
                           const Eigen::VectorXd &variance, const FeatureSet &use);
 
-/// The number of independent features `use` is worth: within each experiment, features are
-/// correlated through the bed realisation (Kish's design effect, n / (1 + (k - 1) rho), with
-/// rho the mean correlation between an experiment's features over the seeds `seed_rows`).
-double effectiveCount(const std::vector<FeatureKey> &keys, const FeatureSet &use,
-                      const Eigen::MatrixXd &seed_rows);
 
-/// Sample-split test that a model predicts held-out features better than the null: the
-/// one-sided p of F = SSE_null / SSE_model with (n_eff, n_eff) degrees of freedom.
-double heldOutPValue(double sse_null, double sse_model, double n_eff);
+/// Sample-split test that a model predicts held-out features better than the null, by the log
+/// predictive density (a proper score: a model gains nothing by widening its spread, nor by
+/// a confident miss): the per-feature differences of log density, their mean over `n_eff`
+/// independent features, and the one-sided p of a t test that the mean is > 0.
+struct DensityComparison {
+    double mean_gain = 0.0; ///< mean log-density gain per feature (model - null)
+    double p_value = 1.0;
+    int features = 0;
+};
+DensityComparison compareDensities(const Eigen::VectorXd &measured,
+                                   const Eigen::VectorXd &model_mean,
+                                   const Eigen::VectorXd &model_variance,
+                                   const Eigen::VectorXd &null_mean,
+                                   const Eigen::VectorXd &null_variance, const FeatureSet &use,
+                                   double n_eff);
 
 } // namespace grainlink::gap

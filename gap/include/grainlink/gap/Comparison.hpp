@@ -42,9 +42,11 @@ Measured measure(const ExperimentSet &set, const FeatureDesign &design);
 Eigen::VectorXd simulatedFeatures(const ExperimentSet &set, const FeatureDesign &design,
                                   const SimulatedCurves &curves);
 
-/// Regime coordinates of the design's features for the null model: the bin centre and every
-/// numeric condition of its experiment.
-std::vector<RegimePoint> regimePoints(const ExperimentSet &set, const FeatureDesign &design);
+/// Regime coordinates of the design's features for the null model: the bin centre, every
+/// numeric condition and every text condition of its experiment, scaled by their range over
+/// the `reference` features (the calibration; empty: all).
+std::vector<RegimePoint> regimePoints(const ExperimentSet &set, const FeatureDesign &design,
+                                      const std::vector<bool> &reference = {});
 
 /// How each kind's x axis is written in reports.
 std::map<std::string, AxisLabel> axisLabels(const ExperimentSet &set);

@@ -1,11 +1,12 @@
 #pragma once
 // The null model's generic discrepancy (Kennedy & O'Hagan 2001): what the base model misses,
 // fitted on the calibration experiments without naming a cause. The relative residual
-// (measured - simulated) / simulated of every feature is a Gaussian process over the regime
-// coordinates of its kind (sinkage, plate size, box, ...), with a constant part (a bias that
-// carries over to every experiment of the kind) and a squared-exponential part (a bias that
-// varies smoothly with the regime); the measured-and-simulated uncertainty is the noise. An
-// effect is claimed only where it predicts held-out experiments better than this
+// (measured - simulated) / simulated of every feature is a zero-mean Gaussian process over the
+// regime coordinates of its kind (sinkage, plate size, box, ...), squared-exponential in
+// coordinates scaled by the calibration's own range; the measured-and-simulated uncertainty is
+// the noise. It knows the regimes it was fitted in: near them it carries the discrepancy over,
+// far from them (beyond its length scale) it reverts to the base model with a growing spread.
+// An effect is claimed only where it predicts held-out experiments better than this
 // (docs/gap.md, "The null model").
 #include <Eigen/Core>
 
@@ -31,9 +32,8 @@ class Discrepancy {
 public:
     /// Hyperparameters per kind, chosen by the largest marginal likelihood on a grid.
     struct Hyper {
-        double constant_sd = 0.0; ///< sd of the constant (bias) part, relative
-        double smooth_sd = 0.0;   ///< sd of the smooth part, relative
-        double length = 1.0;      ///< length scale of the smooth part, in scaled coordinates
+        double sd = 0.0;     ///< prior sd of the relative discrepancy
+        double length = 1.0; ///< length scale, in scaled coordinates
         double log_marginal = 0.0;
     };
 
@@ -59,9 +59,13 @@ private:
 };
 
 /// Regime coordinates of features: each named numeric coordinate scaled by its range over the
-/// features of the same kind (a coordinate constant within a kind is dropped).
+/// `reference` features of the same kind (the calibration; where it is constant there, by its
+/// range over all), a coordinate constant over all features of a kind dropped; each text label
+/// (a box) a coordinate per value, so that two values lie one length unit apart.
 std::vector<RegimePoint>
 regimeCoordinates(const std::vector<std::string> &kinds,
-                  const std::vector<std::map<std::string, double>> &coordinates);
+                  const std::vector<std::map<std::string, double>> &coordinates,
+                  const std::vector<std::map<std::string, std::string>> &labels = {},
+                  const std::vector<bool> &reference = {});
 
 } // namespace grainlink::gap

@@ -18,6 +18,7 @@ struct Measured {
     std::vector<FeatureKey> keys;
     Eigen::VectorXd value; ///< mean over the trials
     Eigen::VectorXd u_D;   ///< standard uncertainty of that mean: repeats, stated sigma, zero
+    Eigen::VectorXd u_repeats; ///< the part of u_D estimated from the repeats' scatter
     Eigen::VectorXi trials;
     /// True where u_D comes from repeats on re-prepared beds (and so holds the bed-to-bed
     /// scatter); where false the simulation's single-bed scatter is added (one real bed is one
@@ -44,8 +45,18 @@ struct ValidationResult {
     Eigen::VectorXd u_val;      ///< sqrt(u_num^2 + u_bed^2 + u_D^2)
     Eigen::VectorXd residual;   ///< measured - simulated
     Eigen::VectorXd standardised; ///< residual / u_val
+    /// Degrees of freedom of u_val (Welch-Satterthwaite: the seeds' and repeats' scatter are
+    /// estimates from few samples; stated uncertainties and checks count as exact).
+    Eigen::VectorXd dof;
+    /// The standardised residual as the normal deviate of the same tail probability under
+    /// Student's t with `dof`: what the gap test and the flags use.
+    Eigen::VectorXd z;
     Eigen::VectorXd ratio;      ///< simulated / measured
 };
+
+/// The normal deviate with the same two-sided tail probability as `t` under Student's t with
+/// `dof` degrees of freedom (infinite or NaN dof: t itself).
+double normalEquivalent(double t, double dof);
 
 /// u_val and the residuals of `base` (seeds x features) against `measured`. A check's
 /// systematic part is its mean difference from the base with the seed noise of that difference

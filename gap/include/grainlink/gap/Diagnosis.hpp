@@ -1,0 +1,132 @@
+#pragma once
+// The diagnosis (docs/gap.md, "The pipeline"): numerical uncertainty first, then where the gap
+// lies, which catalogued effect explains it, and how far the gap on held-out experiments
+// shrinks once the effect is added. What needs simulating is asked of a Simulator (DEM runs
+// through `grainlink study`, or an analytic model in tests), in batches so that a study can
+// run them in parallel and cache every one.
+#include "grainlink/gap/Attribution.hpp"
+#include "grainlink/gap/Comparison.hpp"
+#include "grainlink/gap/Discrepancy.hpp"
+#include "grainlink/gap/Effects.hpp"
+#include "grainlink/gap/Validation.hpp"
+
+#include <Eigen/Core>
+
+#include <functional>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlink::gap {
+
+/// One model variant to simulate: the base with up to two effects at given strengths, or with
+/// one numerical choice changed (`check`), over seeds 0 .. seeds - 1 of the base's sequence.
+struct VariantRequest {
+    std::string label;
+    const Effect *effect = nullptr;
+    double strength = 0.0;
+    const Effect *second = nullptr;
+    double second_strength = 0.0;
+    std::string check; ///< "", "resolution", "time_step", "domain", "rate"
+    int seeds = 1;
+};
+
+/// Runs variants of the base model on a design: one matrix per request, seeds x features.
+class Simulator {
+public:
+    virtual ~Simulator() = default;
+    /// The numerical checks this simulator can run ("resolution", ...).
+    virtual std::vector<std::string> checks() const = 0;
+    virtual std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &design,
+                                                  const FeatureDesign &features,
+                                                  const std::vector<VariantRequest> &requests) = 0;
+    /// Experiments that could be added to `design` (conditions only, no data): a plate test,
+    /// a direct shear test, an angle of repose, ...; used to name the experiment that would
+    /// separate effects the design cannot tell apart. Empty: none offered.
+    virtual std::vector<ExperimentSet> probes(const ExperimentSet &design) const {
+        (void)design;
+        return {};
+    }
+    /// The scenario effects are resolved against (their off values, their applicability).
+    virtual YAML::Node referenceScenario() const = 0;
+};
+
+struct DiagnosisOptions {
+    double alpha = 0.05;   ///< family-wise level of the gap test and of each claim
+    double flag_at = 2.0;  ///< a feature beyond this many u_val is flagged
+    int seeds = 3;         ///< base and confirming runs
+    int signature_seeds = 2;
+    int check_seeds = 2;
+    int measurement_grid = 17; ///< strengths tabulated for a measuring-chain effect (no simulation)
+    int max_confirmed = 3;    ///< candidates re-simulated at their fitted strength
+    int pair_pool = 4;        ///< singles combined into pairs when none explains the gap
+    /// Held-out experiments by id; empty: the split rule of docs/gap.md ("Calibration and
+    /// held-out experiments").
+    std::vector<std::string> held_out;
+    std::function<void(const std::string &)> log; ///< progress lines
+};
+
+/// What the diagnosis found about one candidate effect.
+struct CandidateResult {
+    std::string name;
+    std::string applicability; ///< empty: applicable; else why not
+    Effect effect;             ///< resolved against the base
+    StrengthFit fit;           ///< on the calibration features
+    double calibration_gain = 0.0; ///< chi^2 with the effect off minus at its best strength
+    HeldOutScore predicted;    ///< held-out score from the signature (before confirmation)
+    bool confirmed = false;    ///< re-simulated at the fitted strength
+    HeldOutScore held_out;     ///< held-out score of the confirming simulation
+    double p_value = 1.0;      ///< sample-split test against the null
+    bool beats_null = false;
+    bool explains = false;     ///< beats the null and leaves no gap on any feature
+    GapVerdict after;          ///< the gap test with the effect added (confirmed)
+    Eigen::VectorXd confirmed_mean; ///< features of the confirming runs
+};
+
+struct PairResult {
+    std::string a, b;
+    PairFit fit;
+    bool confirmed = false;
+    HeldOutScore held_out;
+    double p_value = 1.0;
+    bool explains = false;
+    GapVerdict after;
+    Eigen::VectorXd confirmed_mean;
+};
+
+struct Diagnosis {
+    FeatureDesign design;
+    Measured measured;
+    ValidationResult validation;
+    GapVerdict verdict;
+    std::vector<RegimeFinding> findings;
+    std::vector<Eigen::Index> calibration, held_out; ///< feature indices
+    std::vector<std::string> calibration_experiments, held_out_experiments;
+    HeldOutScore held_out_base;  ///< the base model on the held-out features
+    HeldOutScore held_out_null;  ///< base + the fitted discrepancy
+    std::vector<CandidateResult> candidates; ///< ranked by calibration chi^2 (applicable first)
+    std::vector<PairResult> pairs;
+    /// Signature overlap on the whole design: overlap[i][j] = how much of candidate i's
+    /// signature candidate j reproduces (candidates in `candidates` order; applicable ones).
+    std::vector<std::vector<double>> overlap;
+    std::vector<std::string> indistinguishable; ///< candidates the design cannot tell from the leader
+    std::string separating_experiment;         ///< the probe that would separate them best
+    enum class Outcome { NoGap, Explained, ExplainedByPair, Unexplained };
+    Outcome outcome = Outcome::NoGap;
+    std::string claim;        ///< one sentence: the result
+    std::string unexplained;  ///< what remains (features still flagged after the best model)
+    int simulations = 0;      ///< variant x seed runs requested
+};
+const char *outcomeName(Diagnosis::Outcome outcome);
+
+/// The calibration / held-out split by experiment id (docs/gap.md): `held_out` when given;
+/// otherwise, for every experiment type with two or more experiments, the experiments of its
+/// last condition group (its last `box` label when it has several, else its last experiment).
+std::vector<std::string> defaultHeldOut(const ExperimentSet &set);
+
+/// Runs the whole pipeline on measured `set` with the catalogue's diagnosable `effects`.
+Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &effects,
+                   Simulator &simulator, const DiagnosisOptions &options);
+
+} // namespace grainlink::gap

@@ -1,0 +1,566 @@
+#include "grainlink/gap/Diagnosis.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <sstream>
+
+namespace grainlink::gap {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string fmt(double v, int digits = 3) {
+    std::ostringstream s;
+    s.precision(digits);
+    s << v;
+    return s.str();
+}
+
+/// Column mean and the variance of that mean over a variant's seeds; where one seed gives no
+/// scatter, the base's single-bed scatter stands in.
+std::pair<Eigen::VectorXd, Eigen::VectorXd> meanAndVariance(const Eigen::MatrixXd &rows,
+                                                            const Eigen::VectorXd &base_sd) {
+    const ColumnStats s = columnStats(rows);
+    Eigen::VectorXd var(rows.cols());
+    for (Eigen::Index k = 0; k < rows.cols(); ++k) {
+        const double sd = s.count[k] >= 2 ? s.sd[k] : base_sd[k];
+        var[k] = std::isfinite(sd) ? sd * sd / std::max(1, s.count[k]) : 0.0;
+    }
+    return {s.mean, var};
+}
+
+std::string strengthText(const Effect &e, double s) {
+    return e.parameter + " " + fmt(s) + (e.unit == "-" ? "" : " " + e.unit);
+}
+
+/// The effect at the strength of the seeds' first n rows of `rows`.
+Eigen::MatrixXd firstRows(const Eigen::MatrixXd &rows, int n) {
+    return rows.topRows(std::min<Eigen::Index>(rows.rows(), n));
+}
+
+} // namespace
+
+const char *outcomeName(Diagnosis::Outcome outcome) {
+    switch (outcome) {
+    case Diagnosis::Outcome::NoGap:
+        return "no_gap";
+    case Diagnosis::Outcome::Explained:
+        return "explained";
+    case Diagnosis::Outcome::ExplainedByPair:
+        return "explained_by_pair";
+    case Diagnosis::Outcome::Unexplained:
+        return "unexplained";
+    }
+    return "?";
+}
+
+std::vector<std::string> defaultHeldOut(const ExperimentSet &set) {
+    std::map<ExperimentType, std::vector<const Experiment *>> by_type;
+    for (const Experiment &e : set.experiments)
+        by_type[e.type].push_back(&e);
+    std::vector<std::string> held;
+    for (const auto &[type, list] : by_type) {
+        if (list.size() < 2)
+            continue;
+        std::set<std::string> boxes;
+        for (const Experiment *e : list)
+            boxes.insert(e->labels.count("box") ? e->labels.at("box") : "");
+        if (boxes.size() >= 2) {
+            // A whole box held out: the discrepancy model must carry over to a new container.
+            const std::string last = *boxes.rbegin();
+            for (const Experiment *e : list)
+                if ((e->labels.count("box") ? e->labels.at("box") : "") == last)
+                    held.push_back(e->id);
+        } else {
+            held.push_back(list.back()->id);
+        }
+    }
+    return held;
+}
+
+Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &effects,
+                   Simulator &simulator, const DiagnosisOptions &opt) {
+    const auto log = [&](const std::string &line) {
+        if (opt.log)
+            opt.log(line);
+    };
+    Diagnosis D;
+    D.design = designFeatures(set);
+    D.measured = measure(set, D.design);
+    const FeatureDesign &design = D.design;
+    const Measured &meas = D.measured;
+    const Eigen::Index n = Eigen::Index(design.size());
+    log("design: " + std::to_string(set.experiments.size()) + " experiments, " +
+        std::to_string(n) + " features");
+
+    // 1. Numerical uncertainty: the base over its seeds, and each numerical check.
+    std::vector<VariantRequest> first{{"base", nullptr, 0.0, nullptr, 0.0, "", opt.seeds}};
+    for (const std::string &c : simulator.checks())
+        first.push_back({"check " + c, nullptr, 0.0, nullptr, 0.0, c, opt.check_seeds});
+    const auto first_rows = simulator.simulate(set, design, first);
+    for (const auto &r : first)
+        D.simulations += r.seeds;
+    const Eigen::MatrixXd &base_rows = first_rows[0];
+    std::vector<NumericalCheck> checks;
+    for (std::size_t i = 1; i < first.size(); ++i)
+        checks.push_back({first[i].check, first_rows[i]});
+    D.validation = validate(meas, base_rows, checks);
+    const ValidationResult &V = D.validation;
+    D.verdict = testGap(meas.keys, V.z, opt.alpha, opt.flag_at);
+    D.findings = localise(meas.keys, V, [&] {
+        std::map<std::string, Conditions> c;
+        for (const Experiment &e : set.experiments)
+            c[e.id] = e.conditionText();
+        return c;
+    }(), axisLabels(set), opt.flag_at);
+    log(D.verdict.summary);
+
+    // Everything but the simulated mean's own seed noise: the fixed part of every comparison.
+    Eigen::VectorXd u2_fixed = V.u_D.array().square() + V.u_bed.array().square();
+    for (const auto &[name, u] : V.u_checks)
+        u2_fixed += u.array().square().matrix();
+    const Eigen::VectorXd u2_val = V.u_val.array().square();
+
+    // Calibration and held-out features.
+    const std::vector<std::string> held_ids = opt.held_out.empty() ? defaultHeldOut(set) : opt.held_out;
+    const std::set<std::string> held_set(held_ids.begin(), held_ids.end());
+    for (const std::string &id : held_ids)
+        set.find(id); // throws naming an unknown id
+    for (const Experiment &e : set.experiments)
+        (held_set.count(e.id) ? D.held_out_experiments : D.calibration_experiments).push_back(e.id);
+    for (Eigen::Index k = 0; k < n; ++k) {
+        if (!std::isfinite(V.standardised[k]))
+            continue;
+        (held_set.count(meas.keys[std::size_t(k)].experiment) ? D.held_out : D.calibration)
+            .push_back(k);
+    }
+    D.held_out_base = scoreHeldOut(meas.value, V.simulated, u2_val, D.held_out);
+
+    // The null model: the base plus a discrepancy fitted on the calibration features.
+    std::vector<bool> in_calibration(std::size_t(n), false);
+    for (Eigen::Index k : D.calibration)
+        in_calibration[std::size_t(k)] = true;
+    const std::vector<RegimePoint> points = regimePoints(set, design, in_calibration);
+    Eigen::VectorXd null_mean = V.simulated, null_var = u2_val;
+    {
+        std::vector<RegimePoint> cal_points;
+        Eigen::VectorXd rho(Eigen::Index(D.calibration.size())), sd(rho.size());
+        for (std::size_t i = 0; i < D.calibration.size(); ++i) {
+            const Eigen::Index k = D.calibration[i];
+            cal_points.push_back(points[std::size_t(k)]);
+            rho[Eigen::Index(i)] = (meas.value[k] - V.simulated[k]) / V.simulated[k];
+            sd[Eigen::Index(i)] = V.u_val[k] / std::abs(V.simulated[k]);
+        }
+        const Discrepancy disc = Discrepancy::fit(cal_points, rho, sd);
+        std::vector<RegimePoint> held_points;
+        for (Eigen::Index k : D.held_out)
+            held_points.push_back(points[std::size_t(k)]);
+        const DiscrepancyPrediction p = disc.predict(held_points);
+        for (std::size_t i = 0; i < D.held_out.size(); ++i) {
+            const Eigen::Index k = D.held_out[i];
+            null_mean[k] = V.simulated[k] * (1.0 + p.mean[Eigen::Index(i)]);
+            null_var[k] = u2_val[k] + V.simulated[k] * V.simulated[k] * p.variance[Eigen::Index(i)];
+        }
+    }
+    D.held_out_null = scoreHeldOut(meas.value, null_mean, null_var, D.held_out);
+    const BlockCorrelation correlation(meas.keys, base_rows);
+    const double n_eff = correlation.effectiveCount(D.held_out);
+
+    if (!D.verdict.gap) {
+        D.outcome = Diagnosis::Outcome::NoGap;
+        D.claim = "no gap: every experiment agrees with the base model within its validation "
+                  "uncertainty (" + D.verdict.summary + ")";
+        return D;
+    }
+
+    // 2. Signatures of every applicable effect on the whole design.
+    const YAML::Node reference = simulator.referenceScenario();
+    struct Live {
+        CandidateResult result;
+        std::unique_ptr<TabulatedResponse> response;
+    };
+    std::vector<Live> live;
+    std::vector<VariantRequest> sig;
+    std::vector<std::pair<std::size_t, double>> sig_of; // (live index, strength)
+    for (const Effect *raw : effects) {
+        Live L;
+        L.result.name = raw->name;
+        L.result.applicability = inapplicable(*raw, reference);
+        if (L.result.applicability.empty()) {
+            try {
+                L.result.effect = resolveAgainst(*raw, reference);
+            } catch (const std::exception &e) {
+                L.result.applicability = e.what();
+            }
+        }
+        if (!L.result.applicability.empty()) {
+            L.result.effect = *raw;
+            live.push_back(std::move(L));
+            continue;
+        }
+        const Effect &e = L.result.effect;
+        const bool measurement = e.kind == Effect::Kind::Measurement;
+        std::vector<double> strengths;
+        if (measurement)
+            for (int i = 0; i < opt.measurement_grid; ++i)
+                strengths.push_back(e.prior.fromScale(
+                    e.prior.toScale(e.prior.lo) +
+                    (e.prior.toScale(e.prior.hi) - e.prior.toScale(e.prior.lo)) * i /
+                        (opt.measurement_grid - 1.0)));
+        else
+            strengths = e.signature;
+        for (double s : strengths) {
+            if (std::abs(s - e.prior.off) <= 1e-12 * (1.0 + std::abs(s)))
+                continue; // the base itself
+            sig.push_back({e.name + " " + fmt(s), raw, s, nullptr, 0.0, "",
+                           measurement ? opt.seeds : opt.signature_seeds});
+            sig_of.emplace_back(live.size(), s);
+        }
+        live.push_back(std::move(L));
+    }
+    log("signatures: " + std::to_string(sig.size()) + " variants");
+    const auto sig_rows = simulator.simulate(set, design, sig);
+    for (const auto &r : sig)
+        D.simulations += r.seeds;
+    for (std::size_t li = 0; li < live.size(); ++li) {
+        Live &L = live[li];
+        if (!L.result.applicability.empty())
+            continue;
+        const bool measurement = L.result.effect.kind == Effect::Kind::Measurement;
+        const int seeds = measurement ? opt.seeds : opt.signature_seeds;
+        std::vector<double> s{L.result.effect.prior.off};
+        // The base at the same seeds (common random numbers: a signature is a difference).
+        const auto off = meanAndVariance(firstRows(base_rows, seeds), V.seed_sd);
+        std::vector<Eigen::VectorXd> means{off.first}, vars{off.second};
+        for (std::size_t k = 0; k < sig.size(); ++k)
+            if (sig_of[k].first == li) {
+                const auto mv = meanAndVariance(sig_rows[k], V.seed_sd);
+                s.push_back(sig_of[k].second);
+                means.push_back(mv.first);
+                vars.push_back(mv.second);
+            }
+        if (s.size() < 2) {
+            L.result.applicability = "no strength to simulate apart from the base's own";
+            continue;
+        }
+        L.response = std::make_unique<TabulatedResponse>(L.result.effect.prior, s, means, vars);
+    }
+
+    // 3. Fit each effect's strength on the calibration experiments.
+    for (Live &L : live) {
+        if (!L.response)
+            continue;
+        L.result.fit = fitStrength(*L.response, L.result.effect.prior, meas.value, u2_fixed,
+                                   D.calibration, correlation);
+        L.result.calibration_gain = L.result.fit.chi2_off - L.result.fit.chi2;
+        const Eigen::VectorXd m = L.response->mean(L.result.fit.strength);
+        L.result.predicted = scoreHeldOut(
+            meas.value, m, u2_fixed + L.response->variance(L.result.fit.strength), D.held_out);
+    }
+    std::stable_sort(live.begin(), live.end(), [](const Live &a, const Live &b) {
+        if (bool(a.response) != bool(b.response))
+            return bool(a.response);
+        return a.result.fit.chi2 < b.result.fit.chi2;
+    });
+
+    // Signature overlap on the whole design, at each effect's fitted strength (or, where the
+    // calibration does not move it, its strongest simulated one).
+    std::vector<std::size_t> applicable;
+    for (std::size_t i = 0; i < live.size(); ++i)
+        if (live[i].response)
+            applicable.push_back(i);
+    FeatureSet all_features;
+    for (Eigen::Index k = 0; k < n; ++k)
+        if (std::isfinite(V.standardised[k]))
+            all_features.push_back(k);
+    const auto representative = [&](const Live &L) {
+        if (L.result.calibration_gain > 1.0)
+            return L.result.fit.strength;
+        const auto &st = L.response->strengths();
+        double best = st.front();
+        for (double s : st)
+            if (std::abs(L.result.effect.prior.toScale(s) - L.result.effect.prior.toScale(L.result.effect.prior.off)) >
+                std::abs(L.result.effect.prior.toScale(best) - L.result.effect.prior.toScale(L.result.effect.prior.off)))
+                best = s;
+        return best;
+    };
+    D.overlap.assign(applicable.size(), std::vector<double>(applicable.size(), 1.0));
+    for (std::size_t a = 0; a < applicable.size(); ++a)
+        for (std::size_t b = 0; b < applicable.size(); ++b)
+            if (a != b)
+                D.overlap[a][b] =
+                    signatureOverlap(*live[applicable[a]].response,
+                                     representative(live[applicable[a]]),
+                                     *live[applicable[b]].response,
+                                     live[applicable[b]].result.effect.prior, V.simulated, u2_val,
+                                     all_features, correlation)
+                        .fraction;
+
+    // 4. Confirm the leading candidates: re-simulate at the fitted strength, score held out.
+    const auto evaluateModel = [&](const Eigen::MatrixXd &rows, HeldOutScore &score,
+                                   double &p_value, GapVerdict &after, Eigen::VectorXd &mean) {
+        const auto mv = meanAndVariance(rows, V.seed_sd);
+        mean = mv.first;
+        const Eigen::VectorXd var = u2_fixed + mv.second;
+        score = scoreHeldOut(meas.value, mean, var, D.held_out);
+        const DensityComparison c =
+            compareDensities(meas.value, mean, var, null_mean, null_var, D.held_out, n_eff);
+        p_value = c.p_value;
+        Eigen::VectorXd e = (meas.value - mean).array() / var.array().sqrt();
+        for (Eigen::Index k = 0; k < e.size(); ++k)
+            e[k] = normalEquivalent(e[k], V.dof[k]);
+        after = testGap(meas.keys, e, opt.alpha, opt.flag_at);
+        return c.mean_gain > 0.0;
+    };
+    std::vector<std::size_t> to_confirm;
+    if (!applicable.empty()) {
+        const Live &leader = live[applicable.front()];
+        // Within 4 (2 sigma) of the leader's chi^2, widened as its interval is: a tie.
+        const double tie = leader.result.fit.chi2 + 4.0 * leader.result.fit.birge;
+        for (std::size_t i : applicable)
+            if (int(to_confirm.size()) < opt.max_confirmed && live[i].result.calibration_gain > 0.0 &&
+                (to_confirm.empty() || live[i].result.fit.chi2 <= tie))
+                to_confirm.push_back(i);
+    }
+    std::vector<VariantRequest> confirm;
+    for (std::size_t i : to_confirm) {
+        const Effect *raw = nullptr;
+        for (const Effect *e : effects)
+            if (e->name == live[i].result.name)
+                raw = e;
+        confirm.push_back({"confirm " + live[i].result.name, raw, live[i].result.fit.strength,
+                           nullptr, 0.0, "", opt.seeds});
+    }
+    log("confirming " + std::to_string(confirm.size()) + " candidates");
+    const auto confirm_rows = simulator.simulate(set, design, confirm);
+    for (const auto &r : confirm)
+        D.simulations += r.seeds;
+    // The signature is a coarse table: add each confirming run to it, refit, and where the
+    // best strength moved, confirm once more there.
+    std::vector<Eigen::MatrixXd> final_rows = confirm_rows;
+    {
+        std::vector<VariantRequest> again;
+        std::vector<std::size_t> again_of;
+        for (std::size_t c = 0; c < to_confirm.size(); ++c) {
+            Live &L = live[to_confirm[c]];
+            const auto mv = meanAndVariance(confirm_rows[c], V.seed_sd);
+            L.response->add(L.result.fit.strength, mv.first, mv.second);
+            const StrengthFit refit = fitStrength(*L.response, L.result.effect.prior, meas.value,
+                                                  u2_fixed, D.calibration, correlation);
+            const Prior &p = L.result.effect.prior;
+            const double span = p.toScale(p.hi) - p.toScale(p.lo);
+            if (std::abs(p.toScale(refit.strength) - p.toScale(L.result.fit.strength)) > 0.01 * span) {
+                L.result.fit = refit;
+                L.result.calibration_gain = refit.chi2_off - refit.chi2;
+                again.push_back(confirm[c]);
+                again.back().strength = refit.strength;
+                again_of.push_back(c);
+            }
+        }
+        const auto again_rows = simulator.simulate(set, design, again);
+        for (std::size_t i = 0; i < again.size(); ++i) {
+            D.simulations += again[i].seeds;
+            final_rows[again_of[i]] = again_rows[i];
+        }
+    }
+    const double level = opt.alpha / std::max<std::size_t>(1, confirm.size());
+    for (std::size_t c = 0; c < to_confirm.size(); ++c) {
+        CandidateResult &R = live[to_confirm[c]].result;
+        R.confirmed = true;
+        const bool better = evaluateModel(final_rows[c], R.held_out, R.p_value, R.after,
+                                          R.confirmed_mean);
+        R.beats_null = better && R.p_value < level && !D.held_out.empty();
+        R.explains = R.beats_null && !R.after.gap;
+    }
+    for (Live &L : live)
+        D.candidates.push_back(L.result);
+
+    const CandidateResult *winner = nullptr;
+    for (const CandidateResult &R : D.candidates)
+        if (R.explains && (!winner || R.held_out.log_density > winner->held_out.log_density))
+            winner = &R;
+
+    // Pairs, where no single effect explains the gap.
+    if (!winner) {
+        std::vector<std::size_t> pool;
+        for (std::size_t i : applicable)
+            if (int(pool.size()) < opt.pair_pool && live[i].result.calibration_gain > 0.0)
+                pool.push_back(i);
+        std::vector<PairResult> pairs;
+        for (std::size_t a = 0; a < pool.size(); ++a)
+            for (std::size_t b = a + 1; b < pool.size(); ++b) {
+                const Live &A = live[pool[a]], &B = live[pool[b]];
+                PairResult P;
+                P.a = A.result.name;
+                P.b = B.result.name;
+                const auto off = meanAndVariance(firstRows(base_rows, opt.signature_seeds), V.seed_sd);
+                P.fit = fitPair(*A.response, A.result.effect.prior, *B.response,
+                                B.result.effect.prior, off.first, off.second, meas.value,
+                                u2_fixed, D.calibration, correlation);
+                pairs.push_back(P);
+            }
+        std::sort(pairs.begin(), pairs.end(),
+                  [](const PairResult &x, const PairResult &y) { return x.fit.chi2 < y.fit.chi2; });
+        const std::size_t confirm_pairs = std::min<std::size_t>(2, pairs.size());
+        std::vector<VariantRequest> pr;
+        for (std::size_t i = 0; i < confirm_pairs; ++i) {
+            const Effect *ea = nullptr, *eb = nullptr;
+            for (const Effect *e : effects) {
+                if (e->name == pairs[i].a)
+                    ea = e;
+                if (e->name == pairs[i].b)
+                    eb = e;
+            }
+            pr.push_back({"confirm " + pairs[i].a + " + " + pairs[i].b, ea, pairs[i].fit.a.strength,
+                          eb, pairs[i].fit.b.strength, "", opt.seeds});
+        }
+        if (!pr.empty())
+            log("no single effect explains the gap: confirming " + std::to_string(pr.size()) + " pairs");
+        const auto pair_rows = simulator.simulate(set, design, pr);
+        for (const auto &r : pr)
+            D.simulations += r.seeds;
+        const double pair_level = opt.alpha / std::max<std::size_t>(1, confirm.size() + pr.size());
+        for (std::size_t i = 0; i < confirm_pairs; ++i) {
+            PairResult &P = pairs[i];
+            P.confirmed = true;
+            const bool better = evaluateModel(pair_rows[i], P.held_out, P.p_value, P.after,
+                                              P.confirmed_mean);
+            P.explains = better && P.p_value < pair_level && !P.after.gap && !D.held_out.empty();
+        }
+        D.pairs = pairs;
+    }
+
+    // The verdict.
+    const auto reduction = [&](const HeldOutScore &after) {
+        return D.held_out_base.gap > 0.0 ? 100.0 * (1.0 - after.gap / D.held_out_base.gap) : 0.0;
+    };
+    std::ostringstream claim;
+    if (winner) {
+        D.outcome = Diagnosis::Outcome::Explained;
+        const Effect &e = winner->effect;
+        claim << "explained by " << e.name << " (" << e.description << "): "
+              << strengthText(e, winner->fit.strength) << " [" << fmt(winner->fit.lo) << ", "
+              << fmt(winner->fit.hi) << "] (base " << fmt(e.prior.off) << "); held-out gap "
+              << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
+              << fmt(100.0 * winner->held_out.gap, 2) << " % (" << fmt(reduction(winner->held_out), 2)
+              << " % smaller; null model " << fmt(100.0 * D.held_out_null.gap, 2)
+              << " %, p = " << fmt(winner->p_value, 2) << ")";
+        for (const CandidateResult &R : D.candidates)
+            if (&R != winner && R.explains)
+                D.indistinguishable.push_back(R.name);
+    } else {
+        const PairResult *pair = nullptr;
+        for (const PairResult &P : D.pairs)
+            if (P.explains && (!pair || P.held_out.log_density > pair->held_out.log_density))
+                pair = &P;
+        if (pair) {
+            D.outcome = Diagnosis::Outcome::ExplainedByPair;
+            claim << "explained by " << pair->a << " + " << pair->b << ": " << pair->a << " "
+                  << fmt(pair->fit.a.strength) << ", " << pair->b << " " << fmt(pair->fit.b.strength)
+                  << "; held-out gap " << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
+                  << fmt(100.0 * pair->held_out.gap, 2) << " % (p = " << fmt(pair->p_value, 2) << ")";
+        } else {
+            D.outcome = Diagnosis::Outcome::Unexplained;
+            claim << "unexplained: no catalogued effect, alone or in a pair, predicts the held-out "
+                     "experiments better than the null model and leaves no gap";
+            const CandidateResult *best = nullptr;
+            for (const CandidateResult &R : D.candidates)
+                if (R.confirmed && (!best || R.held_out.gap < best->held_out.gap))
+                    best = &R;
+            if (best)
+                claim << "; closest: " << best->name << " at " << strengthText(best->effect, best->fit.strength)
+                      << " (held-out gap " << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
+                      << fmt(100.0 * best->held_out.gap, 2) << " %, " << best->after.flagged
+                      << " features still beyond " << fmt(opt.flag_at, 2) << " u_val, p = "
+                      << fmt(best->p_value, 2) << ")";
+        }
+    }
+    D.claim = claim.str();
+
+    // What remains after the chosen (or closest) model, in words.
+    {
+        const Eigen::VectorXd *mean = nullptr;
+        if (winner)
+            mean = &winner->confirmed_mean;
+        for (const PairResult &P : D.pairs)
+            if (!mean && P.explains)
+                mean = &P.confirmed_mean;
+        if (!mean)
+            for (const CandidateResult &R : D.candidates)
+                if (!mean && R.confirmed)
+                    mean = &R.confirmed_mean;
+        if (mean) {
+            ValidationResult after = V;
+            after.simulated = *mean;
+            after.residual = meas.value - *mean;
+            after.standardised = after.residual.array() / V.u_val.array();
+            for (Eigen::Index k = 0; k < n; ++k)
+                after.z[k] = normalEquivalent(after.standardised[k], V.dof[k]);
+            after.ratio = mean->array() / meas.value.array();
+            std::ostringstream rest;
+            for (const RegimeFinding &f :
+                 localise(meas.keys, after, {}, axisLabels(set), opt.flag_at))
+                if (f.sign != 0)
+                    rest << (rest.tellp() > 0 ? "; " : "") << f.text;
+            D.unexplained = rest.str();
+        }
+    }
+
+    // 5. Effects the design cannot tell apart from the leader: the experiment that would.
+    if (!winner && !applicable.empty()) {
+        // Without an explanation, the leader's near twins (signature overlap >= 0.8 both ways)
+        // are what the design cannot separate.
+        for (std::size_t b = 1; b < applicable.size(); ++b)
+            if (D.overlap[0][b] >= 0.8 && D.overlap[b][0] >= 0.8)
+                D.indistinguishable.push_back(live[applicable[b]].result.name);
+    }
+    if (!D.indistinguishable.empty()) {
+        const std::string leader = winner ? winner->name : live[applicable.front()].result.name;
+        double best_sep = -1.0;
+        for (const ExperimentSet &probe : simulator.probes(set)) {
+            const FeatureDesign pd = designFeatures(probe);
+            std::vector<VariantRequest> req{{"probe base", nullptr, 0.0, nullptr, 0.0, "", opt.signature_seeds}};
+            std::vector<std::string> names{leader};
+            for (const auto &o : D.indistinguishable)
+                names.push_back(o);
+            for (const std::string &name : names)
+                for (std::size_t i : applicable)
+                    if (live[i].result.name == name) {
+                        const Effect *raw = nullptr;
+                        for (const Effect *e : effects)
+                            if (e->name == name)
+                                raw = e;
+                        req.push_back({"probe " + name, raw, live[i].result.fit.strength, nullptr,
+                                       0.0, "", opt.signature_seeds});
+                    }
+            const auto rows = simulator.simulate(probe, pd, req);
+            for (const auto &r : req)
+                D.simulations += r.seeds;
+            double sep = 0.0;
+            const auto base = meanAndVariance(rows[0], columnStats(rows[0]).sd);
+            for (std::size_t a = 1; a < rows.size(); ++a)
+                for (std::size_t b = a + 1; b < rows.size(); ++b) {
+                    const auto ma = meanAndVariance(rows[a], columnStats(rows[0]).sd);
+                    const auto mb = meanAndVariance(rows[b], columnStats(rows[0]).sd);
+                    for (Eigen::Index k = 0; k < ma.first.size(); ++k) {
+                        const double d = ma.first[k] - mb.first[k];
+                        const double v = ma.second[k] + mb.second[k] + base.second[k];
+                        if (std::isfinite(d) && v > 0.0)
+                            sep += d * d / v;
+                    }
+                }
+            if (sep > best_sep) {
+                best_sep = sep;
+                D.separating_experiment = probe.name;
+            }
+        }
+    }
+    log(D.claim);
+    return D;
+}
+
+} // namespace grainlink::gap
