@@ -1,0 +1,335 @@
+#include "grainlink/gap/Importers.hpp"
+
+#include "grainlink/gap/Experiments.hpp"
+
+#include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <regex>
+#include <sstream>
+#include <stdexcept>
+
+namespace grainlink::gap {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+/// The CSV's header and rows (comment lines dropped).
+struct Csv {
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+};
+
+std::vector<std::string> split(const std::string &line) {
+    std::vector<std::string> cells;
+    std::string cell;
+    std::istringstream in(line);
+    while (std::getline(in, cell, ','))
+        cells.push_back(cell);
+    return cells;
+}
+
+Csv readCsv(const fs::path &path) {
+    std::ifstream in(path);
+    if (!in)
+        throw std::runtime_error(path.string() + ": cannot read");
+    Csv c;
+    std::string line;
+    while (std::getline(in, line)) {
+        if (!line.empty() && line.back() == '\r')
+            line.pop_back();
+        if (line.empty() || line[0] == '#')
+            continue;
+        if (c.header.empty())
+            c.header = split(line);
+        else
+            c.rows.push_back(split(line));
+    }
+    if (c.header.empty())
+        throw std::runtime_error(path.string() + ": no header line");
+    return c;
+}
+
+std::size_t column(const Csv &c, const std::string &name, const fs::path &path) {
+    const auto it = std::find(c.header.begin(), c.header.end(), name);
+    if (it == c.header.end())
+        throw std::runtime_error(path.string() + ": no column '" + name + "'");
+    return std::size_t(it - c.header.begin());
+}
+
+/// Writes the named columns of `c` to `path` (a copy of just what the folder uses).
+void writeColumns(const Csv &c, const std::vector<std::string> &names, const fs::path &source,
+                  const fs::path &path, const std::string &comment) {
+    std::vector<std::size_t> cols;
+    for (const auto &n : names)
+        cols.push_back(column(c, n, source));
+    std::ofstream out(path);
+    out << "# " << comment << "\n# copied from " << source.string() << "\n";
+    for (std::size_t i = 0; i < names.size(); ++i)
+        out << (i ? "," : "") << names[i];
+    out << '\n';
+    for (const auto &row : c.rows) {
+        for (std::size_t i = 0; i < cols.size(); ++i)
+            out << (i ? "," : "") << (cols[i] < row.size() ? row[cols[i]] : "");
+        out << '\n';
+    }
+    if (!out)
+        throw std::runtime_error(path.string() + ": cannot write");
+}
+
+YAML::Node loadOrNew(const fs::path &file, const std::string &name) {
+    if (fs::exists(file))
+        return YAML::LoadFile(file.string());
+    YAML::Node root;
+    root["name"] = name;
+    root["experiments"] = YAML::Node(YAML::NodeType::Sequence);
+    return root;
+}
+
+void save(const YAML::Node &root, const fs::path &file, const std::string &header) {
+    YAML::Emitter e;
+    e << root;
+    const fs::path tmp = file.string() + ".tmp";
+    {
+        std::ofstream out(tmp);
+        out << header << e.c_str() << '\n';
+        if (!out)
+            throw std::runtime_error(tmp.string() + ": cannot write");
+    }
+    fs::rename(tmp, file);
+}
+
+YAML::Node flow(YAML::Node n) {
+    n.SetStyle(YAML::EmitterStyle::Flow);
+    return n;
+}
+
+} // namespace
+
+std::vector<std::string> importCmu(const std::string &cmu_directory, const std::string &out,
+                                   const CmuImportOptions &options) {
+    const fs::path src(cmu_directory), dst(out);
+    if (!fs::is_directory(src / "plates") && !fs::is_directory(src / "steady_state_wheel"))
+        throw std::runtime_error(cmu_directory + ": not the CMU 3d-terramechanics folder (no "
+                                                 "plates/ or steady_state_wheel/)");
+    const std::map<std::string, std::string> sinkage_columns{
+        {"synced", "sinkage_synced_m"},
+        {"authors", "sinkage_m"},
+        {"deflection_corrected", "sinkage_synced_deflcorr_m"}};
+    if (!sinkage_columns.count(options.sinkage))
+        throw std::invalid_argument("sinkage column '" + options.sinkage +
+                                    "': use synced, authors or deflection_corrected");
+    fs::create_directories(dst / "data");
+    YAML::Node root;
+    root["name"] = "cmu-3d-terramechanics";
+    YAML::Node list(YAML::NodeType::Sequence);
+    std::vector<std::string> ids;
+
+    if (options.plates && fs::is_directory(src / "plates")) {
+        // plate_<box>_d<DDD>mm_force-displacement_<N>.csv: one experiment per box and size.
+        const std::regex name(R"(plate_(large|small)_d(\d{3})mm_force-displacement_(\d+)\.csv)");
+        std::map<std::pair<std::string, int>, std::vector<fs::path>> groups;
+        for (const auto &entry : fs::directory_iterator(src / "plates")) {
+            std::smatch m;
+            const std::string f = entry.path().filename().string();
+            if (std::regex_match(f, m, name))
+                groups[{m[1], std::stoi(m[2])}].push_back(entry.path());
+        }
+        const std::string zcol = sinkage_columns.at(options.sinkage);
+        for (auto &[key, files] : groups) {
+            std::sort(files.begin(), files.end());
+            const std::string id = key.first + "_d" + (key.second < 100 ? "0" : "") +
+                                   std::to_string(key.second);
+            YAML::Node e;
+            e["id"] = id;
+            e["type"] = "plate_sinkage";
+            YAML::Node cond;
+            cond["plate_diameter_m"] = key.second / 1000.0;
+            cond["box"] = key.first;
+            // The carriage's median descent speed over the trials (quasi-static, not constant).
+            double speed = 0.0;
+            int speeds = 0;
+            YAML::Node copies(YAML::NodeType::Sequence);
+            for (const fs::path &f : files) {
+                const fs::path json = fs::path(f).replace_extension(".json");
+                if (fs::exists(json)) {
+                    std::ifstream in(json);
+                    const nlohmann::json j = nlohmann::json::parse(in);
+                    const auto &p = j["processing"];
+                    for (auto it = p.begin(); it != p.end(); ++it)
+                        if (it.key().rfind("descent_speed_in_window_mm_per_s", 0) == 0 &&
+                            it->is_array() && it->size() == 3) {
+                            speed += (*it)[1].get<double>() / 1000.0;
+                            ++speeds;
+                        }
+                }
+                const std::string copy = "data/" + f.filename().string();
+                writeColumns(readCsv(f), {zcol, "pressure_synced_kPa", "force_N"}, f, dst / copy,
+                             "CMU 3d-terramechanics plate test (MIT licence, (c) 2022 Catherine "
+                             "Pavlov, CMU), box " + key.first + ", plate " +
+                                 std::to_string(key.second) + " mm");
+                copies.push_back(copy);
+            }
+            if (speeds > 0)
+                cond["speed_m_s"] = speed / speeds;
+            e["conditions"] = flow(cond);
+            YAML::Node data;
+            data["files"] = flow(copies);
+            YAML::Node x;
+            x["column"] = zcol;
+            x["unit"] = "m";
+            data["x"] = flow(x);
+            YAML::Node y, p;
+            p["column"] = "pressure_synced_kPa";
+            p["unit"] = "kPa";
+            y["pressure_Pa"] = flow(p);
+            data["y"] = y;
+            e["data"] = data;
+            YAML::Node zero;
+            zero["method"] = "as_recorded"; // the authors' hand-picked first contact
+            e["zero"] = flow(zero);
+            // Data README section 6: the zero is good to about 0.5 mm; the force zeros are
+            // stale by up to about 2 N of 100-350 N.
+            YAML::Node u;
+            u["x_zero_sigma"] = 0.0005;
+            u["x_unit"] = "m";
+            u["y_relative"] = 0.01;
+            u["repeats"] = "rebuilt_bed";
+            e["uncertainty"] = flow(u);
+            list.push_back(e);
+            ids.push_back(id);
+        }
+    }
+
+    if (options.wheels && fs::is_directory(src / "steady_state_wheel")) {
+        for (const std::string wheel : {"smooth", "grouser"}) {
+            const fs::path f = src / "steady_state_wheel" / (wheel + ".csv");
+            if (!fs::exists(f))
+                continue;
+            const Csv c = readCsv(f);
+            const std::size_t beta_col = column(c, "beta_deg", f);
+            std::vector<int> betas;
+            for (const auto &row : c.rows)
+                betas.push_back(std::stoi(row[beta_col]));
+            std::sort(betas.begin(), betas.end());
+            betas.erase(std::unique(betas.begin(), betas.end()), betas.end());
+            const std::string copy = "data/wheel_" + wheel + ".csv";
+            writeColumns(c, {"beta_deg", "slip", "F_tractive_N", "F_side_N", "F_load_N", "Z_mm"}, f,
+                         dst / copy,
+                         "CMU 3d-terramechanics steady-state wheel tests (MIT licence, (c) 2022 "
+                         "Catherine Pavlov, CMU), " + wheel + " wheel; Z_mm with the authors' "
+                         "31.5 mm offset convention");
+            for (int beta : betas) {
+                const std::string id = wheel + "_beta" + std::to_string(beta);
+                YAML::Node e;
+                e["id"] = id;
+                e["type"] = "wheel_steady_state";
+                YAML::Node cond;
+                cond["wheel"] = wheel;
+                cond["wheel_radius_m"] = 0.058; // to the grouser base
+                cond["wheel_width_m"] = 0.05;
+                cond["grouser_height_m"] = wheel == "grouser" ? 0.005 : 0.0;
+                cond["slip_angle_deg"] = double(beta);
+                cond["carriage_speed_m_s"] = 0.01;
+                e["conditions"] = flow(cond);
+                YAML::Node data;
+                data["files"] = flow(YAML::Node(std::vector<std::string>{copy}));
+                data["scatter"] = true;
+                YAML::Node filter;
+                filter["beta_deg"] = beta;
+                data["filter"] = flow(filter);
+                YAML::Node x;
+                x["column"] = "slip";
+                x["unit"] = "-";
+                data["x"] = flow(x);
+                YAML::Node y;
+                const auto obs = [&](const char *o, const char *col, const char *unit) {
+                    YAML::Node n;
+                    n["column"] = col;
+                    n["unit"] = unit;
+                    y[o] = flow(n);
+                };
+                obs("traction_N", "F_tractive_N", "N");
+                obs("side_force_N", "F_side_N", "N");
+                obs("vertical_load_N", "F_load_N", "N");
+                obs("sinkage_m", "Z_mm", "mm");
+                data["y"] = y;
+                e["data"] = data;
+                list.push_back(e);
+                ids.push_back(id);
+            }
+        }
+    }
+    if (ids.empty())
+        throw std::runtime_error(cmu_directory + ": no plate or wheel tests found");
+    root["experiments"] = list;
+    save(root, dst / "experiments.yaml",
+         "# Written by `grainlink gap import cmu " + cmu_directory +
+             "` (docs/gap.md).\n# Source: https://github.com/robomechanics/3d-terramechanics, "
+             "MIT licence, (c) 2022 Catherine Pavlov, Carnegie Mellon University.\n");
+    loadExperiments(out); // what was written reads back (strictly)
+    return ids;
+}
+
+void importCsv(const CsvImport &csv, const std::string &out) {
+    const fs::path dst(out), src(csv.file);
+    parseType(csv.type);
+    const Csv c = readCsv(src);
+    fs::create_directories(dst / "data");
+    std::vector<std::string> columns;
+    if (!csv.x_column.empty())
+        columns.push_back(csv.x_column);
+    for (const auto &[obs, col] : csv.y)
+        columns.push_back(col.first);
+    const std::string copy = "data/" + csv.id + ".csv";
+    writeColumns(c, columns, src, dst / copy, "imported by grainlink gap import csv");
+    YAML::Node root = loadOrNew(dst / "experiments.yaml", dst.filename().string());
+    for (const auto &e : root["experiments"])
+        if (e["id"].as<std::string>() == csv.id)
+            throw std::invalid_argument("experiment id '" + csv.id + "' is already in " +
+                                        (dst / "experiments.yaml").string());
+    YAML::Node e;
+    e["id"] = csv.id;
+    e["type"] = csv.type;
+    if (!csv.conditions.empty()) {
+        YAML::Node cond;
+        for (const auto &[k, v] : csv.conditions) {
+            char *end = nullptr;
+            const double d = std::strtod(v.c_str(), &end);
+            if (!v.empty() && end == v.c_str() + v.size())
+                cond[k] = d;
+            else
+                cond[k] = v;
+        }
+        e["conditions"] = flow(cond);
+    }
+    YAML::Node data;
+    data["files"] = flow(YAML::Node(std::vector<std::string>{copy}));
+    if (csv.scatter)
+        data["scatter"] = true;
+    if (!csv.x_column.empty()) {
+        YAML::Node x;
+        x["column"] = csv.x_column;
+        x["unit"] = csv.x_unit;
+        data["x"] = flow(x);
+    }
+    YAML::Node y;
+    for (const auto &[obs, col] : csv.y) {
+        YAML::Node n;
+        n["column"] = col.first;
+        n["unit"] = col.second;
+        y[obs] = flow(n);
+    }
+    data["y"] = y;
+    e["data"] = data;
+    root["experiments"].push_back(e);
+    save(root, dst / "experiments.yaml", "# Measurements for grainlink gap (docs/gap.md).\n");
+    loadExperiments(out);
+}
+
+} // namespace grainlink::gap
