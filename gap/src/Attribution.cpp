@@ -327,7 +327,8 @@ Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const
 }
 
 HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd &predicted,
-                          const Eigen::VectorXd &variance, const FeatureSet &use) {
+                          const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_val,
+                          const FeatureSet &use) {
     HeldOutScore s;
     double se = 0.0, rel = 0.0, excess = 0.0;
     for (Eigen::Index k : use) {
@@ -337,7 +338,7 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
         ++s.features;
         se += r * r / v;
         rel += (r / y) * (r / y);
-        excess += (r * r - v) / (y * y);
+        excess += (r * r - u2_val[k]) / (y * y);
         s.log_density += -0.5 * (r * r / v + std::log(2.0 * M_PI * v));
     }
     if (s.features == 0)

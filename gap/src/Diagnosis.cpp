@@ -138,7 +138,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         (held_set.count(meas.keys[std::size_t(k)].experiment) ? D.held_out : D.calibration)
             .push_back(k);
     }
-    D.held_out_base = scoreHeldOut(meas.value, V.simulated, u2_val, D.held_out);
+    D.held_out_base = scoreHeldOut(meas.value, V.simulated, u2_val, u2_val, D.held_out);
 
     // The null model: the base plus a discrepancy fitted on the calibration features.
     std::vector<bool> in_calibration(std::size_t(n), false);
@@ -166,7 +166,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             null_var[k] = u2_val[k] + V.simulated[k] * V.simulated[k] * p.variance[Eigen::Index(i)];
         }
     }
-    D.held_out_null = scoreHeldOut(meas.value, null_mean, null_var, D.held_out);
+    D.held_out_null = scoreHeldOut(meas.value, null_mean, null_var, u2_val, D.held_out);
+    D.null_mean = null_mean;
+    D.null_variance = null_var;
     const BlockCorrelation correlation(meas.keys, base_rows);
     const double n_eff = correlation.effectiveCount(D.held_out);
 
@@ -248,6 +250,16 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             continue;
         }
         L.response = std::make_unique<TabulatedResponse>(L.result.effect.prior, s, means, vars);
+        // How far its strongest simulated change moves the design, in chi^2 units.
+        for (std::size_t i = 1; i < means.size(); ++i) {
+            const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+            FeatureSet every;
+            for (Eigen::Index k = 0; k < n; ++k)
+                if (std::isfinite(V.standardised[k]))
+                    every.push_back(k);
+            L.result.signature_chi2 = std::max(
+                L.result.signature_chi2, chiSquare(means[i], off.first, zero, u2_val, every));
+        }
     }
 
     // 3. Fit each effect's strength on the calibration experiments.
@@ -258,8 +270,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                                    D.calibration, correlation);
         L.result.calibration_gain = L.result.fit.chi2_off - L.result.fit.chi2;
         const Eigen::VectorXd m = L.response->mean(L.result.fit.strength);
-        L.result.predicted = scoreHeldOut(
-            meas.value, m, u2_fixed + L.response->variance(L.result.fit.strength), D.held_out);
+        L.result.predicted = scoreHeldOut(meas.value, m,
+                                          u2_fixed + L.response->variance(L.result.fit.strength),
+                                          u2_val, D.held_out);
     }
     std::stable_sort(live.begin(), live.end(), [](const Live &a, const Live &b) {
         if (bool(a.response) != bool(b.response))
@@ -306,7 +319,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const auto mv = meanAndVariance(rows, V.seed_sd);
         mean = mv.first;
         const Eigen::VectorXd var = u2_fixed + mv.second;
-        score = scoreHeldOut(meas.value, mean, var, D.held_out);
+        score = scoreHeldOut(meas.value, mean, var, u2_val, D.held_out);
         const DensityComparison c =
             compareDensities(meas.value, mean, var, null_mean, null_var, D.held_out, n_eff);
         p_value = c.p_value;

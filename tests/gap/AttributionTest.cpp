@@ -112,10 +112,12 @@ TEST_CASE("signature overlap: proportional signatures overlap fully, orthogonal 
 TEST_CASE("held-out scores: a perfect model has no gap; a 10 % error is a 10 % relative rmse",
           "[gap][attribution]") {
     const Eigen::VectorXd y = Eigen::VectorXd::Constant(4, 100.0);
-    const auto perfect = scoreHeldOut(y, y, Eigen::VectorXd::Constant(4, 4.0), all(4));
+    const auto perfect = scoreHeldOut(y, y, Eigen::VectorXd::Constant(4, 4.0),
+                                      Eigen::VectorXd::Constant(4, 4.0), all(4));
     CHECK(perfect.gap == 0.0);
     CHECK(perfect.smse == 0.0);
-    const auto off = scoreHeldOut(y, y * 0.9, Eigen::VectorXd::Constant(4, 1e-6), all(4));
+    const auto off = scoreHeldOut(y, y * 0.9, Eigen::VectorXd::Constant(4, 1e-6),
+                                  Eigen::VectorXd::Constant(4, 1e-6), all(4));
     CHECK(off.relative_rmse == Approx(0.1));
     CHECK(off.gap == Approx(0.1).epsilon(1e-6));
 }

@@ -2,11 +2,15 @@
 // hidden effect with its strength, claim nothing where there is no gap, and call an effect
 // outside the catalogue unexplained. The reference is the planted truth, not the code.
 #include "grainlink/gap/Diagnosis.hpp"
+#include "grainlink/gap/Report.hpp"
 
 #include <catch2/catch.hpp>
 
 #include <cmath>
 #include <random>
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
 
 using namespace grainlink::gap;
 
@@ -201,4 +205,35 @@ TEST_CASE("diagnosis on an analytic soil: the null model interpolates between ca
     CHECK(beyond.held_out_null.gap > 0.4 * beyond.held_out_base.gap);
     INFO(beyond.claim);
     CHECK(beyond.outcome == Diagnosis::Outcome::Explained);
+}
+
+TEST_CASE("the diagnosis writes diagnosis.json, features.csv, report.txt and a self-contained "
+          "report.html",
+          "[gap][diagnosis][report]") {
+    const Diagnosis d = run({"cohesion", 4.0e4});
+    const ExperimentSet set = measuredSet({"cohesion", 4.0e4}, 7);
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("grainlink-gap-report-" + std::to_string(::getpid()));
+    std::filesystem::remove_all(dir);
+    const auto files =
+        writeDiagnosis(d, set, dir.string(), GRAINLINK_SOURCE_DIR "/tools/gap_report.py");
+    std::ifstream in(dir / "diagnosis.json");
+    const nlohmann::json j = nlohmann::json::parse(in);
+    CHECK(j["outcome"] == "explained");
+    CHECK(j["claim"].get<std::string>().find("cohesion") != std::string::npos);
+    CHECK(j["candidates"].size() == d.candidates.size());
+    std::ifstream features(dir / "features.csv");
+    std::string line;
+    int lines = 0;
+    while (std::getline(features, line))
+        ++lines;
+    CHECK(lines == int(d.design.size()) + 1);
+    if (std::find(files.begin(), files.end(), "report.html") != files.end()) {
+        std::ifstream page(dir / "report.html");
+        const std::string text((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
+        CHECK(text.find("data:image/png;base64,") != std::string::npos);
+        CHECK(text.find("explained") != std::string::npos);
+    } else {
+        WARN("report.html not made: /usr/bin/python3 with matplotlib missing");
+    }
 }

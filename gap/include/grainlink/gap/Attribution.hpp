@@ -153,16 +153,18 @@ Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const
                          const Eigen::VectorXd &base_mean, const Eigen::VectorXd &u2,
                          const FeatureSet &use, const BlockCorrelation &correlation = {});
 
-/// How well predictions match held-out features. `smse`: mean squared standardised error;
-/// `relative_rmse`: root mean square of (measured - predicted) / measured; `gap`: that
-/// relative error in excess of the validation uncertainty, sqrt(max(0, mean(r^2 - u^2))) in
-/// relative terms (0 when the model is as good as the data can tell).
+/// How well predictions match held-out features. `smse`: mean squared error standardised by
+/// the prediction's own variance; `relative_rmse`: root mean square of (measured - predicted)
+/// / measured; `gap`: that relative error in excess of the validation uncertainty `u2_val`
+/// (the same for every model compared), sqrt(max(0, mean((r^2 - u_val^2) / y^2))): 0 when the
+/// model is as good as the data can tell.
 struct HeldOutScore {
     double smse = 0.0, relative_rmse = 0.0, gap = 0.0, log_density = 0.0;
     int features = 0;
 };
 HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd &predicted,
-                          const Eigen::VectorXd &variance, const FeatureSet &use);
+                          const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_val,
+                          const FeatureSet &use);
 
 
 /// Sample-split test that a model predicts held-out features better than the null, by the log

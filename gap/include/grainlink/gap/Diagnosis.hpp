@@ -73,6 +73,8 @@ struct CandidateResult {
     std::string applicability; ///< empty: applicable; else why not
     Effect effect;             ///< resolved against the base
     StrengthFit fit;           ///< on the calibration features
+    double signature_chi2 = 0.0; ///< its largest simulated change of the design, in chi^2 (u_val);
+                                 ///< below about 1 the effect does not act on these experiments
     double calibration_gain = 0.0; ///< chi^2 with the effect off minus at its best strength
     HeldOutScore predicted;    ///< held-out score from the signature (before confirmation)
     bool confirmed = false;    ///< re-simulated at the fitted strength
@@ -105,6 +107,7 @@ struct Diagnosis {
     std::vector<std::string> calibration_experiments, held_out_experiments;
     HeldOutScore held_out_base;  ///< the base model on the held-out features
     HeldOutScore held_out_null;  ///< base + the fitted discrepancy
+    Eigen::VectorXd null_mean, null_variance; ///< the null model's prediction (held-out features)
     std::vector<CandidateResult> candidates; ///< ranked by calibration chi^2 (applicable first)
     std::vector<PairResult> pairs;
     /// Signature overlap on the whole design: overlap[i][j] = how much of candidate i's

@@ -1,0 +1,246 @@
+#include "grainlink/gap/Report.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+namespace grainlink::gap {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+
+namespace {
+
+Json number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+Json score(const HeldOutScore &s) {
+    return {{"features", s.features},
+            {"relative_rmse", number(s.relative_rmse)},
+            {"gap_beyond_uncertainty", number(s.gap)},
+            {"mean_squared_standardised_error", number(s.smse)},
+            {"log_predictive_density", number(s.log_density)}};
+}
+
+Json verdict(const GapVerdict &g) {
+    return {{"gap", g.gap},
+            {"flagged_features", g.flagged},
+            {"features", g.features},
+            {"largest_abs_z", number(g.max_abs)},
+            {"feature_bound", number(g.feature_bound)},
+            {"worst_experiment", g.worst_experiment},
+            {"worst_experiment_rms_z", number(g.worst_rms)},
+            {"experiment_bound", number(g.experiment_bound)},
+            {"summary", g.summary}};
+}
+
+Json strength(const Effect &e, const StrengthFit &f) {
+    return {{"parameter", e.parameter}, {"unit", e.unit},          {"value", number(f.strength)},
+            {"ci95", {number(f.lo), number(f.hi)}}, {"base_value", number(e.prior.off)},
+            {"prior", {e.prior.lo, e.prior.hi}}, {"at_prior_bound", f.at_bound}};
+}
+
+void writeAtomically(const fs::path &path, const std::string &text) {
+    const fs::path tmp = path.string() + ".tmp";
+    {
+        std::ofstream out(tmp);
+        out << text;
+        if (!out)
+            throw std::runtime_error(tmp.string() + ": cannot write");
+    }
+    fs::rename(tmp, path);
+}
+
+std::string pct(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.1f %%", 100.0 * v);
+    return b;
+}
+
+} // namespace
+
+Json toJson(const Diagnosis &d, const ExperimentSet &set) {
+    Json j;
+    j["format"] = "grainlink-gap-diagnosis";
+    j["version"] = 1;
+    j["measurements"] = set.name;
+    j["outcome"] = outcomeName(d.outcome);
+    j["claim"] = d.claim;
+    j["where"] = Json::array();
+    for (const RegimeFinding &f : d.findings)
+        j["where"].push_back({{"kind", f.kind},
+                              {"x_range", {f.x_lo, f.x_hi}},
+                              {"sign", f.sign},
+                              {"experiments", f.experiments},
+                              {"of", f.covering},
+                              {"ratio_simulated_over_measured", {number(f.ratio_min), number(f.ratio_max)}},
+                              {"text", f.text}});
+    j["gap_test"] = verdict(d.verdict);
+    j["calibration_experiments"] = d.calibration_experiments;
+    j["held_out_experiments"] = d.held_out_experiments;
+    j["held_out"] = {{"base", score(d.held_out_base)}, {"null", score(d.held_out_null)}};
+    j["candidates"] = Json::array();
+    for (const CandidateResult &c : d.candidates) {
+        Json cj{{"effect", c.name}, {"acts_on", c.effect.acts_on}, {"description", c.effect.description}};
+        if (!c.applicability.empty()) {
+            cj["applicable"] = false;
+            cj["why_not"] = c.applicability;
+        } else {
+            cj["applicable"] = true;
+            cj["signature_chi2"] = number(c.signature_chi2);
+            cj["acts_on_design"] = c.signature_chi2 >= 1.0;
+            cj["strength"] = strength(c.effect, c.fit);
+            cj["calibration_chi2"] = number(c.fit.chi2);
+            cj["calibration_chi2_gain"] = number(c.calibration_gain);
+            cj["confirmed"] = c.confirmed;
+            if (c.confirmed) {
+                cj["held_out"] = score(c.held_out);
+                cj["p_value_against_null"] = number(c.p_value);
+                cj["beats_null"] = c.beats_null;
+                cj["gap_test_with_effect"] = verdict(c.after);
+                cj["explains"] = c.explains;
+            }
+        }
+        j["candidates"].push_back(cj);
+    }
+    j["pairs"] = Json::array();
+    for (const PairResult &p : d.pairs) {
+        Json pj{{"effects", {p.a, p.b}},
+                {"strengths", {number(p.fit.a.strength), number(p.fit.b.strength)}},
+                {"calibration_chi2", number(p.fit.chi2)},
+                {"confirmed", p.confirmed}};
+        if (p.confirmed) {
+            pj["held_out"] = score(p.held_out);
+            pj["p_value_against_null"] = number(p.p_value);
+            pj["gap_test_with_effects"] = verdict(p.after);
+            pj["explains"] = p.explains;
+        }
+        j["pairs"].push_back(pj);
+    }
+    Json names = Json::array();
+    for (const CandidateResult &c : d.candidates)
+        if (c.applicability.empty())
+            names.push_back(c.name);
+    j["signature_overlap"] = {{"effects", names}, {"fraction", d.overlap}};
+    j["indistinguishable_from_leader"] = d.indistinguishable;
+    j["separating_experiment"] = d.separating_experiment;
+    j["unexplained"] = d.unexplained;
+    j["simulations"] = d.simulations;
+    return j;
+}
+
+std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
+    std::ostringstream r;
+    r << "grainlink gap diagnose: " << set.name << "\n\n";
+    r << "Result: " << d.claim << "\n\n";
+    r << "Numerical uncertainty and the gap test: " << d.verdict.summary << "\n";
+    r << "Where the gap lies:\n";
+    for (const RegimeFinding &f : d.findings)
+        r << "  - " << f.text << '\n';
+    r << "\nCalibration experiments: ";
+    for (const auto &e : d.calibration_experiments)
+        r << e << ' ';
+    r << "\nHeld-out experiments:    ";
+    for (const auto &e : d.held_out_experiments)
+        r << e << ' ';
+    r << "\nHeld-out gap beyond uncertainty: base " << pct(d.held_out_base.gap) << ", null model "
+      << pct(d.held_out_null.gap) << "\n\nCandidates (by calibration chi^2):\n";
+    for (const CandidateResult &c : d.candidates) {
+        r << "  " << c.name << ": ";
+        if (!c.applicability.empty()) {
+            r << "not applicable (" << c.applicability << ")\n";
+            continue;
+        }
+        if (c.signature_chi2 < 1.0) {
+            r << "no signature on these experiments (its strongest simulated change moves them by "
+              << "chi^2 " << c.signature_chi2 << ")\n";
+            continue;
+        }
+        r << c.effect.parameter << " = " << c.fit.strength << " [" << c.fit.lo << ", " << c.fit.hi
+          << "] " << c.effect.unit << ", chi^2 " << c.fit.chi2 << " (off: " << c.fit.chi2_off << ")";
+        if (c.confirmed)
+            r << "; confirmed: held-out gap " << pct(c.held_out.gap) << ", p = " << c.p_value
+              << (c.explains ? ", EXPLAINS" : c.beats_null ? ", beats the null but leaves a gap"
+                                                            : ", does not beat the null");
+        r << '\n';
+    }
+    if (!d.indistinguishable.empty()) {
+        r << "\nCannot be told apart from the leader on these experiments: ";
+        for (const auto &n : d.indistinguishable)
+            r << n << ' ';
+        r << '\n';
+        if (!d.separating_experiment.empty())
+            r << "The experiment that would separate them best: " << d.separating_experiment << '\n';
+    }
+    if (!d.unexplained.empty())
+        r << "\nWhat remains beyond 2 u_val with the best model: " << d.unexplained << '\n';
+    r << "\nSimulations: " << d.simulations << " (variant x seed runs asked for; cached runs reused)\n";
+    return r.str();
+}
+
+std::vector<std::string> writeDiagnosis(const Diagnosis &d, const ExperimentSet &set,
+                                        const std::string &directory,
+                                        const std::string &plot_tool) {
+    const fs::path dir(directory);
+    fs::create_directories(dir);
+    std::vector<std::string> files;
+    writeAtomically(dir / "diagnosis.json", toJson(d, set).dump(2) + "\n");
+    files.push_back("diagnosis.json");
+
+    // The best model's prediction, for the plots: the winner, the explaining pair, the closest.
+    const Eigen::VectorXd *best = nullptr;
+    std::string best_name;
+    for (const CandidateResult &c : d.candidates)
+        if (c.explains && !best)
+            best = &c.confirmed_mean, best_name = c.name;
+    for (const PairResult &p : d.pairs)
+        if (p.explains && !best)
+            best = &p.confirmed_mean, best_name = p.a + "+" + p.b;
+    for (const CandidateResult &c : d.candidates)
+        if (c.confirmed && !best)
+            best = &c.confirmed_mean, best_name = c.name;
+    std::ostringstream csv;
+    csv.precision(10);
+    csv << "experiment,observable,kind,x_lo,x_hi,held_out,measured,u_D,simulated,u_seed,u_bed,"
+           "u_num,u_val,dof,z,ratio,null_mean,null_sd,best_model,best_model_mean\n";
+    const std::set<Eigen::Index> held(d.held_out.begin(), d.held_out.end());
+    const auto &v = d.validation;
+    for (std::size_t i = 0; i < d.design.keys.size(); ++i) {
+        const Eigen::Index k = Eigen::Index(i);
+        const FeatureKey &key = d.design.keys[i];
+        const auto num = [](double x) {
+            std::ostringstream s;
+            s.precision(10);
+            if (std::isfinite(x))
+                s << x;
+            return s.str();
+        };
+        csv << key.experiment << ',' << key.observable << ',' << key.kind << ',' << key.x_lo << ','
+            << key.x_hi << ',' << (held.count(k) ? 1 : 0) << ',' << num(d.measured.value[k]) << ','
+            << num(v.u_D[k]) << ',' << num(v.simulated[k]) << ',' << num(v.u_seed[k]) << ','
+            << num(v.u_bed[k]) << ',' << num(v.u_num[k]) << ',' << num(v.u_val[k]) << ','
+            << num(v.dof[k]) << ',' << num(v.z[k]) << ',' << num(v.ratio[k]) << ','
+            << (held.count(k) && d.null_mean.size() ? num(d.null_mean[k]) : "") << ','
+            << (held.count(k) && d.null_variance.size() ? num(std::sqrt(d.null_variance[k])) : "")
+            << ',' << best_name << ',' << (best ? num((*best)[k]) : "") << '\n';
+    }
+    writeAtomically(dir / "features.csv", csv.str());
+    files.push_back("features.csv");
+    writeAtomically(dir / "report.txt", reportText(d, set));
+    files.push_back("report.txt");
+    if (!plot_tool.empty()) {
+        const std::string cmd = "/usr/bin/python3 '" + plot_tool + "' '" + dir.string() + "'";
+        if (std::system(cmd.c_str()) == 0 && fs::exists(dir / "report.html"))
+            files.push_back("report.html");
+        else
+            std::fprintf(stderr, "[gap] report.html not written (needs /usr/bin/python3 with "
+                                 "matplotlib: %s); diagnosis.json and report.txt are complete\n",
+                         cmd.c_str());
+    }
+    return files;
+}
+
+} // namespace grainlink::gap

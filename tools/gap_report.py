@@ -1,0 +1,181 @@
+#!/usr/bin/python3
+"""The sim-to-real diagnosis as one self-contained HTML page (docs/gap.md, "Outputs").
+
+Reads DIR/diagnosis.json and DIR/features.csv (written by `grainlink gap diagnose`) and writes
+DIR/report.html: the result in words, measured against simulated with their bands, the map of
+standardised residuals, the signature overlap of the candidate effects, and the held-out gap
+before and after. Every plot is embedded (base64 PNG), so the page travels alone.
+
+usage: /usr/bin/python3 tools/gap_report.py DIR
+"""
+import base64
+import csv
+import html
+import io
+import json
+import math
+import sys
+from collections import OrderedDict
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+
+def number(text):
+    try:
+        return float(text)
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def png(fig):
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110, bbox_inches="tight")
+    plt.close(fig)
+    return base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def axis_of(kind):
+    if kind.startswith("plate_sinkage"):
+        return "sinkage [mm]", 1000.0
+    if "shear" in kind:
+        return "shear displacement [mm]", 1000.0
+    if kind.startswith("wheel"):
+        return "slip [-]", 1.0
+    return "", 1.0
+
+
+def curves_plot(rows, diag):
+    """One panel per experiment and observable: measured +- 2 u_D, simulated +- 2 u_val, the
+    best model and (held out) the null model."""
+    panels = OrderedDict()
+    for r in rows:
+        panels.setdefault((r["experiment"], r["observable"]), []).append(r)
+    n = len(panels)
+    if n == 0:
+        return None
+    cols = min(3, n)
+    nrows = math.ceil(n / cols)
+    fig, axes = plt.subplots(nrows, cols, figsize=(4.2 * cols, 3.2 * nrows), squeeze=False)
+    held = set(diag.get("held_out_experiments", []))
+    for ax, ((exp, obs), rs) in zip(axes.flat, panels.items()):
+        label, scale = axis_of(rs[0]["kind"])
+        x = [0.5 * (number(r["x_lo"]) + number(r["x_hi"])) * scale for r in rs]
+        if all(number(r["x_lo"]) == number(r["x_hi"]) for r in rs):
+            x = list(range(len(rs)))
+        m = [number(r["measured"]) for r in rs]
+        ud = [2 * number(r["u_D"]) for r in rs]
+        s = [number(r["simulated"]) for r in rs]
+        uv = [2 * number(r["u_val"]) for r in rs]
+        ax.errorbar(x, m, yerr=ud, fmt="o", color="k", ms=4, label="measured ±2u_D")
+        ax.plot(x, s, "-", color="tab:blue", label="base model")
+        ax.fill_between(x, [a - b for a, b in zip(s, uv)], [a + b for a, b in zip(s, uv)],
+                        color="tab:blue", alpha=0.2, label="±2u_val")
+        best = [number(r["best_model_mean"]) for r in rs]
+        if any(math.isfinite(b) for b in best):
+            ax.plot(x, best, "--", color="tab:red", label=rs[0]["best_model"] or "best model")
+        nm = [number(r["null_mean"]) for r in rs]
+        if any(math.isfinite(v) for v in nm):
+            ax.plot(x, nm, ":", color="tab:green", label="null model")
+        ax.set_title(exp + (" (held out)" if exp in held else "") + "\n" + obs, fontsize=9)
+        ax.set_xlabel(label, fontsize=8)
+        ax.tick_params(labelsize=7)
+    for ax in list(axes.flat)[n:]:
+        ax.axis("off")
+    axes.flat[0].legend(fontsize=6)
+    fig.tight_layout()
+    return png(fig)
+
+
+def residual_map(rows):
+    exps = list(OrderedDict.fromkeys((r["experiment"], r["observable"]) for r in rows))
+    width = max(sum(1 for r in rows if (r["experiment"], r["observable"]) == e) for e in exps)
+    grid = [[math.nan] * width for _ in exps]
+    for i, e in enumerate(exps):
+        k = 0
+        for r in rows:
+            if (r["experiment"], r["observable"]) == e:
+                grid[i][k] = number(r["z"])
+                k += 1
+    fig, ax = plt.subplots(figsize=(1.0 + 0.6 * width, 0.8 + 0.35 * len(exps)))
+    im = ax.imshow(grid, cmap="RdBu", vmin=-6, vmax=6, aspect="auto")
+    ax.set_yticks(range(len(exps)))
+    ax.set_yticklabels([f"{e} {o}" for e, o in exps], fontsize=7)
+    ax.set_xlabel("bin (increasing x)", fontsize=8)
+    fig.colorbar(im, ax=ax, label="z = (measured - simulated) / u_val")
+    ax.set_title("standardised residuals (|z| > 2: outside the validation uncertainty)", fontsize=9)
+    return png(fig)
+
+
+def overlap_plot(diag):
+    names = diag["signature_overlap"]["effects"]
+    f = diag["signature_overlap"]["fraction"]
+    if not names:
+        return None
+    fig, ax = plt.subplots(figsize=(1.5 + 0.45 * len(names), 1.2 + 0.45 * len(names)))
+    im = ax.imshow(f, cmap="viridis", vmin=0, vmax=1)
+    ax.set_xticks(range(len(names)))
+    ax.set_xticklabels(names, rotation=60, ha="right", fontsize=7)
+    ax.set_yticks(range(len(names)))
+    ax.set_yticklabels(names, fontsize=7)
+    ax.set_xlabel("reproduced by", fontsize=8)
+    fig.colorbar(im, ax=ax, label="share of the row's signature")
+    ax.set_title("signature overlap on this design", fontsize=9)
+    return png(fig)
+
+
+def before_after(diag):
+    labels, values = ["base", "null model"], [diag["held_out"]["base"]["gap_beyond_uncertainty"],
+                                              diag["held_out"]["null"]["gap_beyond_uncertainty"]]
+    for c in diag["candidates"]:
+        if c.get("confirmed"):
+            labels.append(c["effect"])
+            values.append(c["held_out"]["gap_beyond_uncertainty"])
+    for p in diag["pairs"]:
+        if p.get("confirmed"):
+            labels.append(" + ".join(p["effects"]))
+            values.append(p["held_out"]["gap_beyond_uncertainty"])
+    values = [100 * (v if v is not None else math.nan) for v in values]
+    fig, ax = plt.subplots(figsize=(1.5 + 0.8 * len(labels), 3))
+    ax.bar(range(len(labels)), values, color=["0.5", "tab:green"] + ["tab:red"] * (len(labels) - 2))
+    ax.set_xticks(range(len(labels)))
+    ax.set_xticklabels(labels, rotation=30, ha="right", fontsize=7)
+    ax.set_ylabel("held-out gap beyond u_val [%]", fontsize=8)
+    ax.set_title("held-out gap before and after", fontsize=9)
+    return png(fig)
+
+
+def main(directory):
+    with open(f"{directory}/diagnosis.json") as f:
+        diag = json.load(f)
+    with open(f"{directory}/features.csv") as f:
+        rows = list(csv.DictReader(f))
+    with open(f"{directory}/report.txt") as f:
+        text = f.read()
+    figures = [("Measured against simulated", curves_plot(rows, diag)),
+               ("Where the gap lies", residual_map(rows)),
+               ("Held-out gap", before_after(diag)),
+               ("Which effects this design can tell apart", overlap_plot(diag))]
+    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>grainlink gap: "
+             f"{html.escape(diag['measurements'])}</title><style>body{{font-family:sans-serif;"
+             "max-width:1100px;margin:auto}} pre{{background:#f4f4f4;padding:8px;white-space:"
+             "pre-wrap}} img{{max-width:100%}}</style></head><body>",
+             f"<h1>Sim-to-real diagnosis: {html.escape(diag['measurements'])}</h1>",
+             f"<p><b>{html.escape(diag['outcome'])}</b>: {html.escape(diag['claim'])}</p>",
+             "<ul>" + "".join(f"<li>{html.escape(w['text'])}</li>" for w in diag["where"]) + "</ul>"]
+    for title, fig in figures:
+        if fig:
+            parts.append(f"<h2>{title}</h2><img src='data:image/png;base64,{fig}'>")
+    parts.append(f"<h2>Report</h2><pre>{html.escape(text)}</pre></body></html>")
+    with open(f"{directory}/report.html.tmp", "w") as f:
+        f.write("\n".join(parts))
+    import os
+    os.replace(f"{directory}/report.html.tmp", f"{directory}/report.html")
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 2:
+        sys.exit(__doc__)
+    main(sys.argv[1])
