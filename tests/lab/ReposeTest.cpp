@@ -32,7 +32,6 @@ soil:
     seed: 3
     settle_kinetic_energy_J: 1.0e-8
     max_settle_time_s: 0.4
-  packing_cache_directory: ""
 repose:
   tube_radius_m: 0.021
   tube_height_m: 0.1
@@ -143,7 +142,7 @@ TEST_CASE("Angle of repose: more rolling resistance builds a steeper heap", "[la
 
 TEST_CASE("Repose input errors name the key and the line", "[lab][repose]") {
     CHECK_THROWS_WITH(parse(edited("tube_radius_m: 0.021", "tube_radius_m: 0.015")),
-                      Contains("repose.yaml:20:") && Contains("repose.tube_radius_m") &&
+                      Contains("repose.yaml:19:") && Contains("repose.tube_radius_m") &&
                           Contains("inside the tube"));
     CHECK_THROWS_WITH(parse(edited("lift_speed_m_s: 0.1", "lift_speed_m_s: 0")),
                       Contains("repose.lift_speed_m_s") && Contains("must be > 0"));
