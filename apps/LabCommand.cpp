@@ -1,6 +1,7 @@
 // `grainlink lab TEST SCENARIO.yaml --out DIR`: the virtual soil laboratory (docs/lab.md).
 #include "LabCommands.hpp"
 
+#include "grainlink/lab/LabPlot.hpp"
 #include "grainlink/lab/LabTest.hpp"
 
 #include <cstdio>
@@ -33,7 +34,8 @@ int runLab(const LabOptions &options) {
         files += (files.empty() ? "" : ",") + f;
     std::printf("written: %s/{%s}%s\n", directory.c_str(), files.c_str(),
                 run.checks.empty() ? "" : ", reruns in check_*/");
-    std::printf("plot with tools/plot_lab.py %s\n", directory.c_str());
+    // The plot is a view of the results: without python3 or matplotlib the run still succeeded.
+    std::printf("%s\n", lab::plotLabRun(directory, run.summary.test).message.c_str());
     return 0;
 }
 
