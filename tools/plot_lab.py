@@ -89,12 +89,13 @@ def direct_shear(summary, left, right):
         fit = fitted(summary, f"mohr_coulomb_{kind}")
         if fit:
             psi, dpsi = fit["psi"]["value"], fit["psi"]["half_width_95"]
-            c, dc = (fit["c"]["value"], fit["c"]["half_width_95"]) if "c" in fit else (0.0, 0.0)
+            c = fit["c"]["value"] if "c" in fit else 0.0  # through the origin: c not fitted
+            cohesion = (f"c = {1e-3 * c:.2f} ± {1e-3 * fit['c']['half_width_95']:.2f} kPa"
+                        if "c" in fit else "c = 0 (not fitted)")
             xs = [top * 1.1 * k / 50 for k in range(51)]
             right.plot(xs, [1e-3 * c + x * math.tan(math.radians(psi)) for x in xs], "--",
                        color=right.lines[-1].get_color(),
-                       label=f"{kind}: psi = {psi:.1f} ± {dpsi:.1f} deg, "
-                             f"c = {1e-3 * c:.2f} ± {1e-3 * dc:.2f} kPa (95 %)")
+                       label=f"{kind}: psi = {psi:.1f} ± {dpsi:.1f} deg, {cohesion} (95 %)")
     right.set_xlabel("normal stress sigma [kPa]")
     right.set_ylabel("shear stress tau [kPa]")
     right.set_xlim(left=0)

@@ -239,9 +239,12 @@ LabSummary BevameterResult::summary() const {
     }
     for (const auto &p : runs) {
         LabRunSummary r;
-        r.values = {{"plate_radius_m", p.plate_radius_m}, {"resolution", p.resolution},
-                    {"surface_m", p.surface_m},           {"wall_gap_m", p.wall_gap_m},
-                    {"depth_below_m", p.depth_below_m},   {"steps", double(p.steps)},
+        r.values = {{"plate_radius_m", p.plate_radius_m},
+                    {"resolution", p.resolution},
+                    {"surface_m", p.surface_m},
+                    {"wall_gap_m", p.wall_gap_m},
+                    {"depth_below_m", p.depth_below_m},
+                    {"steps", double(p.steps)},
                     {"wall_s", p.wall_s}};
         std::vector<double> time, sinkage, force, pressure;
         for (const auto &x : p.samples) {
@@ -250,7 +253,9 @@ LabSummary BevameterResult::summary() const {
             force.push_back(x.force_N);
             pressure.push_back(x.pressure_Pa);
         }
-        r.curves = {{"time_s", time}, {"sinkage_m", sinkage}, {"force_N", force},
+        r.curves = {{"time_s", time},
+                    {"sinkage_m", sinkage},
+                    {"force_N", force},
                     {"pressure_Pa", pressure}};
         s.runs.push_back(r);
     }
@@ -270,8 +275,8 @@ void BevameterResult::writeCsvs(const std::string &directory) const {
     auto csv = openCsv(dir, "bekker_fit.csv", "parameter,value,standard_error,half_width_95,unit");
     if (fit) {
         const auto &f = *fit;
-        csv << "k_c," << f.parameters.k_c << ',' << f.standard_error[0] << ','
-            << f.half_width_95[0] << ",N/m^(n+1)\n";
+        csv << "k_c," << f.parameters.k_c << ',' << f.standard_error[0] << ',' << f.half_width_95[0]
+            << ",N/m^(n+1)\n";
         csv << "k_phi," << f.parameters.k_phi << ',' << f.standard_error[1] << ','
             << f.half_width_95[1] << ",N/m^(n+2)\n";
         csv << "n," << f.parameters.n << ',' << f.standard_error[2] << ',' << f.half_width_95[2]

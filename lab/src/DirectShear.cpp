@@ -548,10 +548,14 @@ LabSummary DirectShearResult::summary() const {
             sigma.push_back(p.normal_stress_Pa);
             rise.push_back(p.plate_height_m);
         }
-        x.curves = {{"time_s", time},          {"displacement_m", d},
-                    {"shear_force_N", shear},  {"normal_force_N", normal},
-                    {"area_m2", area},         {"shear_stress_Pa", tau},
-                    {"normal_stress_Pa", sigma}, {"plate_height_m", rise}};
+        x.curves = {{"time_s", time},
+                    {"displacement_m", d},
+                    {"shear_force_N", shear},
+                    {"normal_force_N", normal},
+                    {"area_m2", area},
+                    {"shear_stress_Pa", tau},
+                    {"normal_stress_Pa", sigma},
+                    {"plate_height_m", rise}};
         s.runs.push_back(x);
     }
     return s;

@@ -39,8 +39,9 @@ std::string labPlotTool() {
 PlotOutcome plotLabRun(const std::string &directory, const std::string &test,
                        const std::string &python, const std::string &tool) {
     if (!fs::exists(python))
-        return {false, "no plot: " + python + " not found (scripts/install-deps installs python3 "
-                       "and python3-matplotlib)"};
+        return {false, "no plot: " + python +
+                           " not found (scripts/install-deps installs python3 "
+                           "and python3-matplotlib)"};
     if (!fs::exists(tool))
         return {false, "no plot: " + tool + " not found"};
     const std::string command =

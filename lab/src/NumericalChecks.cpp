@@ -256,13 +256,13 @@ std::vector<NumericalCheck> checkBevameter(const BevameterScenario &scenario,
                                            const CheckRequest &request,
                                            const LabRunOptions &options) {
     const double z_max = scenario.test.max_sinkage_m;
-    return runNumericalChecks(
-        request, bevameterQuantities(baseline, z_max),
-        [&](CheckKind kind, double factor, const std::string &name) {
-            BevameterScenario changed = scenario;
-            changed.soil = checkedSoil(scenario.soil, kind, factor);
-            return bevameterQuantities(runBevameter(changed, checkRunOptions(options, name)), z_max);
-        });
+    return runNumericalChecks(request, bevameterQuantities(baseline, z_max),
+                              [&](CheckKind kind, double factor, const std::string &name) {
+                                  BevameterScenario changed = scenario;
+                                  changed.soil = checkedSoil(scenario.soil, kind, factor);
+                                  return bevameterQuantities(
+                                      runBevameter(changed, checkRunOptions(options, name)), z_max);
+                              });
 }
 
 Quantities reposeQuantities(const ReposeResult &result) {
@@ -273,15 +273,15 @@ Quantities reposeQuantities(const ReposeResult &result) {
 std::vector<NumericalCheck> checkRepose(const ReposeScenario &scenario,
                                         const ReposeResult &baseline, const CheckRequest &request,
                                         const LabRunOptions &options) {
-    return runNumericalChecks(
-        request, reposeQuantities(baseline),
-        [&](CheckKind kind, double factor, const std::string &name) {
-            ReposeScenario changed = scenario;
-            changed.soil = checkedSoil(scenario.soil, kind, factor);
-            if (kind == CheckKind::Walls) // the tube holds the widened fill
-                changed.test.tube_radius_m *= factor;
-            return reposeQuantities(runRepose(changed, checkRunOptions(options, name)));
-        });
+    return runNumericalChecks(request, reposeQuantities(baseline),
+                              [&](CheckKind kind, double factor, const std::string &name) {
+                                  ReposeScenario changed = scenario;
+                                  changed.soil = checkedSoil(scenario.soil, kind, factor);
+                                  if (kind == CheckKind::Walls) // the tube holds the widened fill
+                                      changed.test.tube_radius_m *= factor;
+                                  return reposeQuantities(
+                                      runRepose(changed, checkRunOptions(options, name)));
+                              });
 }
 
 Quantities directShearQuantities(const DirectShearResult &result) {

@@ -181,14 +181,13 @@ struct ReposeExperiment {
     ReposeFill prepareBed(double progress_interval_s) const;
     Result start(const ReposeFill &) const { return {}; }
     std::vector<double> conditions() const { return {scenario.test.lift_speed_m_s}; }
-    ReposeRun run(const ReposeFill &fill, double lift_speed_m_s,
-                  double progress_interval_s) const;
+    ReposeRun run(const ReposeFill &fill, double lift_speed_m_s, double progress_interval_s) const;
     void fit(Result &result) const {
         const ReposeRun &lift = result.runs.front();
         const double bin = scenario.test.bin_width_m > 0.0 ? scenario.test.bin_width_m
                                                            : 2.0 * result.bed.largest_radius_m;
-        measureHeap(lift.positions_m, lift.radii_m, testCentre(scenario.soil, scenario.test.centre_m),
-                    bin, result);
+        measureHeap(lift.positions_m, lift.radii_m,
+                    testCentre(scenario.soil, scenario.test.centre_m), bin, result);
         if (!result.heapFormed())
             throw std::invalid_argument("no heap: the grains spread out (" +
                                         std::to_string(result.flank_bins) +

@@ -457,9 +457,8 @@ ShearRun ShearAnnulusExperiment::run(const LabBed &bed, double pressure,
             std::ostringstream msg;
             msg << "bevameter_shear: the annulus did not reach " << run.target_force_N
                 << " N (sigma = " << pressure
-                << " Pa) within servo.max_load_time_s = " << t.servo.max_load_time_s
-                << " s (last " << s.force_N << " N, grouser tips "
-                << surface - (s.z_mid_m - g.grouser_height_m)
+                << " Pa) within servo.max_load_time_s = " << t.servo.max_load_time_s << " s (last "
+                << s.force_N << " N, grouser tips " << surface - (s.z_mid_m - g.grouser_height_m)
                 << " m below the surface); raise servo.max_load_time_s or approach_speed_m_s, "
                    "or lower the pressure";
             throw std::runtime_error(msg.str());
@@ -595,14 +594,10 @@ LabSummary ShearAnnulusResult::summary() const {
             tau.push_back(p.shear_stress_Pa);
             sinkage.push_back(p.sinkage_m);
         }
-        x.curves = {{"time_s", time},
-                    {"rotation_rad", rotation},
-                    {"shear_displacement_m", j},
-                    {"normal_force_N", force},
-                    {"normal_pressure_Pa", sigma},
-                    {"torque_N_m", torque},
-                    {"shear_stress_Pa", tau},
-                    {"sinkage_m", sinkage}};
+        x.curves = {
+            {"time_s", time},          {"rotation_rad", rotation},    {"shear_displacement_m", j},
+            {"normal_force_N", force}, {"normal_pressure_Pa", sigma}, {"torque_N_m", torque},
+            {"shear_stress_Pa", tau},  {"sinkage_m", sinkage}};
         s.runs.push_back(x);
     }
     return s;

@@ -84,13 +84,12 @@ TEST_CASE("Servo keys: the servo: block, and the annulus's old flat keys read th
                       Contains("missing key 'bevameter_shear.servo.max_speed_m_s'"));
     CHECK_THROWS_WITH(parseAnnulus(annulus("")), Contains("missing key 'bevameter_shear.servo'"));
     // Both spellings at once: the old key is unknown next to the block.
-    CHECK_THROWS_WITH(
-        parseAnnulus(annulus("  servo: {gain_m_s_per_N: 0.1, max_speed_m_s: 0.05}\n"
-                             "  servo_deadband_N: 0.1\n")),
-        Contains("unknown key 'bevameter_shear.servo_deadband_N'"));
-    CHECK_THROWS_WITH(
-        parseAnnulus(annulus("  servo: {gain_m_s_per_N: 0.1, max_speed_m_s: 0.05, deadband_N: -1}\n")),
-        Contains("bevameter_shear.servo.deadband_N") && Contains("must be >= 0"));
+    CHECK_THROWS_WITH(parseAnnulus(annulus("  servo: {gain_m_s_per_N: 0.1, max_speed_m_s: 0.05}\n"
+                                           "  servo_deadband_N: 0.1\n")),
+                      Contains("unknown key 'bevameter_shear.servo_deadband_N'"));
+    CHECK_THROWS_WITH(parseAnnulus(annulus(
+                          "  servo: {gain_m_s_per_N: 0.1, max_speed_m_s: 0.05, deadband_N: -1}\n")),
+                      Contains("bevameter_shear.servo.deadband_N") && Contains("must be >= 0"));
 }
 
 TEST_CASE("Servo keys: the box's max_consolidation_time_s is max_load_time_s", "[lab][config]") {
@@ -130,16 +129,16 @@ TEST_CASE("Lab soil: keys a lab test would read and ignore are errors with their
             "repose.yaml")),
         Contains("repose.yaml:18:") && Contains("soil.packing_cache_directory") &&
             Contains("never cached"));
-    CHECK_THROWS_WITH(
-        parseBox(replacedOnce(kTinyShearBox, "soil:\n", "soil:\n  name: other\n")),
-        Contains("box.yaml:3:") && Contains("soil.name") && Contains("top-level 'name'"));
+    CHECK_THROWS_WITH(parseBox(replacedOnce(kTinyShearBox, "soil:\n", "soil:\n  name: other\n")),
+                      Contains("box.yaml:3:") && Contains("soil.name") &&
+                          Contains("top-level 'name'"));
     CHECK_THROWS_WITH(parseBox(replacedOnce(kTinyShearBox, "soil:\n",
                                             "soil:\n  output: {series_interval_s: 0.01}\n")),
                       Contains("soil.output") && Contains("writes its own outputs"));
-    CHECK_THROWS_WITH(parseAnnulus(replacedOnce(
-                          annulus("  servo: {gain_m_s_per_N: 0.1, max_speed_m_s: 0.05}\n"),
-                          "soil:\n", "soil:\n  bodies: []\n")),
-                      Contains("the shear test adds its own annulus; remove soil.bodies"));
+    CHECK_THROWS_WITH(
+        parseAnnulus(replacedOnce(annulus("  servo: {gain_m_s_per_N: 0.1, max_speed_m_s: 0.05}\n"),
+                                  "soil:\n", "soil:\n  bodies: []\n")),
+        Contains("the shear test adds its own annulus; remove soil.bodies"));
 }
 
 TEST_CASE("Every shipped lab scenario reads strictly, in the current spelling", "[lab][config]") {

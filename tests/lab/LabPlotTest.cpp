@@ -45,13 +45,18 @@ lab::LabSummary summaryOf(const std::string &test) {
     s.scenario = "plot-" + test;
     if (test == "bevameter") {
         s.condition = "plate_radius_m";
-        s.fits.push_back({"bekker", 1, {{"k_c", "N/m^(n+1)", 1e3, 1e2}, {"k_phi", "N/m^(n+2)", 1e6, 1e5},
-                                        {"n", "-", 1.0, 0.1}}});
+        s.fits.push_back({"bekker",
+                          1,
+                          {{"k_c", "N/m^(n+1)", 1e3, 1e2},
+                           {"k_phi", "N/m^(n+2)", 1e6, 1e5},
+                           {"n", "-", 1.0, 0.1}}});
         s.runs.push_back(run("plate_radius_m", 0.025, {}, {"sinkage_m", "pressure_Pa"}));
     } else if (test == "bevameter_shear") {
         s.condition = "target_pressure_Pa";
-        s.fits.push_back({"janosi", 1, {{"c", "Pa", 100, 10}, {"phi", "deg", 20, 1},
-                                        {"K", "m", 0.002, 0.0002}}});
+        s.fits.push_back(
+            {"janosi",
+             1,
+             {{"c", "Pa", 100, 10}, {"phi", "deg", 20, 1}, {"K", "m", 0.002, 0.0002}}});
         s.runs.push_back(run("target_pressure_Pa", 2000, {{"mean_pressure_Pa", 1900}},
                              {"shear_displacement_m", "shear_stress_Pa", "normal_pressure_Pa"}));
     } else if (test == "direct_shear") {

@@ -35,9 +35,11 @@ lab::LabSummary sample() {
     s.bed.packing_fraction = 1.0 / 3.0;
     s.bed.seed = 12345678901234ULL;
     s.bed.from_cache = true;
-    s.fits.push_back({"bekker", 199, {{"k_c", "N/m^(n+1)", -8.3e3, 0.9e3}, {"n", "-", 0.591, kNaN}}});
-    s.runs.push_back({{{"plate_radius_m", 0.025}, {"steps", 10070}},
-                      {{"sinkage_m", {-0.001, 0.0, 1.0 / 3.0}}, {"pressure_Pa", {0.0, kNaN, 2e4}}}});
+    s.fits.push_back(
+        {"bekker", 199, {{"k_c", "N/m^(n+1)", -8.3e3, 0.9e3}, {"n", "-", 0.591, kNaN}}});
+    s.runs.push_back(
+        {{{"plate_radius_m", 0.025}, {"steps", 10070}},
+         {{"sinkage_m", {-0.001, 0.0, 1.0 / 3.0}}, {"pressure_Pa", {0.0, kNaN, 2e4}}}});
     s.wall_s = 12.5;
     return s;
 }
@@ -145,15 +147,15 @@ TEST_CASE("A lab run's summary.json holds what its CSV and report hold", "[lab][
                      ("grainlink_lab_summary_test-" + std::to_string(::getpid()));
     std::filesystem::create_directories(dir);
     std::ofstream(dir / "repose.yaml") << kTinyRepose;
-    const lab::LabScenario scenario = lab::loadLabScenario("repose", (dir / "repose.yaml").string());
+    const lab::LabScenario scenario =
+        lab::loadLabScenario("repose", (dir / "repose.yaml").string());
     CHECK(lab::labTestName(scenario) == "repose");
     CHECK(lab::labWarnings(scenario).empty());
     lab::LabRunOptions options;
     options.output_directory = (dir / "out").string();
     options.progress_interval_s = 1e9; // quiet
     const lab::LabRun run = lab::runLabTest(scenario, options);
-    CHECK(run.files ==
-          std::vector<std::string>{"heap_profile.csv", "report.txt", "summary.json"});
+    CHECK(run.files == std::vector<std::string>{"heap_profile.csv", "report.txt", "summary.json"});
     const lab::LabSummary s = lab::readLabSummary((dir / "out" / "summary.json").string());
     CHECK(s.test == "repose");
     CHECK(s.scenario == "tiny-repose");

@@ -32,7 +32,7 @@ struct DirectShearSpec {
     double start_clearance_m = 0.001;  ///< [m] plate bottom above the highest grain at start
     /// Top-plate force servo (LabConfig.hpp, physics.md §12.11): shearing starts once N stayed
     /// within consolidation_tolerance for hold_s, which must happen within max_load_time_s.
-    ServoSpec servo{0.0, 0.0, 0.0, 0.0, 0.02, 0.3};
+    ServoSpec servo{0.0, 0.0, 0.0, 0.0, 0.02, 0.3}; // hold 0.02 s, 0.3 s to load
     double control_interval_s = 0.0005;    ///< [s] servo update period (`servo.control_interval_s`)
     double consolidation_tolerance = 0.05; ///< [-] |N - N_target| / N_target (`servo.tolerance`)
     bool fit_cohesion = true;              ///< false: tau = sigma tan psi through the origin
@@ -114,7 +114,6 @@ struct DirectShearResult : LabResult {
 
 /// Settles (or reads) the bed once in the closed box, then shears a copy of it per stress
 /// (runLabExperiment); writes its outputs into options.output_directory unless empty.
-DirectShearResult runDirectShear(const DirectShearScenario &scenario,
-                                 const LabRunOptions &options);
+DirectShearResult runDirectShear(const DirectShearScenario &scenario, const LabRunOptions &options);
 
 } // namespace grainlink::lab

@@ -38,18 +38,18 @@ dem::TriangleMesh makeShearAnnulus(const AnnulusGeometry &geometry);
 /// The `bevameter_shear:` section.
 struct ShearAnnulusSpec {
     AnnulusGeometry annulus;
-    std::vector<double> normal_pressures_Pa;     ///< [Pa] one run per normal pressure
-    double angular_speed_rad_s = 0.0;            ///< [rad/s] during the shear phase
-    double max_shear_displacement_m = 0.0;       ///< [m] the shear phase ends at j = theta R_mean
-    double approach_speed_m_s = 0.05;            ///< [m/s] downward until the load is first reached
+    std::vector<double> normal_pressures_Pa; ///< [Pa] one run per normal pressure
+    double angular_speed_rad_s = 0.0;        ///< [rad/s] during the shear phase
+    double max_shear_displacement_m = 0.0;   ///< [m] the shear phase ends at j = theta R_mean
+    double approach_speed_m_s = 0.05;        ///< [m/s] downward until the load is first reached
     /// The load servo (LabConfig.hpp): hold_s before the rotation starts, max_load_time_s for the
     /// approach to first reach the load.
-    ServoSpec servo{0.0, 0.0, 0.0, 0.0, 0.02, 1.0};
-    double start_clearance_m = 0.001; ///< [m] grouser tips above the highest grain
-    double sample_interval_s = 0.002; ///< [s] servo update and CSV row
-    std::optional<double> friction_coefficient; ///< annulus-grain; unset: the grains' angles
-    double min_resolution = 3.0;                ///< [-] required (R_o - R_i) / (2 r_max)
-    std::optional<Eigen::Vector2d> centre_m;    ///< [m] axis (x, y); unset: region centre
+    ServoSpec servo{0.0, 0.0, 0.0, 0.0, 0.02, 1.0}; // hold 0.02 s, 1 s to load
+    double start_clearance_m = 0.001;               ///< [m] grouser tips above the highest grain
+    double sample_interval_s = 0.002;               ///< [s] servo update and CSV row
+    std::optional<double> friction_coefficient;     ///< annulus-grain; unset: the grains' angles
+    double min_resolution = 3.0;                    ///< [-] required (R_o - R_i) / (2 r_max)
+    std::optional<Eigen::Vector2d> centre_m;        ///< [m] axis (x, y); unset: region centre
 };
 
 struct ShearAnnulusScenario {
