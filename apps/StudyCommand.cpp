@@ -56,7 +56,7 @@ int report(const study::Study &s, const std::vector<PointResult> &results) {
         done += r.status == PointStatus::Done;
         failed += r.status == PointStatus::Failed;
         unfinished += r.status == PointStatus::Unfinished;
-        ran += r.ran_now;
+        ran += r.ran_now && r.status != PointStatus::Unfinished;
     }
     for (const PointResult &r : results) {
         if (r.status == PointStatus::Failed)

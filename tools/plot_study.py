@@ -47,6 +47,9 @@ def main(folder):
             groups = {}
             for r in rows:
                 groups.setdefault(tuple(r[c] for c in others), []).append(r)
+            if all(len(g) == 1 for g in groups.values()):
+                groups = {(): rows}  # the other keys move with this one (zipped): one line
+                others = []
             for label, members in groups.items():
                 members.sort(key=lambda r: position[r[key]] if keys else 0)
                 x = [position[r[key]] if keys else 0 for r in members]
@@ -61,7 +64,7 @@ def main(folder):
             ax.set_xlabel(key)
             ax.set_ylabel(name)
             if len(groups) > 1:
-                ax.legend(fontsize=7)
+                ax.legend(fontsize=7, loc="best")
     fig.suptitle(f"study '{study['name']}': mean ± standard error over the replicates")
     fig.tight_layout()
     out = os.path.join(folder, "study.png")

@@ -2,6 +2,7 @@
 
 #include "grainlink/study/ScenarioEdit.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -98,14 +99,30 @@ std::vector<std::vector<std::size_t>> combinations(const std::vector<Factor> &fa
     }
 }
 
-/// "stick_angle_deg" for `contact.tangential.stick_angle_deg`; a list item keeps its list:
-/// "force_N.2".
-std::string shortName(const std::string &key) {
-    std::size_t cut = key.rfind('.');
-    if (cut != std::string::npos && cut > 0 &&
-        key.find_first_not_of("0123456789", cut + 1) == std::string::npos)
-        cut = key.rfind('.', cut - 1);
-    return cut == std::string::npos ? key : key.substr(cut + 1);
+/// Label names of the keys: the shortest tail of each dotted path that no other key shares
+/// ("stick_angle_deg", "force_N.2"; "motion.0.duration_s" beside "run.duration_s").
+std::vector<std::string> shortNames(const std::vector<std::string> &keys) {
+    auto tail = [](const std::string &key, int steps) {
+        std::size_t cut = key.size();
+        for (int k = 0; k < steps && cut != std::string::npos && cut > 0; ++k)
+            cut = key.rfind('.', cut - 1);
+        return cut == std::string::npos ? key : key.substr(cut + 1);
+    };
+    std::vector<std::string> names;
+    for (const std::string &key : keys) {
+        for (int steps = 1;; ++steps) {
+            const std::string name = tail(key, steps);
+            // a name starts with a key, not a list index: "force_N.2", "motion.0.duration_s"
+            bool unique = !std::isdigit(static_cast<unsigned char>(name[0]));
+            for (const std::string &other : keys)
+                unique = unique && (other == key || tail(other, steps) != name);
+            if (unique || name == key) {
+                names.push_back(name);
+                break;
+            }
+        }
+    }
+    return names;
 }
 
 } // namespace
@@ -184,6 +201,9 @@ Study loadStudy(const std::string &path, const std::string &directory,
         root["observables"].fail("name at least one field of the runs' " + kind.summary_file);
     root.finish();
 
+    std::vector<std::string> label_keys = study.varied_keys;
+    label_keys.push_back(seed_key);
+    const std::vector<std::string> names = shortNames(label_keys);
     std::set<std::string> ids;
     for (const auto &combination : combinations(factors, zip, vary ? *vary : root)) {
         for (int r = 0; r < replicates; ++r) {
@@ -199,7 +219,7 @@ Study loadStudy(const std::string &path, const std::string &directory,
                     (*vary).items()[k]["key"].fail(e.what());
                 }
                 settings.emplace_back(f.key, inlineText(value));
-                label += (label.empty() ? "" : " ") + shortName(f.key) + "=" + inlineText(value);
+                label += (label.empty() ? "" : " ") + names[k] + "=" + inlineText(value);
                 origin += (origin.empty() ? "" : ", ") + path + ":" +
                           std::to_string(f.lines[combination[k]]) + ": " + f.key + " = " +
                           inlineText(value);
@@ -212,7 +232,7 @@ Study loadStudy(const std::string &path, const std::string &directory,
                     replicate_node->fail(e.what());
                 }
                 settings.emplace_back(seed_key, seed);
-                label += (label.empty() ? "" : " ") + shortName(seed_key) + "=" + seed;
+                label += (label.empty() ? "" : " ") + names.back() + "=" + seed;
                 origin += (origin.empty() ? "" : ", ") + path + ":" +
                           std::to_string(replicate_node->line()) + ": " + seed_key + " = " + seed;
             }

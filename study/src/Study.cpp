@@ -3,6 +3,9 @@
 #include "Executors.hpp"
 #include "grainlink/dem/Deposition.hpp"
 #include "grainlink/study/ScenarioEdit.hpp"
+#include "grainlink/study/StudyFolder.hpp"
+
+#include <filesystem>
 
 #include <set>
 #include <stdexcept>
@@ -37,11 +40,14 @@ void validate(const Study &study) {
             throw std::invalid_argument("study '" + study.name + "': kind '" + p.kind.name +
                                         "' has no scenario reader to check point '" + p.label +
                                         "' with");
+        // Named after the file the run would read, so the reader's line numbers point into it.
+        const std::string path = StudyFolder(study.directory).scenarioPath(p);
         try {
-            // Named after the file the run will read, so the reader's line numbers match it.
-            p.kind.validate(config::ConfigNode::loadString(
-                p.scenario_yaml, StudyFolder(study.directory).scenarioPath(p)));
+            p.kind.validate(config::ConfigNode::loadString(p.scenario_yaml, path));
         } catch (const std::exception &e) {
+            // The refused scenario is the one file written: the message points into it.
+            std::filesystem::create_directories(std::filesystem::path(path).parent_path());
+            writeFileAtomically(path, p.scenario_yaml);
             throw std::invalid_argument(p.origin + ": not a valid " + p.kind.name +
                                         " scenario: " + e.what());
         }

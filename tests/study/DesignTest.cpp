@@ -90,6 +90,7 @@ TEST_CASE("a zipped design pairs the i-th values, and lists of unequal length ar
     for (const Point &p : s.points)
         CHECK(at(p, "contact.tangential.slip_angle_deg") ==
               at(p, "contact.tangential.stick_angle_deg") - 1.0);
+    CHECK(s.points[1].label == "stick_angle_deg=34 slip_angle_deg=33");
     const std::string bad = studyFile(folder, "bad_zip",
                                       "design:\n"
                                       "  combine: zip\n"
@@ -115,6 +116,16 @@ TEST_CASE("list items are reached by index, and a path the base lacks names the 
     CHECK(at(s.points[1], "walls.0.upper_m.0") == 0.07);
     CHECK(at(s.points[1], "walls.0.lower_m.0") == 0.0);
     CHECK(s.points[1].settings[0].second == "[0.07, 0.07, 0.2]");
+    CHECK(s.points[1].label == "upper_m=[0.07, 0.07, 0.2]");
+
+    // Labels name each key by the shortest tail no other key shares, never a bare index.
+    const Study times = loadStudy(
+        studyFile(folder, "times",
+                  "design:\n  combine: zip\n  vary:\n"
+                  "    - {key: bodies.0.motion.0.duration_s, values: [0.1]}\n"
+                  "    - {key: run.duration_s, values: [0.1]}\n"),
+        folder / "out");
+    CHECK(times.points[0].label == "motion.0.duration_s=0.1 run.duration_s=0.1");
 
     const std::string typo =
         studyFile(folder, "typo",
@@ -181,7 +192,19 @@ TEST_CASE("a design point that is not a valid scenario is refused before anythin
                                       path + ":7: deposition.seed = 1: not a valid dem scenario"));
     CHECK_THAT(error, Catch::Contains("stick_angle_deg"));
     CHECK_THAT(error, Catch::Contains("must be in [0, 90)"));
-    CHECK_FALSE(fs::exists(folder / "out")); // nothing ran, nothing was written
+    // Nothing ran: no study file, no point folder; only the refused scenario the message
+    // points into.
+    CHECK_FALSE(fs::exists(folder / "out/study.json"));
+    CHECK_FALSE(fs::exists(folder / "out/points"));
+    const std::string refused = error.substr(error.find(folder / "out/scenarios/"));
+    const std::string file = refused.substr(0, refused.find(".yaml:") + 5);
+    REQUIRE(fs::exists(file));
+    const int line = std::stoi(refused.substr(refused.find(".yaml:") + 6));
+    std::istringstream text(readFile(file));
+    std::string row;
+    for (int k = 0; k < line; ++k)
+        std::getline(text, row);
+    CHECK_THAT(row, Catch::Contains("tangential:")); // the line the reader named
 
     // A key the base does not have is created, and the strict reader refuses it by name.
     const std::string unknown =

@@ -174,3 +174,51 @@ TEST_CASE("a study killed mid-run, started again, runs only the unfinished point
     for (const auto &e : fs::directory_iterator(study / "points"))
         CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
 }
+
+namespace {
+
+/// The child processes of `pid` (every thread's), from /proc.
+std::vector<pid_t> childrenOf(pid_t pid) {
+    std::vector<pid_t> children;
+    const fs::path tasks = "/proc/" + std::to_string(pid) + "/task";
+    std::error_code missing;
+    for (const auto &task : fs::directory_iterator(tasks, missing)) {
+        std::ifstream in(task.path() / "children");
+        for (pid_t child; in >> child;)
+            children.push_back(child);
+    }
+    return children;
+}
+
+} // namespace
+
+TEST_CASE("a run killed from outside leaves its point unfinished while the study goes on; the "
+          "next start runs just that point",
+          "[study][local]") {
+    TempFolder folder("killed-run");
+    // The test scenario with a longer run (the plate rests after 0.12 s), so its process is
+    // there to be killed.
+    std::string scenario = readFile(kData + "/plate.yaml");
+    const std::string run = "run: {duration_s: 0.12}";
+    scenario.replace(scenario.find(run), run.size(), "run: {duration_s: 0.8}");
+    writeFile(folder / "plate.yaml", scenario);
+    writeFile(folder / "three.yaml", "name: three\nbase: {kind: dem, scenario: plate.yaml}\n"
+                                     "design:\n  replicates: 3\n"
+                                     "observables: [bodies.plate.force_N.2]\n");
+    const std::vector<std::string> command{
+        kGrainlink, "study", folder / "three.yaml", "--out", folder / "study", "--jobs", "1"};
+    Process study(command, folder.path, folder / "first.log");
+    std::vector<pid_t> runs;
+    REQUIRE(waitUntil([&] { return !(runs = childrenOf(study.pid())).empty(); }, 30.0));
+    REQUIRE(runs.size() == 1);
+    kill(runs[0], SIGKILL);
+    CHECK(study.wait() == 0); // the others went on; nothing failed
+    const std::string first = readFile(folder / "first.log");
+    INFO(first);
+    CHECK_THAT(first, Catch::Contains("3 points: 2 done (2 run now), 0 failed, 1 unfinished"));
+    CHECK_THAT(first, Catch::Contains("interrupted (killed by signal 9"));
+
+    std::string output;
+    REQUIRE(runToEnd(command, folder.path.string(), output) == 0);
+    CHECK_THAT(output, Catch::Contains("3 points: 3 done (1 run now), 0 failed, 0 unfinished"));
+}
