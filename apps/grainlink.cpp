@@ -1,5 +1,6 @@
 // The `grainlink` command: one binary, one subcommand per job.
 #include "CouplingCommands.hpp"
+#include "GapCommand.hpp"
 #include "LabCommands.hpp"
 #include "Nodes.hpp"
 #include "StudyCommand.hpp"
@@ -143,6 +144,7 @@ int main(int argc, char **argv) {
                          "several share the bodies)");
 
     grainlink::apps::StudyCommand study(app);
+    grainlink::apps::GapCommand gap(app);
 
     CLI11_PARSE(app, argc, argv);
     try {
@@ -173,6 +175,8 @@ int main(int argc, char **argv) {
             return grainlink::apps::runLab(lab_options);
         } else if (study.parsed()) {
             return study.run();
+        } else if (gap.parsed()) {
+            return gap.run();
         } else if (keygen->parsed()) {
             return grainlink::apps::generateKeys(key_directory, key_names);
         }

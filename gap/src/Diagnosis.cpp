@@ -110,6 +110,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         checks.push_back({first[i].check, first_rows[i]});
     D.validation = validate(meas, base_rows, checks);
     const ValidationResult &V = D.validation;
+    const BlockCorrelation correlation(meas.keys, base_rows);
     D.verdict = testGap(meas.keys, V.z, opt.alpha, opt.flag_at);
     D.findings = localise(meas.keys, V, [&] {
         std::map<std::string, Conditions> c;
@@ -169,7 +170,6 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     D.held_out_null = scoreHeldOut(meas.value, null_mean, null_var, u2_val, D.held_out);
     D.null_mean = null_mean;
     D.null_variance = null_var;
-    const BlockCorrelation correlation(meas.keys, base_rows);
     const double n_eff = correlation.effectiveCount(D.held_out);
 
     if (!D.verdict.gap) {

@@ -44,8 +44,11 @@ std::vector<double> roundBinEdges(double start, double typical_end, int count) {
     for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
         if (m * decade <= raw * 1.0000001)
             width = m * decade;
+    // As many bins of that width as fit before the end: at least `count`, since the width was
+    // rounded down.
+    const int bins = std::max(count, int(std::floor((typical_end - start) / width + 1e-9)));
     std::vector<double> edges;
-    for (int k = 0; k <= count; ++k)
+    for (int k = 0; k <= bins; ++k)
         edges.push_back(start + k * width);
     return edges;
 }

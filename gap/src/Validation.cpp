@@ -1,5 +1,8 @@
 #include "grainlink/gap/Validation.hpp"
 
+#include "grainlink/gap/Correlation.hpp"
+
+#include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
@@ -77,23 +80,45 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
         v.u_bed[k] = measured.from_repeats[std::size_t(k)] ? 0.0 : sd;
     }
     Eigen::VectorXd num2 = v.u_seed.array().square();
+    // A numerical choice moves an experiment's curve as a whole: its systematic part is the
+    // experiment's mean relative difference from the base, with the seed noise of that mean
+    // removed in quadrature (docs/gap.md, "Validation uncertainty").
+    const BlockCorrelation correlation(measured.keys, base);
+    std::map<std::string, std::vector<Eigen::Index>> by_experiment;
+    for (Eigen::Index k = 0; k < n; ++k)
+        by_experiment[measured.keys[std::size_t(k)].experiment].push_back(k);
     for (const NumericalCheck &check : checks) {
         if (check.rows.cols() != n)
             throw std::invalid_argument("validate: check '" + check.name + "' has " +
                                         std::to_string(check.rows.cols()) + " features, not " +
                                         std::to_string(n));
         const ColumnStats c = columnStats(check.rows);
-        Eigen::VectorXd u(n);
-        for (Eigen::Index k = 0; k < n; ++k) {
-            if (c.count[k] == 0 || !std::isfinite(b.mean[k])) {
-                u[k] = 0.0; // the check did not reach this feature: nothing to add
-                continue;
+        Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
+        for (const auto &[id, idx] : by_experiment) {
+            double sum = 0.0, var = 0.0;
+            int k_used = 0;
+            for (Eigen::Index k : idx) {
+                if (c.count[k] == 0 || !std::isfinite(b.mean[k]) || b.mean[k] == 0.0)
+                    continue;
+                // Pooled scatter of the base's and the check's seeds.
+                const double nb = b.count[k], nc = c.count[k];
+                const double sb2 = std::isfinite(b.sd[k]) ? b.sd[k] * b.sd[k] : 0.0;
+                const double sc2 = nc >= 2 && std::isfinite(c.sd[k]) ? c.sd[k] * c.sd[k] : sb2;
+                const double dof = std::max(1.0, nb + nc - 2.0);
+                const double pooled = ((nb - 1.0) * sb2 + std::max(0.0, nc - 1.0) * sc2) / dof;
+                sum += (c.mean[k] - b.mean[k]) / b.mean[k];
+                var += pooled * (1.0 / nc + 1.0 / std::max(1.0, nb)) / (b.mean[k] * b.mean[k]);
+                ++k_used;
             }
-            const double d = c.mean[k] - b.mean[k];
-            // The difference of two seed means carries their noise; remove it in quadrature.
-            const double sd_c = c.count[k] >= 2 ? c.sd[k] : v.seed_sd[k];
-            const double noise = sq(sd_c) / std::max(1, c.count[k]) + sq(v.u_seed[k]);
-            u[k] = std::sqrt(std::max(0.0, sq(d) - (std::isfinite(noise) ? noise : 0.0)));
+            if (k_used == 0)
+                continue;
+            const double mean = sum / k_used;
+            const double rho = correlation.rho(id);
+            const double var_mean = var / k_used * (1.0 + (k_used - 1) * rho) / k_used;
+            const double systematic = std::sqrt(std::max(0.0, mean * mean - var_mean));
+            for (Eigen::Index k : idx)
+                if (std::isfinite(b.mean[k]))
+                    u[k] = systematic * std::abs(b.mean[k]);
         }
         num2 += u.array().square().matrix();
         v.u_checks.emplace_back(check.name, u);
@@ -142,8 +167,9 @@ GapVerdict testGap(const std::vector<FeatureKey> &keys, const Eigen::VectorXd &s
         g.summary = "no feature could be compared";
         return g;
     }
-    g.feature_bound = std::max(flag_at, normalBound(0.5 * alpha / g.features));
-    g.experiment_bound = std::max(flag_at, normalBound(0.5 * alpha / double(per_experiment.size())));
+    const double share = alpha / 3.0;
+    g.feature_bound = std::max(flag_at, normalBound(share / g.features));
+    g.experiment_bound = std::max(flag_at, normalBound(share / double(per_experiment.size())));
     for (const auto &[id, acc] : per_experiment) {
         const double rms = std::sqrt(acc.first / acc.second);
         if (rms > g.worst_rms) {
@@ -152,6 +178,11 @@ GapVerdict testGap(const std::vector<FeatureKey> &keys, const Eigen::VectorXd &s
         }
     }
     g.gap = g.max_abs > g.feature_bound || g.worst_rms > g.experiment_bound;
+    for (const auto &[id, acc] : per_experiment)
+        g.sum_mean_square += acc.first / acc.second;
+    g.sum_bound = boost::math::quantile(boost::math::complement(
+        boost::math::chi_squared(double(per_experiment.size())), share));
+    g.gap = g.gap || g.sum_mean_square > g.sum_bound;
     std::ostringstream s;
     if (g.gap)
         s << "gap: ";
@@ -161,6 +192,8 @@ GapVerdict testGap(const std::vector<FeatureKey> &keys, const Eigen::VectorXd &s
       << " u_val; largest |e| " << format(g.max_abs, 3) << " (bound " << format(g.feature_bound, 3)
       << "), largest experiment rms " << format(g.worst_rms, 3) << " in " << g.worst_experiment
       << " (bound " << format(g.experiment_bound, 3) << ")";
+    s << ", sum of experiments' mean z^2 " << format(g.sum_mean_square, 3) << " (bound "
+      << format(g.sum_bound, 3) << ")";
     g.summary = s.str();
     return g;
 }

@@ -40,10 +40,10 @@ TEST_CASE("a bin the curve does not cover has no mean; a scalar is its own value
 }
 
 TEST_CASE("bin edges have a round width", "[gap][features]") {
-    const auto e = roundBinEdges(0.0, 0.02, 6); // 3.33 mm raw -> 2.5 mm
-    REQUIRE(e.size() == 7);
+    const auto e = roundBinEdges(0.0, 0.02, 6); // 3.33 mm raw -> 2.5 mm, 8 of them to 20 mm
+    REQUIRE(e.size() == 9);
     CHECK(e[1] == Approx(0.0025));
-    CHECK(e.back() == Approx(0.015));
+    CHECK(e.back() == Approx(0.02));
     const auto f = roundBinEdges(1.0, 2.0, 5); // 0.2 exactly
     CHECK(f[1] == Approx(1.2));
 }

@@ -25,7 +25,8 @@ TEST_CASE("u_val combines the seeds, one bed's scatter, the checks and the measu
           "[gap][validation]") {
     // Hand calculation (docs/gap.md, V&V 20): seeds 1.0 1.2 0.8 1.0 -> mean 1, sd 0.1633,
     // u_seed = sd/2; no repeats -> u_bed = sd; a resolution check at 1.3 (two seeds, no spread)
-    // -> d = 0.3, its noise u_seed^2 removed: u_res = sqrt(0.09 - 0.02667/4).
+    // -> relative difference 0.3, whose noise uses the pooled scatter (3 sd^2 + 0) / 4 = 0.02
+    // over 1/2 + 1/4: u_res = sqrt(0.09 - 0.015).
     Eigen::MatrixXd base(4, 1);
     base << 1.0, 1.2, 0.8, 1.0;
     Eigen::MatrixXd check(2, 1);
@@ -35,13 +36,53 @@ TEST_CASE("u_val combines the seeds, one bed's scatter, the checks and the measu
     CHECK(v.seed_sd[0] == Approx(sd));
     CHECK(v.u_seed[0] == Approx(sd / 2.0));
     CHECK(v.u_bed[0] == Approx(sd));
-    CHECK(v.u_checks.at(0).second[0] == Approx(std::sqrt(0.09 - sd * sd / 4.0)));
-    CHECK(v.u_num[0] == Approx(0.3));
-    CHECK(v.u_val[0] == Approx(std::sqrt(0.09 + sd * sd + 0.01)));
-    CHECK(v.standardised[0] == Approx(0.5 / std::sqrt(0.09 + sd * sd + 0.01)));
+    const double u_res = std::sqrt(0.09 - 0.02 * 0.75);
+    CHECK(v.u_checks.at(0).second[0] == Approx(u_res));
+    CHECK(v.u_num[0] == Approx(std::sqrt(sd * sd / 4.0 + u_res * u_res)));
+    CHECK(v.u_val[0] == Approx(std::sqrt(sd * sd / 4.0 + u_res * u_res + sd * sd + 0.01)));
     CHECK(v.ratio[0] == Approx(1.0 / 1.5));
     // With repeats the measured scatter already holds the bed's: no u_bed.
     CHECK(validate(oneFeature(1.5, 0.1, true), base, {}).u_bed[0] == 0.0);
+}
+
+TEST_CASE("a numerical check's systematic part: found when it shifts the curve, near zero when "
+          "it does not",
+          "[gap][validation]") {
+    // Six bins of one experiment, beds moving the whole curve (level sd 10 %), three base seeds
+    // and two check seeds. A check that lowers everything by 30 % is found at about 30 %; one
+    // that changes nothing contributes about half the noise of the difference on average (the
+    // positive part of d^2 - var d), not the noise itself.
+    Measured m;
+    for (int b = 0; b < 6; ++b)
+        m.keys.push_back({"e", "p", "k", 0.001 * b, 0.001 * (b + 1)});
+    m.value = Eigen::VectorXd::Constant(6, 100.0);
+    m.u_D = Eigen::VectorXd::Constant(6, 1.0);
+    m.trials = Eigen::VectorXi::Constant(6, 3);
+    m.from_repeats.assign(6, true);
+    std::mt19937 rng(5);
+    std::normal_distribution<double> z;
+    double shifted = 0.0, still = 0.0;
+    const int draws = 400;
+    for (int d = 0; d < draws; ++d) {
+        Eigen::MatrixXd base(3, 6), same(2, 6), lower(2, 6);
+        for (int s = 0; s < 3; ++s) {
+            const double level = 1.0 + 0.1 * z(rng);
+            for (int b = 0; b < 6; ++b)
+                base(s, b) = 100.0 * level * (1.0 + 0.02 * z(rng));
+        }
+        for (int s = 0; s < 2; ++s) {
+            const double level = 1.0 + 0.1 * z(rng);
+            for (int b = 0; b < 6; ++b) {
+                same(s, b) = 100.0 * level * (1.0 + 0.02 * z(rng));
+                lower(s, b) = 0.7 * same(s, b);
+            }
+        }
+        still += validate(m, base, {{"time_step", same}}).u_checks[0].second[2] / draws;
+        shifted += validate(m, base, {{"time_step", lower}}).u_checks[0].second[2] / draws;
+    }
+    // The seed noise of a 3-vs-2 mean difference of one level is 10 % x sqrt(1/3 + 1/2) = 9 %.
+    CHECK(still < 7.0);
+    CHECK(shifted == Approx(30.0).margin(6.0));
 }
 
 TEST_CASE("standardised residuals of a matching model are about unit normal",
@@ -92,6 +133,15 @@ TEST_CASE("the gap test holds its false-alarm rate with independent or fully cor
     // Family-wise level 5 %: Bonferroni is conservative, so the rate is at most about that.
     CHECK(double(alarms_independent) / draws < 0.06);
     CHECK(double(alarms_correlated) / draws < 0.06);
+
+    // Many features moderately off (half of them at 2.5 u_val): (a) and (b) miss it, (c) not.
+    Eigen::VectorXd half = Eigen::VectorXd::Zero(30);
+    for (int k = 0; k < 30; k += 2)
+        half[k] = 2.5;
+    const GapVerdict h = testGap(keys, half);
+    CHECK(h.max_abs < h.feature_bound);
+    CHECK(h.worst_rms < h.experiment_bound);
+    CHECK(h.gap);
 
     // A consistent 3 u_val gap on every feature, and one feature 6 u_val out, are gaps; a
     // consistent 1.5 is not.

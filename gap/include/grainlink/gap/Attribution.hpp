@@ -4,6 +4,7 @@
 // that best explains the calibration experiments, how far two effects' signatures overlap on
 // the design, and how well a fitted model predicts the held-out experiments against the null
 // (docs/gap.md, "Attribution" and "Confirmation").
+#include "grainlink/gap/Correlation.hpp"
 #include "grainlink/gap/Features.hpp"
 
 #include <Eigen/Core>
@@ -67,31 +68,6 @@ public:
 
 private:
     std::function<Eigen::VectorXd(double)> mean_, variance_;
-};
-
-/// The features a comparison uses (e.g. the calibration experiments').
-using FeatureSet = std::vector<Eigen::Index>;
-
-/// The features of one experiment share its bed realisation, in the simulation and in every
-/// measured trial: their residuals are correlated. Modelled as one correlation coefficient rho
-/// per experiment between any two of its features (compound symmetry), estimated from the
-/// base model's seeds; experiments are independent of each other.
-class BlockCorrelation {
-public:
-    BlockCorrelation() = default; ///< every feature independent
-    /// rho of each experiment: the mean correlation of its features over the seeds `rows`
-    /// (clipped to [0, 0.95]; 0.5 where fewer than three seeds tell).
-    BlockCorrelation(const std::vector<FeatureKey> &keys, const Eigen::MatrixXd &rows);
-    /// e^T R^-1 e of standardised residuals e over `use` (generalised least squares).
-    double chiSquare(const Eigen::VectorXd &e, const FeatureSet &use) const;
-    /// How many independent features `use` is worth (Kish: k / (1 + (k - 1) rho) each).
-    double effectiveCount(const FeatureSet &use) const;
-    double rho(const std::string &experiment) const;
-
-private:
-    std::map<std::string, std::vector<Eigen::Index>> groups(const FeatureSet &use) const;
-    std::vector<std::string> experiment_of_;
-    std::map<std::string, double> rho_;
 };
 
 /// chi^2 of `mean` against `measured` over `use`, with variance `u2_fixed + variance`,

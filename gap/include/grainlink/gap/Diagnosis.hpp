@@ -30,6 +30,7 @@ struct VariantRequest {
     double second_strength = 0.0;
     std::string check; ///< "", "resolution", "time_step", "domain", "rate"
     int seeds = 1;
+    int seed_offset = 0; ///< the first seed: a twin's "measured" beds are not the model's own
 };
 
 /// Runs variants of the base model on a design: one matrix per request, seeds x features.

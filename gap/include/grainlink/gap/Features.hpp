@@ -33,9 +33,9 @@ struct FeatureKey {
     double centre() const { return 0.5 * (x_lo + x_hi); }
 };
 
-/// Bin edges shared by every experiment of one observable kind: `count` equal bins from
-/// `start` with a round width (1, 2, 2.5 or 5 times a power of ten) chosen so that `count`
-/// bins span about `typical_end` - `start`.
+/// Bin edges shared by every experiment of one observable kind: equal bins from `start` with a
+/// round width (1, 2, 2.5 or 5 times a power of ten, the largest not above (end - start) /
+/// count), as many as fit before `typical_end` (so at least `count`).
 std::vector<double> roundBinEdges(double start, double typical_end, int count);
 
 /// Features of a set of curves (trials or seeds) on `edges`: one row per curve, one column

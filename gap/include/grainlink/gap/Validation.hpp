@@ -59,20 +59,25 @@ struct ValidationResult {
 double normalEquivalent(double t, double dof);
 
 /// u_val and the residuals of `base` (seeds x features) against `measured`. A check's
-/// systematic part is its mean difference from the base with the seed noise of that difference
-/// removed in quadrature: u_k = sqrt(max(0, d^2 - var d)). Throws if the shapes differ.
+/// systematic part is, per experiment, its mean relative difference from the base over the
+/// experiment's features with the seed noise of that mean removed in quadrature,
+/// u_k = |base| sqrt(max(0, mean_r^2 - var mean_r)). Throws if the shapes differ.
 ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
                           const std::vector<NumericalCheck> &checks);
 
-/// The gap test. Two tests, each at half the family-wise level alpha, valid under any
-/// correlation between features: (a) some |e| above the Bonferroni bound over all features;
-/// (b) some experiment's root-mean-square |e| above the Bonferroni bound over experiments (a
-/// consistent gap of moderate size). A feature beyond `flag_at` (2 u_val) is flagged either way.
+/// The gap test, three tests each at a third of the family-wise level alpha, valid whatever the
+/// correlation between an experiment's features (experiments independent): (a) some |z| above
+/// the Bonferroni bound over all features; (b) some experiment's root-mean-square z above the
+/// Bonferroni bound over experiments (a consistent gap of moderate size); (c) the sum over
+/// experiments of their mean z^2 above the chi^2 quantile with one degree of freedom per
+/// experiment (many features moderately off: a mean of correlated z^2 spreads at most like one
+/// z^2). A feature beyond `flag_at` (2 u_val) is flagged either way.
 struct GapVerdict {
     bool gap = false;
     double max_abs = 0.0, feature_bound = 0.0;
     std::string worst_experiment;
     double worst_rms = 0.0, experiment_bound = 0.0;
+    double sum_mean_square = 0.0, sum_bound = 0.0; ///< (c)
     int flagged = 0, features = 0;
     std::string summary; ///< one sentence
 };

@@ -1,0 +1,278 @@
+// `grainlink gap`: import, diagnose, twin, selftest (docs/gap.md). The pipeline is the gap
+// library; this is its command line.
+#include "GapCommand.hpp"
+
+#include "grainlink/gap/Importers.hpp"
+#include "grainlink/gap/Report.hpp"
+#include "grainlink/gap/Selftest.hpp"
+#include "grainlink/gap/StudySimulator.hpp"
+#include "grainlink/gap/Twin.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
+namespace grainlink::apps {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string thisExecutable() { return fs::read_symlink("/proc/self/exe").string(); }
+
+/// A file the program ships (data/..., tools/...): beside the installed program
+/// (<prefix>/share/grainlink), in the source tree of a build (build/apps/grainlink), or under
+/// the current directory.
+std::string shipped(const std::string &relative) {
+    const fs::path exe = fs::path(thisExecutable()).parent_path();
+    for (const fs::path &p : {exe / ".." / "share" / "grainlink" / relative,
+                              exe / ".." / ".." / relative, fs::path(relative)})
+        if (fs::exists(p))
+            return fs::canonical(p).string();
+    throw std::runtime_error("cannot find " + relative + " beside " + exe.string() +
+                             " nor in the current directory");
+}
+
+std::string duration(double s) {
+    char text[32];
+    if (s < 0.0 || !std::isfinite(s))
+        return "?";
+    if (s < 120.0)
+        std::snprintf(text, sizeof text, "%.0f s", s);
+    else
+        std::snprintf(text, sizeof text, "%.0f min %02.0f s", std::floor(s / 60.0), std::fmod(s, 60.0));
+    return text;
+}
+
+study::ExecutorOptions executorOptions(const std::string &executor, int jobs, double interval) {
+    study::ExecutorOptions o;
+    o.executor = executor == "slurm" ? study::ExecutorOptions::Executor::Slurm
+                                     : study::ExecutorOptions::Executor::Local;
+    o.grainlink = thisExecutable();
+    o.jobs = jobs;
+    o.progress_interval_s = interval;
+    o.progress = [](const study::StudyProgress &p) {
+        std::fprintf(stderr, "[gap] simulations: %zu/%zu done (%zu reused), %zu running, %zu failed; %s "
+                             "elapsed, ETA %s\n",
+                     p.done, p.total, p.reused, p.running, p.failed, duration(p.elapsed_s).c_str(),
+                     duration(p.eta_s).c_str());
+    };
+    return o;
+}
+
+gap::EffectCatalogue catalogueWith(const std::string &extra) {
+    gap::EffectCatalogue c = gap::loadEffects(shipped("data/effects.yaml"));
+    if (!extra.empty())
+        c = gap::mergeEffects(c, gap::loadEffects(extra));
+    return c;
+}
+
+gap::DiagnosisOptions diagnosisOptions(const gap::BaseModel &base) {
+    gap::DiagnosisOptions o;
+    o.seeds = base.seeds;
+    o.signature_seeds = base.signature_seeds;
+    o.check_seeds = base.check_seeds;
+    o.log = [](const std::string &line) { std::fprintf(stderr, "[gap] %s\n", line.c_str()); };
+    return o;
+}
+
+} // namespace
+
+GapCommand::GapCommand(CLI::App &app) {
+    command_ = app.add_subcommand("gap", "sim-to-real gap diagnosis (docs/gap.md)");
+    command_->require_subcommand(1);
+
+    diagnose_ = command_->add_subcommand(
+        "diagnose", "where a simulation disagrees with measurements, which effect causes it, and "
+                    "how far the held-out gap shrinks once it is added");
+    diagnose_->add_option("measurements", measurements_, "folder with experiments.yaml")->required();
+    diagnose_->add_option("--model", model_, "base model YAML (docs/gap.md)")->required();
+    diagnose_->add_option("--out", out_, "output folder (default out/gap/<measurements name>)");
+    diagnose_->add_option("--hold-out", held_out_,
+                          "experiment ids to hold out (comma separated; default: docs/gap.md's rule)")
+        ->delimiter(',');
+    diagnose_->add_option("--only", only_, "diagnose with these catalogue effects only")->delimiter(',');
+
+    twin_ = command_->add_subcommand(
+        "twin", "simulated measurements with one effect hidden; the key goes to a separate file");
+    twin_->add_option("--model", model_, "base model YAML")->required();
+    twin_->add_option("--design", design_, "design YAML: experiments, conditions, reach (docs/gap.md)")
+        ->required();
+    twin_->add_option("--out", out_, "the twin's measurements folder")->required();
+    twin_->add_option("--key", key_, "the key file (default <out>.key.json, outside the folder)");
+    auto *which = twin_->add_option_group("effect");
+    which->add_option("--effect", effect_, "the hidden effect (a catalogue name, or crust)");
+    which->add_flag("--random", random_, "a catalogue effect drawn with --seed");
+    which->add_flag("--null", null_, "no effect at all");
+    which->require_option(1);
+    twin_->add_option("--strength", strength_, "its strength (default: drawn from its prior)");
+    twin_->add_option("--seed", seed_, "seed of the beds and the draws");
+    twin_->add_option("--noise", noise_, "relative sd of every sample");
+    twin_->add_option("--level-noise", level_noise_, "relative sd of each trial's level");
+
+    selftest_ = command_->add_subcommand(
+        "selftest", "the diagnosis run blind on twins of every catalogue effect, null twins and "
+                    "an effect outside the catalogue, scored against their keys");
+    selftest_->add_option("--scale", scale_, "ci (minutes) or full (the benchmark)")
+        ->check(CLI::IsMember({"ci", "full"}));
+    selftest_->add_option("--out", out_, "output folder (default out/gap/selftest-<scale>)");
+    selftest_->add_option("--seed", seed_, "seed of the strengths and the twins' beds");
+
+    for (auto *c : {diagnose_, twin_, selftest_}) {
+        c->add_option("--effects", effects_file_, "an effects file added to the catalogue");
+        c->add_option("--sims", sims_, "the simulation cache (a study folder; default <out>/sims)");
+        c->add_option("--jobs", jobs_, "simulations at once (local executor)");
+        c->add_option("--executor", executor_, "local or slurm (docs/study.md)")
+            ->check(CLI::IsMember({"local", "slurm"}));
+        c->add_option("--progress-interval", progress_interval_s_, "seconds between progress lines");
+    }
+
+    import_ = command_->add_subcommand("import", "write a measurements folder from raw data");
+    import_->require_subcommand(1);
+    import_cmu_ = import_->add_subcommand("cmu", "the CMU 3d-terramechanics test bed's plate and wheel tests");
+    import_cmu_->add_option("source", source_, "the data folder (plates/, steady_state_wheel/)")->required();
+    import_cmu_->add_option("--out", out_, "measurements folder to write")->required();
+    import_cmu_->add_option("--sinkage", sinkage_, "synced, authors or deflection_corrected")
+        ->check(CLI::IsMember({"synced", "authors", "deflection_corrected"}));
+    import_cmu_->add_flag("--no-wheels", no_wheels_, "plates only");
+    import_cmu_->add_flag("--no-plates", no_plates_, "wheels only");
+    import_csv_ = import_->add_subcommand("csv", "one CSV file as one experiment (appended)");
+    import_csv_->add_option("file", source_, "CSV file with a header line")->required();
+    import_csv_->add_option("--out", out_, "measurements folder")->required();
+    import_csv_->add_option("--id", csv_id_, "experiment id")->required();
+    import_csv_->add_option("--type", csv_type_, "experiment type (plate_sinkage, direct_shear, ...)")
+        ->required();
+    import_csv_->add_option("--x", csv_x_, "x column and unit, COLUMN:UNIT (none for a scalar)");
+    import_csv_->add_option("--y", csv_y_, "observable, column and unit, OBSERVABLE=COLUMN:UNIT")
+        ->required();
+    import_csv_->add_option("--condition", csv_conditions_, "a condition KEY=VALUE (SI key names)");
+    import_csv_->add_flag("--scatter", csv_scatter_, "one point per row (steady-state tests)");
+}
+
+int GapCommand::run() const {
+    if (diagnose_->parsed())
+        return diagnose();
+    if (twin_->parsed())
+        return twin();
+    if (selftest_->parsed())
+        return selftest();
+    if (import_cmu_->parsed())
+        return importCmu();
+    if (import_csv_->parsed())
+        return importCsv();
+    return 2;
+}
+
+int GapCommand::diagnose() const {
+    const auto t0 = std::chrono::steady_clock::now();
+    const gap::ExperimentSet set = gap::loadExperiments(measurements_);
+    const gap::BaseModel base = gap::loadBaseModel(model_);
+    const gap::EffectCatalogue catalogue = catalogueWith(effects_file_);
+    std::vector<const gap::Effect *> effects;
+    for (const gap::Effect *e : catalogue.diagnosable())
+        if (only_.empty() || std::find(only_.begin(), only_.end(), e->name) != only_.end())
+            effects.push_back(e);
+    for (const std::string &name : only_)
+        catalogue.find(name); // names an unknown effect
+    const std::string out = out_.empty() ? "out/gap/" + set.name : out_;
+    gap::StudySimulator sim(base, sims_.empty() ? out + "/sims" : sims_,
+                            executorOptions(executor_, jobs_, progress_interval_s_));
+    gap::DiagnosisOptions options = diagnosisOptions(base);
+    options.held_out = held_out_;
+    const gap::Diagnosis d = gap::diagnose(set, effects, sim, options);
+    const auto files = gap::writeDiagnosis(d, set, out, shipped("tools/gap_report.py"));
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::printf("%s", gap::reportText(d, set).c_str());
+    std::printf("\nsimulations: %d run now, %d reused from the cache; wall %s\n", sim.runsDone(),
+                sim.runsReused(), duration(wall).c_str());
+    std::printf("written:");
+    for (const auto &f : files)
+        std::printf(" %s/%s", out.c_str(), f.c_str());
+    std::printf("\n");
+    return 0;
+}
+
+int GapCommand::twin() const {
+    const gap::BaseModel base = gap::loadBaseModel(model_);
+    const gap::EffectCatalogue catalogue = catalogueWith(effects_file_);
+    const gap::Design design = gap::loadDesign(design_);
+    gap::StudySimulator sim(base, sims_.empty() ? out_ + ".sims" : sims_,
+                            executorOptions(executor_, jobs_, progress_interval_s_));
+    gap::TwinOptions o;
+    o.seed = seed_;
+    o.noise = noise_;
+    o.level_noise = level_noise_;
+    o.strength = strength_;
+    if (random_) {
+        const auto list = catalogue.diagnosable();
+        std::mt19937 rng(seed_);
+        o.effect = list[std::uniform_int_distribution<std::size_t>(0, list.size() - 1)(rng)]->name;
+    } else if (!null_) {
+        o.effect = effect_;
+    }
+    const std::string key = key_.empty() ? out_ + ".key.json" : key_;
+    gap::makeTwin(design, catalogue, sim, o, out_, key);
+    std::printf("twin written to %s; its key (not to be read by the diagnosis) to %s\n",
+                out_.c_str(), key.c_str());
+    return 0;
+}
+
+int GapCommand::selftest() const {
+    gap::SelftestOptions o;
+    o.scale = scale_;
+    o.out = out_.empty() ? "out/gap/selftest-" + scale_ : out_;
+    o.sims = sims_;
+    o.seed = seed_;
+    o.base_model = shipped("scenarios/gap/selftest-" + scale_ + "/base.yaml");
+    o.design = shipped("scenarios/gap/selftest-" + scale_ + "/design.yaml");
+    o.catalogue = catalogueWith(effects_file_);
+    o.executor = executorOptions(executor_, jobs_, progress_interval_s_);
+    o.plot_tool = shipped("tools/gap_report.py");
+    const gap::SelftestResult r = gap::runSelftest(o);
+    std::printf("%s", r.report.c_str());
+    return r.passed ? 0 : 1;
+}
+
+int GapCommand::importCmu() const {
+    gap::CmuImportOptions o;
+    o.sinkage = sinkage_;
+    o.wheels = !no_wheels_;
+    o.plates = !no_plates_;
+    const auto ids = gap::importCmu(source_, out_, o);
+    std::printf("wrote %s/experiments.yaml: %zu experiments\n", out_.c_str(), ids.size());
+    return 0;
+}
+
+int GapCommand::importCsv() const {
+    gap::CsvImport csv;
+    csv.file = source_;
+    csv.id = csv_id_;
+    csv.type = csv_type_;
+    csv.scatter = csv_scatter_;
+    const auto split = [](const std::string &s, char c) {
+        const auto at = s.find(c);
+        if (at == std::string::npos)
+            throw std::invalid_argument("'" + s + "': expected '" + std::string(1, c) + "'");
+        return std::pair{s.substr(0, at), s.substr(at + 1)};
+    };
+    if (!csv_x_.empty()) {
+        const auto [col, unit] = split(csv_x_, ':');
+        csv.x_column = col;
+        csv.x_unit = unit;
+    }
+    for (const std::string &y : csv_y_) {
+        const auto [obs, rest] = split(y, '=');
+        csv.y[obs] = split(rest, ':');
+    }
+    for (const std::string &c : csv_conditions_) {
+        const auto [k, v] = split(c, '=');
+        csv.conditions[k] = v;
+    }
+    gap::importCsv(csv, out_);
+    std::printf("added experiment '%s' to %s/experiments.yaml\n", csv_id_.c_str(), out_.c_str());
+    return 0;
+}
+
+} // namespace grainlink::apps

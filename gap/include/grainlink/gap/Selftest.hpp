@@ -1,0 +1,50 @@
+#pragma once
+// The blind self-test (docs/gap.md, "Proof on data whose effect is withheld"): twins of every
+// catalogue effect at a strength drawn from its prior, null twins and twins of an effect
+// outside the catalogue, each diagnosed without its key, then scored against it.
+#include "grainlink/gap/Diagnosis.hpp"
+#include "grainlink/gap/Twin.hpp"
+#include "grainlink/study/Study.hpp"
+
+#include <string>
+#include <vector>
+
+namespace grainlink::gap {
+
+struct SelftestOptions {
+    std::string scale = "ci";
+    std::string out, sims;     ///< sims: the shared simulation cache (default out/sims)
+    std::string base_model, design, plan; ///< plan: selftest.yaml (default beside the design)
+    std::string plot_tool;     ///< tools/gap_report.py, for each twin's report.html
+    unsigned seed = 1;
+    EffectCatalogue catalogue;
+    study::ExecutorOptions executor;
+};
+
+struct SelftestTwin {
+    std::string name;       ///< folder name under out/twins
+    TwinKey key;
+    bool weak = false;      ///< the hidden effect stays within the validation uncertainty
+    Diagnosis::Outcome outcome = Diagnosis::Outcome::NoGap;
+    std::string claimed;    ///< the claimed effect ("" none; "a + b" a pair)
+    double claimed_strength = 0.0;
+    bool correct = false;
+    bool strength_within_25 = false;
+    double reduction_pct = 0.0; ///< held-out gap reduction of the claimed model (0 if none)
+    std::string claim;
+};
+
+struct SelftestResult {
+    std::vector<SelftestTwin> twins;
+    std::vector<std::string> failed_twins; ///< twins whose simulations failed, with why
+    std::string line;   ///< "selftest: top-1 A/B (P %), strength within 25 %: C/D, ..."
+    std::string report; ///< the line, the confusion matrix and every twin
+    bool passed = false; ///< every target of docs/gap.md met
+    int top1 = 0, top1_of = 0, strength_ok = 0, strength_of = 0, null_false = 0, nulls = 0,
+        ooc_unexplained = 0, oocs = 0, weak = 0;
+    double median_reduction_pct = 0.0;
+};
+
+SelftestResult runSelftest(const SelftestOptions &options);
+
+} // namespace grainlink::gap

@@ -1,0 +1,76 @@
+#pragma once
+// The diagnosis' simulations as grainlink runs (docs/gap.md, "The base model"): every
+// experiment becomes a lab test of the base model (a plate test, a direct shear box, an angle
+// of repose, a bevameter shear annulus) with its conditions filled in; experiments that share a
+// bed run in one test (plates of several sizes on copies of one settled bed). Each variant x
+// seed x test is one point of a `grainlink study`, cached by its resolved scenario, so a killed
+// diagnosis resumes without redoing finished runs and the same run is never made twice.
+#include "grainlink/gap/Diagnosis.hpp"
+#include "grainlink/study/Study.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <map>
+#include <string>
+#include <vector>
+
+namespace grainlink::gap {
+
+/// The base model file (docs/gap.md): the soil, how each experiment type is simulated, the
+/// simulated container per measured box, and the numerical uncertainty plan.
+struct BaseModel {
+    std::string path;
+    std::string name;
+    YAML::Node soil;                           ///< the DEM soil (docs/scenario.md)
+    std::map<std::string, YAML::Node> tests;   ///< experiment type -> {<lab section>: ..., soil: ...}
+    std::map<std::string, YAML::Node> boxes;   ///< box label -> {soil: ...} merged over the soil
+    int seeds = 3, signature_seeds = 2, check_seeds = 2, threads = 1;
+    std::map<std::string, double> checks;      ///< numerical check -> its factor
+};
+
+/// Reads the base model strictly (unknown keys with file:line); the soil and test sections are
+/// checked by the lab's own readers on every scenario made from them.
+BaseModel loadBaseModel(const std::string &path);
+
+/// The lab test that simulates an experiment type ("bevameter", "direct_shear", ...); throws
+/// naming the type when grainlink cannot simulate it from a base model yet.
+std::string labTestOf(ExperimentType type);
+
+class StudySimulator final : public Simulator {
+public:
+    /// `directory`: the study folder every run goes into (shared by every diagnosis and twin
+    /// that uses it: the cache).
+    StudySimulator(BaseModel base, std::string directory, study::ExecutorOptions executor);
+
+    std::vector<std::string> checks() const override;
+    std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &design,
+                                          const FeatureDesign &features,
+                                          const std::vector<VariantRequest> &requests) override;
+    std::vector<ExperimentSet> probes(const ExperimentSet &design) const override;
+    YAML::Node referenceScenario() const override;
+
+    /// The simulated curves of one variant and seed (measurement effects applied), per
+    /// experiment; what `simulate` turns into features.
+    std::vector<SimulatedCurves> curves(const ExperimentSet &design,
+                                        const std::vector<VariantRequest> &requests,
+                                        std::vector<int> &seeds_of);
+
+    /// The resolved scenario of one test group for one variant and seed (YAML text), as a
+    /// study point runs it.
+    std::string scenarioText(const ExperimentSet &design, const std::vector<std::string> &group,
+                             const VariantRequest &request, int seed) const;
+
+    int runsDone() const { return runs_done_; }
+    int runsReused() const { return runs_reused_; }
+
+private:
+    YAML::Node scenarioNode(const ExperimentSet &design, const std::vector<std::string> &group,
+                            const VariantRequest &request, int seed) const;
+    std::vector<std::vector<std::string>> groups(const ExperimentSet &design) const;
+    BaseModel base_;
+    std::string directory_;
+    study::ExecutorOptions executor_;
+    int runs_done_ = 0, runs_reused_ = 0;
+};
+
+} // namespace grainlink::gap

@@ -1,0 +1,49 @@
+#pragma once
+// Data whose cause is known (docs/gap.md, "Proof on data whose effect is withheld"): a twin is
+// a measurements folder simulated from the base model with one effect hidden in it (or none,
+// or one outside the catalogue), on a design of experiments, with noise; the effect and its
+// strength go to a key file beside the folder that the diagnosis never reads. The self-test
+// runs the diagnosis blind on many twins and scores it against their keys.
+#include "grainlink/gap/Effects.hpp"
+#include "grainlink/gap/StudySimulator.hpp"
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlink::gap {
+
+/// A design: experiments with their conditions and how far each reaches, no data
+/// (design.yaml, docs/gap.md). `repeats` per experiment id.
+struct Design {
+    ExperimentSet set; ///< each experiment with one flat stand-in trial over its reach
+    std::map<std::string, int> repeats;
+};
+Design loadDesign(const std::string &path);
+
+struct TwinKey {
+    std::string effect;       ///< "" for a null twin
+    double strength = 0.0;
+    bool in_catalogue = true;
+    unsigned seed = 0;
+    double noise = 0.0, level_noise = 0.0;
+};
+
+struct TwinOptions {
+    std::string effect;              ///< "" with !random: a null twin
+    std::optional<double> strength;  ///< none: drawn from the prior
+    unsigned seed = 1;               ///< the beds' seeds and the draws
+    double noise = 0.01;             ///< relative sd of every sample
+    double level_noise = 0.02;       ///< relative sd of a trial's level (its calibration)
+};
+
+/// Draws a strength uniformly on the effect's prior (on its own scale).
+double drawStrength(const Effect &effect, unsigned seed);
+
+/// Simulates the twin into `out` (experiments.yaml + data/), writes its key to `key_path`, and
+/// returns the key.
+TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySimulator &simulator,
+                 const TwinOptions &options, const std::string &out, const std::string &key_path);
+
+} // namespace grainlink::gap

@@ -1,0 +1,472 @@
+#include "grainlink/gap/StudySimulator.hpp"
+
+#include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/lab/LabSummary.hpp"
+#include "grainlink/study/ScenarioEdit.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+namespace grainlink::gap {
+
+using config::ConfigNode;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// `over` merged into `target`: mappings key by key, anything else replaced; a key set to
+/// null (`walls: ~`) is removed.
+void mergeInto(YAML::Node target, const YAML::Node &over) {
+    if (!over || over.IsNull())
+        return;
+    if (!over.IsMap() || !target.IsMap()) {
+        target = YAML::Clone(over);
+        return;
+    }
+    for (auto it = over.begin(); it != over.end(); ++it) {
+        const std::string key = it->first.as<std::string>();
+        if (it->second.IsNull()) {
+            target.remove(key);
+            continue;
+        }
+        if (target[key] && target[key].IsMap() && it->second.IsMap())
+            mergeInto(target[key], it->second);
+        else
+            target[key] = YAML::Clone(it->second);
+    }
+}
+
+std::string boxOf(const Experiment &e) {
+    const auto it = e.labels.find("box");
+    return it == e.labels.end() ? "" : it->second;
+}
+
+/// The numbers of a condition over a group, sorted and unique.
+std::vector<double> conditionValues(const ExperimentSet &set, const std::vector<std::string> &ids,
+                                    const std::string &key, double scale) {
+    std::vector<double> v;
+    for (const auto &id : ids) {
+        const Experiment &e = set.find(id);
+        const auto it = e.numbers.find(key);
+        if (it == e.numbers.end())
+            throw std::invalid_argument(e.source + ": experiment '" + id + "' (" +
+                                        typeName(e.type) + ") needs the condition '" + key + "'");
+        v.push_back(it->second * scale);
+    }
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    return v;
+}
+
+YAML::Node flowList(const std::vector<double> &v) {
+    YAML::Node n(YAML::NodeType::Sequence);
+    for (double x : v)
+        n.push_back(x);
+    n.SetStyle(YAML::EmitterStyle::Flow);
+    return n;
+}
+
+/// Every number under `node` times `f` (a radius distribution's sizes).
+void scaleAll(YAML::Node node, double f) {
+    if (node.IsScalar()) {
+        try {
+            node = node.as<double>() * f;
+        } catch (const YAML::Exception &) {
+        }
+    } else if (node.IsSequence()) {
+        for (std::size_t i = 0; i < node.size(); ++i)
+            scaleAll(node[i], f);
+    }
+}
+
+bool close(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b)); }
+
+} // namespace
+
+std::string labTestOf(ExperimentType type) {
+    switch (type) {
+    case ExperimentType::PlateSinkage:
+        return "bevameter";
+    case ExperimentType::BevameterShear:
+        return "bevameter_shear";
+    case ExperimentType::DirectShear:
+        return "direct_shear";
+    case ExperimentType::AngleOfRepose:
+        return "repose";
+    case ExperimentType::WheelSteadyState:
+    case ExperimentType::Mole:
+        break;
+    }
+    throw std::invalid_argument(std::string("grainlink gap cannot simulate ") + typeName(type) +
+                                " experiments from a base model yet (plate_sinkage, "
+                                "bevameter_shear, direct_shear and angle_of_repose it can)");
+}
+
+BaseModel loadBaseModel(const std::string &path) {
+    const ConfigNode root = ConfigNode::loadFile(path);
+    BaseModel b;
+    b.path = path;
+    b.name = root.text("name", "base");
+    b.soil = YAML::Clone(root["soil"].yaml());
+    if (!b.soil.IsMap())
+        root["soil"].fail("the soil is a mapping (docs/scenario.md)");
+    const ConfigNode tests = root["tests"];
+    for (const std::string &type : tests.keys()) {
+        const ConfigNode t = tests[type];
+        ExperimentType et;
+        try {
+            et = parseType(type);
+        } catch (const std::invalid_argument &e) {
+            t.fail(e.what());
+        }
+        std::string section;
+        try {
+            section = labTestOf(et);
+        } catch (const std::invalid_argument &e) {
+            t.fail(e.what());
+        }
+        YAML::Node node;
+        node[section] = YAML::Clone(t[section].yaml());
+        if (t.has("soil"))
+            node["soil"] = YAML::Clone(t["soil"].yaml());
+        if (t.has("probe")) {
+            const ConfigNode probe = t["probe"];
+            (void)probe["conditions"].items();
+            (void)probe["reach"].number();
+            node["probe"] = YAML::Clone(probe.yaml());
+            probe.finish();
+        }
+        t.finish();
+        b.tests[type] = node;
+    }
+    if (const auto boxes = root.optional("boxes"))
+        for (const std::string &label : boxes->keys()) {
+            const ConfigNode box = (*boxes)[label];
+            b.boxes[label] = YAML::Clone(box["soil"].yaml());
+            box.finish();
+        }
+    if (const auto n = root.optional("numerics")) {
+        const auto count = [&](const char *key, int fallback, int lo, int hi) {
+            if (!n->has(key))
+                return fallback;
+            const long long v = (*n)[key].integer();
+            if (v < lo || v > hi)
+                (*n)[key].fail("must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+            return int(v);
+        };
+        b.seeds = count("seeds", 3, 2, 64);
+        b.signature_seeds = count("signature_seeds", 2, 1, 64);
+        b.check_seeds = count("check_seeds", 2, 1, 64);
+        b.threads = count("threads", 1, 1, 256);
+        if (const auto checks = n->optional("checks"))
+            for (const std::string &c : checks->keys()) {
+                static const std::set<std::string> known{"resolution", "time_step", "domain", "rate"};
+                if (!known.count(c))
+                    (*checks)[c].fail("unknown numerical check '" + c +
+                                      "' (resolution, time_step, domain, rate)");
+                const double v = (*checks)[c].number();
+                if (!(v > 0.0) || v == 1.0)
+                    (*checks)[c].fail("a check's factor is > 0 and not 1");
+                b.checks[c] = v;
+            }
+        n->finish();
+    } else {
+        b.checks = {{"resolution", 0.8}, {"time_step", 0.5}};
+    }
+    root.finish();
+    return b;
+}
+
+StudySimulator::StudySimulator(BaseModel base, std::string directory,
+                               study::ExecutorOptions executor)
+    : base_(std::move(base)), directory_(std::move(directory)), executor_(std::move(executor)) {}
+
+std::vector<std::string> StudySimulator::checks() const {
+    std::vector<std::string> c;
+    for (const auto &[name, f] : base_.checks)
+        c.push_back(name);
+    return c;
+}
+
+YAML::Node StudySimulator::referenceScenario() const {
+    YAML::Node r;
+    r["soil"] = YAML::Clone(base_.soil);
+    for (const auto &[type, node] : base_.tests)
+        for (auto it = node.begin(); it != node.end(); ++it) {
+            const std::string k = it->first.as<std::string>();
+            if (k != "soil" && k != "probe")
+                r[k] = YAML::Clone(it->second);
+        }
+    return r;
+}
+
+std::vector<std::vector<std::string>> StudySimulator::groups(const ExperimentSet &design) const {
+    // Experiments of one type in one box share a bed: one lab test runs them all.
+    std::map<std::pair<ExperimentType, std::string>, std::vector<std::string>> g;
+    for (const Experiment &e : design.experiments)
+        g[{e.type, boxOf(e)}].push_back(e.id);
+    std::vector<std::vector<std::string>> out;
+    for (auto &[key, ids] : g)
+        out.push_back(ids);
+    return out;
+}
+
+YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
+                                        const std::vector<std::string> &group,
+                                        const VariantRequest &request, int seed) const {
+    const Experiment &first = design.find(group.front());
+    const std::string type = typeName(first.type);
+    const std::string test = labTestOf(first.type);
+    const auto t = base_.tests.find(type);
+    if (t == base_.tests.end() || !t->second[test])
+        throw std::invalid_argument(base_.path + ": the base model says nothing of how to simulate " +
+                                    type + " experiments (add tests." + type + "." + test +
+                                    ", docs/gap.md)");
+    // A box the base model does not describe is simulated in the base's own container: the
+    // scenario (and so the cached run) is then the same for every such box.
+    const auto box = base_.boxes.find(boxOf(first));
+    const bool own_box = box != base_.boxes.end();
+    YAML::Node root;
+    root["name"] = base_.name + "-" + type + (own_box ? "-" + box->first : "");
+    root["soil"] = YAML::Clone(base_.soil);
+    mergeInto(root["soil"], t->second["soil"]);
+    if (own_box)
+        mergeInto(root["soil"], box->second);
+    YAML::Node section = YAML::Clone(t->second[test]);
+    const FeatureDesign fd = designFeatures(design);
+    double reach = 0.0;
+    for (const auto &id : group)
+        for (const auto &o : design.find(id).observables) {
+            const auto r = fd.x_reach.find(id + "/" + o);
+            if (r != fd.x_reach.end() && std::isfinite(r->second))
+                reach = std::max(reach, r->second);
+        }
+    // Conditions of the experiments, and a reach beyond the measured one: room for a zero
+    // offset (the catalogue's prior: +-2 mm) and a compliant rig's extra travel.
+    if (test == "bevameter") {
+        section["plate_radii_m"] = flowList(conditionValues(design, group, "plate_diameter_m", 0.5));
+        section["max_sinkage_m"] = 1.1 * reach + 0.002;
+    } else if (test == "direct_shear") {
+        section["normal_stresses_Pa"] = flowList(conditionValues(design, group, "normal_stress_Pa", 1.0));
+        section["max_displacement_m"] = 1.1 * reach;
+    } else if (test == "bevameter_shear") {
+        section["normal_pressures_Pa"] = flowList(conditionValues(design, group, "normal_pressure_Pa", 1.0));
+        section["max_shear_displacement_m"] = 1.1 * reach;
+    }
+    root[test] = section;
+    YAML::Node soil = root["soil"];
+    const long long seed0 = soil["deposition"]["seed"] ? soil["deposition"]["seed"].as<long long>() : 1;
+    soil["deposition"]["seed"] = seed0 + seed;
+    soil["simulation"]["threads"] = base_.threads;
+
+    for (auto [effect, strength] : {std::pair{request.effect, request.strength},
+                                    std::pair{request.second, request.second_strength}})
+        if (effect && effect->kind != Effect::Kind::Measurement)
+            root = applyEffect(*effect, strength, root, first.type);
+
+    if (!request.check.empty()) {
+        const double f = base_.checks.at(request.check);
+        YAML::Node s = root["soil"];
+        if (request.check == "resolution") {
+            // Grains f times the size, the same solid volume, a time step f times as long.
+            YAML::Node r = s["deposition"]["radius"];
+            for (const char *k : {"value_m", "min_m", "max_m", "radii_m"})
+                if (r[k])
+                    scaleAll(r[k], f);
+            s["deposition"]["count"] = std::llround(s["deposition"]["count"].as<double>() / (f * f * f));
+            s["simulation"]["time_step_s"] = s["simulation"]["time_step_s"].as<double>() * f;
+        } else if (request.check == "time_step") {
+            s["simulation"]["time_step_s"] = s["simulation"]["time_step_s"].as<double>() * f;
+        } else if (request.check == "domain") {
+            Effect domain;
+            domain.kind = Effect::Kind::Builtin;
+            domain.builtin = "domain_size";
+            root = applyEffect(domain, f, root, first.type);
+        } else if (request.check == "rate") {
+            YAML::Node sec = root[test];
+            for (const char *k : {"speed_m_s", "shear_speed_m_s", "angular_speed_rad_s", "lift_speed_m_s"})
+                if (sec[k])
+                    sec[k] = sec[k].as<double>() * f;
+            if (sec["sample_interval_s"])
+                sec["sample_interval_s"] = sec["sample_interval_s"].as<double>() / f;
+        }
+    }
+    return root;
+}
+
+std::string StudySimulator::scenarioText(const ExperimentSet &design,
+                                         const std::vector<std::string> &group,
+                                         const VariantRequest &request, int seed) const {
+    return study::emitYaml(scenarioNode(design, group, request, seed));
+}
+
+std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
+                                                    const std::vector<VariantRequest> &requests,
+                                                    std::vector<int> &seeds_of) {
+    const auto gs = groups(design);
+    // Every (request, seed, group) is a point; equal scenarios are one point.
+    study::Study st;
+    st.name = "gap";
+    st.directory = directory_;
+    std::map<std::string, std::size_t> index; // point id -> position in st.points
+    struct Slot {
+        std::size_t request;
+        int seed;
+        std::size_t group;
+        std::size_t point;
+    };
+    std::vector<Slot> slots;
+    for (std::size_t r = 0; r < requests.size(); ++r)
+        for (int s = 0; s < requests[r].seeds; ++s)
+            for (std::size_t g = 0; g < gs.size(); ++g) {
+                const Experiment &e = design.find(gs[g].front());
+                const study::Point p = study::makePoint(
+                    study::standardKind("lab", labTestOf(e.type)),
+                    scenarioText(design, gs[g], requests[r], requests[r].seed_offset + s),
+                    requests[r].label + " seed " + std::to_string(s) + " " + gs[g].front());
+                auto [it, fresh] = index.try_emplace(p.id, st.points.size());
+                if (fresh)
+                    st.points.push_back(p);
+                slots.push_back({r, s, g, it->second});
+            }
+    const auto results = study::run(st, executor_);
+    for (const auto &res : results)
+        (res.ran_now ? runs_done_ : runs_reused_)++;
+
+    // Parse each finished point once.
+    std::vector<std::optional<lab::LabSummary>> summaries(results.size());
+    for (std::size_t i = 0; i < results.size(); ++i) {
+        if (results[i].status != study::PointStatus::Done) {
+            std::fprintf(stderr, "[gap] run %s (%s) %s: %s; log %s; its features are missing\n",
+                         results[i].point.id.c_str(), results[i].point.label.c_str(),
+                         results[i].status == study::PointStatus::Failed ? "failed" : "unfinished",
+                         results[i].error.c_str(), results[i].log.c_str());
+            continue;
+        }
+        summaries[i] = lab::labSummaryFromJson(results[i].summary.dump(), results[i].folder);
+    }
+    std::vector<SimulatedCurves> out;
+    seeds_of.clear();
+    for (std::size_t r = 0; r < requests.size(); ++r)
+        for (int s = 0; s < requests[r].seeds; ++s) {
+            SimulatedCurves c;
+            for (const Slot &slot : slots) {
+                if (slot.request != r || slot.seed != s || !summaries[slot.point])
+                    continue;
+                const lab::LabSummary &sum = *summaries[slot.point];
+                for (const std::string &id : gs[slot.group]) {
+                    const Experiment &e = design.find(id);
+                    Curve curve;
+                    const auto pick = [&](const char *value_key, double want, const char *x,
+                                          const char *y) {
+                        for (const auto &run : sum.runs)
+                            if (close(run.value(value_key), want)) {
+                                curve.x = run.curve(x);
+                                curve.y = run.curve(y);
+                            }
+                    };
+                    switch (e.type) {
+                    case ExperimentType::PlateSinkage:
+                        pick("plate_radius_m", 0.5 * e.numbers.at("plate_diameter_m"), "sinkage_m",
+                             "pressure_Pa");
+                        break;
+                    case ExperimentType::DirectShear:
+                        pick("target_normal_stress_Pa", e.numbers.at("normal_stress_Pa"),
+                             "displacement_m", "shear_stress_Pa");
+                        break;
+                    case ExperimentType::BevameterShear:
+                        pick("target_pressure_Pa", e.numbers.at("normal_pressure_Pa"),
+                             "shear_displacement_m", "shear_stress_Pa");
+                        break;
+                    case ExperimentType::AngleOfRepose:
+                        for (const auto &fit : sum.fits)
+                            if (fit.law == "repose")
+                                curve = Curve{{0.0}, {sum.fitted("repose", "angle").value}};
+                        if (curve.empty())
+                            curve = Curve{{0.0}, {kNaN}}; // the grains spread: no heap
+                        break;
+                    default:
+                        break;
+                    }
+                    const std::string &obs = e.observables.front();
+                    for (auto [effect, strength] :
+                         {std::pair{requests[r].effect, requests[r].strength},
+                          std::pair{requests[r].second, requests[r].second_strength}})
+                        if (effect && effect->kind == Effect::Kind::Measurement)
+                            curve = applyMeasurementEffect(*effect, strength, e, obs, curve);
+                    c[id][obs] = curve;
+                }
+            }
+            out.push_back(std::move(c));
+            seeds_of.push_back(s);
+        }
+    return out;
+}
+
+std::vector<Eigen::MatrixXd> StudySimulator::simulate(const ExperimentSet &design,
+                                                      const FeatureDesign &features,
+                                                      const std::vector<VariantRequest> &requests) {
+    std::vector<int> seeds;
+    const auto all = curves(design, requests, seeds);
+    std::vector<Eigen::MatrixXd> out;
+    std::size_t k = 0;
+    for (const VariantRequest &r : requests) {
+        Eigen::MatrixXd rows(r.seeds, Eigen::Index(features.size()));
+        for (int s = 0; s < r.seeds; ++s)
+            rows.row(s) = simulatedFeatures(design, features, all[k++]).transpose();
+        out.push_back(rows);
+    }
+    return out;
+}
+
+std::vector<ExperimentSet> StudySimulator::probes(const ExperimentSet &design) const {
+    std::set<std::string> present;
+    for (const Experiment &e : design.experiments)
+        present.insert(typeName(e.type));
+    std::vector<ExperimentSet> out;
+    for (const auto &[type, node] : base_.tests) {
+        if (present.count(type) || !node["probe"])
+            continue;
+        ExperimentSet p;
+        p.name = type + " (" + std::to_string(node["probe"]["conditions"].size()) + " conditions)";
+        p.directory = base_.path;
+        int k = 0;
+        for (const auto &cond : node["probe"]["conditions"]) {
+            Experiment e;
+            e.id = "probe_" + type + "_" + std::to_string(k++);
+            e.type = parseType(type);
+            e.source = base_.path + ": tests." + type + ".probe";
+            for (auto it = cond.begin(); it != cond.end(); ++it) {
+                const std::string key = it->first.as<std::string>();
+                try {
+                    e.numbers[key] = it->second.as<double>();
+                } catch (const YAML::Exception &) {
+                    e.labels[key] = it->second.as<std::string>();
+                }
+            }
+            // A flat stand-in trial over the probe's reach: it only sets the bins.
+            const double reach = node["probe"]["reach"].as<double>();
+            if (e.type == ExperimentType::PlateSinkage) {
+                e.x_name = "sinkage_m", e.observables = {"pressure_Pa"};
+            } else if (e.type == ExperimentType::DirectShear || e.type == ExperimentType::BevameterShear) {
+                e.x_name = "shear_displacement_m", e.observables = {"shear_stress_Pa"};
+            } else {
+                e.x_name = "", e.observables = {"angle_deg"};
+            }
+            Trial t;
+            t.curves[e.observables[0]] = e.x_name.empty() ? Curve{{0.0}, {0.0}} : Curve{{0.0, reach}, {0.0, 0.0}};
+            e.trials.push_back(t);
+            p.experiments.push_back(e);
+        }
+        out.push_back(p);
+    }
+    return out;
+}
+
+} // namespace grainlink::gap
