@@ -51,7 +51,10 @@ void collect(YAML::Node node, const std::vector<std::string> &parts, std::size_t
         collect(node[p], parts, i + 1, create, out);
         return;
     }
-    if (create && (node.IsMap() || node.IsNull())) {
+    // Missing steps are created, except a list a wildcard would walk: `*` names only the items
+    // there are (a test without walls gets no walls).
+    const bool before_wildcard = i + 1 < parts.size() && parts[i + 1] == "*";
+    if (create && !before_wildcard && (node.IsMap() || node.IsNull())) {
         node[p] = YAML::Node(YAML::NodeType::Map);
         collect(node[p], parts, i + 1, create, out);
     }

@@ -84,6 +84,10 @@ TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off"
 
     const YAML::Node wall = applyEffect(c.find("wall_friction"), 0.25, base, ExperimentType::PlateSinkage);
     CHECK(wall["soil"]["walls"][0]["friction_coefficient"].as<double>() == Approx(0.25));
+    // A wildcard path edits the walls there are; a test without walls gets none.
+    YAML::Node wall_less = YAML::Clone(base);
+    wall_less["soil"].remove("walls");
+    CHECK_FALSE(applyEffect(c.find("wall_friction"), 0.25, wall_less, ExperimentType::DirectShear)["soil"]["walls"]);
     const YAML::Node tool = applyEffect(c.find("tool_friction"), 0.5, base, ExperimentType::DirectShear);
     CHECK_FALSE(tool["bevameter"]["plate_friction_coefficient"]); // only for plate tests
 }
