@@ -67,10 +67,11 @@ NodesInScenario nodesIn(const config::ConfigNode &root) {
     return nodes;
 }
 
-CoordinatorConfig configFor(const CoupledRunOptions &options, const char *default_endpoint) {
+} // namespace
+
+CoordinatorConfig checkedCoupledConfig(const config::ConfigNode &root) {
     // The coupling sections, and the participants' own sections checked up front, so a typo
     // stops the run before any process starts.
-    const auto root = config::ConfigNode::loadFile(options.config_path);
     CoordinatorConfig config = coupling::coordinatorConfigFrom(root);
     const NodesInScenario nodes = nodesIn(root);
     for (const auto &section : nodes.soil_sections)
@@ -81,10 +82,18 @@ CoordinatorConfig configFor(const CoupledRunOptions &options, const char *defaul
     if (const auto rig = root.optional("rig"))
         mbs::parseSingleWheelRig(*rig);
     else if (nodes.simbody)
-        makeModel(root, options.config_path); // builds it once: every model error shows now
+        makeModel(root, root.file()); // builds it once: every model error shows now
     if (const auto test = root.optional("wheel_test"))
         mbs::parseWheelTest(*test);
     root.finish();
+    return config;
+}
+
+namespace {
+
+CoordinatorConfig configFor(const CoupledRunOptions &options, const char *default_endpoint) {
+    CoordinatorConfig config =
+        checkedCoupledConfig(config::ConfigNode::loadFile(options.config_path));
     if (!options.endpoint.empty())
         config.endpoint = options.endpoint;
     if (config.endpoint.empty())

@@ -1,5 +1,8 @@
 #pragma once
 // The coupling subcommands of `grainlink`: coordinator, run, keygen.
+#include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/coupling/Coordinator.hpp"
+
 #include <string>
 #include <vector>
 
@@ -14,6 +17,9 @@ struct CoupledRunOptions {
     double progress_interval_s = 5.0;
 };
 
+/// A coupled scenario's coordinator configuration, with every participant's own section read
+/// too (`grainlink run` and `grainlink study` check a file with it before starting anything).
+coupling::CoordinatorConfig checkedCoupledConfig(const config::ConfigNode &root);
 /// `grainlink coordinator`: only the coordinator; every participant is started by the user.
 int runCoordinator(const CoupledRunOptions &options);
 /// `grainlink run`: the coordinator plus the participant processes the file names.

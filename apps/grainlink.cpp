@@ -2,6 +2,7 @@
 #include "CouplingCommands.hpp"
 #include "LabCommands.hpp"
 #include "Nodes.hpp"
+#include "StudyCommand.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 
 #include <CLI/CLI.hpp>
@@ -141,6 +142,8 @@ int main(int argc, char **argv) {
                          "the scenario section of its bed (default soil; one per soil node when "
                          "several share the bodies)");
 
+    grainlink::apps::StudyCommand study(app);
+
     CLI11_PARSE(app, argc, argv);
     try {
         if (dem->parsed()) {
@@ -168,6 +171,8 @@ int main(int argc, char **argv) {
             return grainlink::apps::runSoilTable(table_options);
         } else if (lab->parsed()) {
             return grainlink::apps::runLab(lab_options);
+        } else if (study.parsed()) {
+            return study.run();
         } else if (keygen->parsed()) {
             return grainlink::apps::generateKeys(key_directory, key_names);
         }

@@ -4,18 +4,55 @@
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/VtkWriter.hpp"
 
+#include <nlohmann/json.hpp>
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 namespace grainlink::dem {
 
 namespace fs = std::filesystem;
 
-namespace {} // namespace
+namespace {
+
+/// An exclusive flock on a packing's lock file for the lifetime of the object; says so when
+/// another process holds it (that process is settling the same packing).
+class PackingLock {
+public:
+    explicit PackingLock(const std::string &path)
+        : fd_(open(path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644)) {
+        if (fd_ < 0)
+            throw std::runtime_error("cannot open the packing cache's lock file '" + path + "'");
+        if (flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+            std::fprintf(stderr,
+                         "[deposition] another process is settling this packing: "
+                         "waiting for it (%s)\n",
+                         path.c_str());
+            while (flock(fd_, LOCK_EX) != 0)
+                if (errno != EINTR)
+                    throw std::runtime_error("cannot lock '" + path + "'");
+        }
+    }
+    ~PackingLock() { close(fd_); }
+    PackingLock(const PackingLock &) = delete;
+    PackingLock &operator=(const PackingLock &) = delete;
+
+private:
+    int fd_;
+};
+
+} // namespace
 
 double bedSurface(const ParticleStore &p) {
     if (p.empty())
@@ -46,13 +83,25 @@ std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progr
         scenario.packing_cache_directory.empty()
             ? fs::path()
             : fs::path(scenario.packing_cache_directory) / ("packing-" + key + ".bin");
-    if (!cache.empty() && fs::exists(cache)) {
+    const auto readCached = [&] {
         readCheckpoint(*sys, cache.string());
         if (from_cache)
             *from_cache = true;
         std::fprintf(stderr, "[deposition] reusing cached packing %s (%zu particles)\n",
                      cache.c_str(), sys->particles().size());
         return runLaw();
+    };
+    // A complete packing file is only ever renamed into place, so it can be read unlocked.
+    // Check, settle and write happen under the packing's lock: two processes needing the same
+    // packing at once settle it once, the second reads what the first wrote.
+    std::optional<PackingLock> lock;
+    if (!cache.empty()) {
+        if (fs::exists(cache))
+            return readCached();
+        fs::create_directories(cache.parent_path());
+        lock.emplace(cache.string() + ".lock");
+        if (fs::exists(cache))
+            return readCached();
     }
     Progress progress("deposition", progress_interval_s);
     const auto report = deposit(*sys, scenario.deposition, [&](const DepositionReport &r) {
@@ -66,8 +115,14 @@ std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progr
                  report.inserted, report.settled ? "" : "NOT (time limit)", report.settle_time_s,
                  report.final_kinetic_energy_per_particle_J);
     if (!cache.empty()) {
-        fs::create_directories(cache.parent_path());
-        writeCheckpoint(*sys, cache.string());
+        writeCheckpoint(*sys, cache.string()); // through a temporary file and a rename
+        // Go on from the packing as stored, as every later run of it does: the settled system
+        // in memory differs from a restored one in round-off (a study's points would depend on
+        // which of them settled the packing).
+        sys = makeSystem(scenario);
+        if (settling_rolling)
+            sys->setRolling(*settling_rolling);
+        readCheckpoint(*sys, cache.string());
     }
     if (from_cache)
         *from_cache = false;
@@ -88,8 +143,15 @@ std::string seriesHeader(const DemSystem &sys) {
     return h;
 }
 
-/// One row; body forces are averaged over the interval since the last row (impulse / time).
-std::string seriesRow(DemSystem &sys, double run_time_s) {
+/// A body's force and torque averaged over one series interval.
+struct BodyLoad {
+    Vec3 force_N = Vec3::Zero();
+    Vec3 torque_N_m = Vec3::Zero();
+};
+
+/// One row; body forces are averaged over the interval since the last row (impulse / time),
+/// and kept in `loads` for the summary.
+std::string seriesRow(DemSystem &sys, double run_time_s, std::vector<BodyLoad> &loads) {
     sys.prepare(); // contacts are counted from the neighbour list
     const Energies e = sys.energies();
     std::ostringstream row;
@@ -106,6 +168,8 @@ std::string seriesRow(DemSystem &sys, double run_time_s) {
             << s.velocity_m_s.x() << ',' << s.velocity_m_s.z() << ','
             << s.angular_velocity_rad_s.y() << ',' << f.x() << ',' << f.y() << ',' << f.z() << ','
             << t.x() << ',' << t.y() << ',' << t.z();
+        loads.resize(std::size_t(sys.bodyCount()));
+        loads[std::size_t(b)] = {f, t};
         body.resetAccumulatedImpulse();
     }
     return row.str();
@@ -165,9 +229,39 @@ std::vector<RigidBodyState> startPoses(const DemSystem &sys, const DemScenario &
     return starts;
 }
 
+nlohmann::json vector(const Vec3 &v) {
+    return {v.x(), v.y(), v.z()};
+}
+
+/// The run's machine-readable summary (a study's observables, docs/scenario.md): written
+/// last, so its presence means the run finished.
+void writeSummaryJson(const DemSystem &sys, const DemScenario &scenario, const RunSummary &summary,
+                      const std::vector<BodyLoad> &loads, double wall_s, const std::string &path) {
+    nlohmann::json j = {{"scenario", scenario.name},
+                        {"particles", summary.particles},
+                        {"steps", summary.steps},
+                        {"final_time_s", sys.time()},
+                        {"run_time_s", summary.simulated_s},
+                        {"wall_s", wall_s},
+                        {"bodies", nlohmann::json::object()}};
+    for (int b = 0; b < sys.bodyCount(); ++b) {
+        const RigidBodyState &s = sys.body(b).state();
+        const BodyLoad load = std::size_t(b) < loads.size() ? loads[std::size_t(b)] : BodyLoad{};
+        j["bodies"][sys.body(b).name()] = {{"position_m", vector(s.position_m)},
+                                           {"velocity_m_s", vector(s.velocity_m_s)},
+                                           {"force_N", vector(load.force_N)},
+                                           {"torque_N_m", vector(load.torque_N_m)}};
+    }
+    std::ofstream file(path, std::ios::trunc);
+    file << j.dump(2) << '\n';
+    if (!file)
+        throw std::runtime_error("cannot write '" + path + "'");
+}
+
 } // namespace
 
 RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
+    const auto started = std::chrono::steady_clock::now();
     RunSummary summary;
     const fs::path out = options.output_directory;
     fs::create_directories(out);
@@ -229,11 +323,12 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
             times.push_back(extras.at("snapshot" + std::to_string(k) + "_s"));
         vtk.resumeAt(int(times.size()), times);
     }
+    std::vector<BodyLoad> loads;
     std::ofstream series(series_path, std::ios::app);
     if (!series)
         throw std::runtime_error("cannot write '" + series_path + "'");
     if (!options.resume)
-        series << seriesHeader(*sys) << '\n' << seriesRow(*sys, 0.0) << '\n';
+        series << seriesHeader(*sys) << '\n' << seriesRow(*sys, 0.0, loads) << '\n';
     if (!options.resume && steps_per_snapshot)
         vtk.write(*sys, 0.0);
 
@@ -255,7 +350,7 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
             sys->step();
             const std::uint64_t done = sys->stepCount() - run_start_step;
             if (done % steps_per_row == 0) {
-                series << seriesRow(*sys, double(done) * dt) << '\n';
+                series << seriesRow(*sys, double(done) * dt, loads) << '\n';
                 series.flush();
                 ++rows;
                 if (rows_per_checkpoint && rows % rows_per_checkpoint == 0)
@@ -298,6 +393,10 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
          << sys->timer().table();
     std::fprintf(stderr, "%s", text.str().c_str());
     std::ofstream(out / "summary.txt") << text.str();
+    writeSummaryJson(
+        *sys, scenario, summary, loads,
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - started).count(),
+        (out / "summary.json").string());
     return summary;
 }
 

@@ -48,6 +48,8 @@ public:
     std::string choice(const std::vector<std::string> &choices) const;
     Vec3 vec3() const;
     std::vector<double> numbers() const;
+    /// The value as YAML, unchecked (a study copies values into scenarios).
+    const YAML::Node &yaml() const { return node_; }
 
     double number(const std::string &key, double fallback) const;
     std::string text(const std::string &key, const std::string &fallback) const;

@@ -1,0 +1,23 @@
+#pragma once
+// A study file (docs/study.md): a base scenario, the keys to vary (full factorial or zipped),
+// replicates over deposition seeds, and the observables; turned into the study's points.
+#include "grainlink/study/Study.hpp"
+
+#include <functional>
+#include <optional>
+#include <string>
+
+namespace grainlink::study {
+
+struct DesignOptions {
+    std::optional<int> threads; ///< `--threads`: every point's thread count (kind.threads_key)
+    /// The kinds a study file may name; the `grainlink` command adds the coupled run's reader.
+    std::function<Kind(const std::string &kind, const std::string &test)> kind_of = standardKind;
+};
+
+/// Reads the study file and makes its points (not validated yet: `run` does that first).
+/// Errors name the study file, the key and the line.
+Study loadStudy(const std::string &path, const std::string &directory,
+                const DesignOptions &options = {});
+
+} // namespace grainlink::study

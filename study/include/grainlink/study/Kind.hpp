@@ -1,0 +1,26 @@
+#pragma once
+// What kind of run a study point is: the `grainlink` subcommand that runs it, the summary file
+// it leaves, where its thread count and deposition seed live, and the parser that checks it.
+#include "grainlink/config/ConfigNode.hpp"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace grainlink::study {
+
+struct Kind {
+    std::string name;                 ///< "dem", "run", "lab direct_shear", ...
+    std::vector<std::string> command; ///< words after `grainlink`: {"lab", "direct_shear"}
+    std::string summary_file;         ///< machine-readable result in the run's output folder
+    std::string threads_key;          ///< dotted path of the scenario's thread count
+    std::string seed_key;             ///< dotted path replicates vary by default
+    /// The run's own scenario reader, called in-process; throws config::ConfigError.
+    std::function<void(const config::ConfigNode &root)> validate;
+};
+
+/// `dem`, `run` or `lab` with its `test` (bevameter, repose, direct_shear, bevameter_shear).
+/// `run` has no validator here: its reader lives in the `grainlink` command, which sets it.
+Kind standardKind(const std::string &kind, const std::string &test = "");
+
+} // namespace grainlink::study

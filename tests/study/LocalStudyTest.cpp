@@ -1,0 +1,224 @@
+// Studies through the local pool, end to end with real `grainlink dem` runs: results do not
+// depend on the pool size or the order, runs with one soil setup share one packing, a failed
+// point is reported and not retried unless asked, and a killed study resumes where it was.
+#include "StudyFixtures.hpp"
+
+#include "grainlink/study/Design.hpp"
+#include "grainlink/study/ResultTable.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <map>
+
+using namespace grainlink::study;
+using namespace grainlink::study::test;
+using nlohmann::json;
+
+namespace {
+
+ExecutorOptions localPool(int jobs, const TempFolder &folder) {
+    ExecutorOptions options;
+    options.grainlink = kGrainlink;
+    options.jobs = jobs;
+    options.working_directory = folder.path.string(); // its packings/ cache starts empty
+    options.progress_interval_s = 0.5;
+    return options;
+}
+
+std::map<std::string, PointResult> byId(const std::vector<PointResult> &results) {
+    std::map<std::string, PointResult> out;
+    for (const PointResult &r : results)
+        out[r.point.id] = r;
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("a point's result depends on neither the pool size nor the order, and one packing per "
+          "soil setup",
+          "[study][local]") {
+    TempFolder one("pool1"), two("pool2");
+    const Study serial = loadStudy(kData + "/sweep.yaml", one / "study");
+    Study parallel = loadStudy(kData + "/sweep.yaml", two / "study");
+    std::reverse(parallel.points.begin(), parallel.points.end());
+    std::vector<StudyProgress> progress;
+    ExecutorOptions two_jobs = localPool(2, two);
+    two_jobs.progress = [&](const StudyProgress &p) { progress.push_back(p); };
+    const auto a = byId(run(serial, localPool(1, one)));
+    const auto b = byId(run(parallel, two_jobs));
+    REQUIRE(a.size() == 4);
+    REQUIRE(b.size() == 4);
+    for (const auto &[id, r] : a) {
+        INFO(r.point.label);
+        REQUIRE(r.status == PointStatus::Done);
+        REQUIRE(b.at(id).status == PointStatus::Done);
+        CHECK(r.ran_now);
+        CHECK(readFile(r.folder + "/series.csv") == readFile(b.at(id).folder + "/series.csv"));
+        CHECK(withoutWallTime(r.summary) == withoutWallTime(b.at(id).summary));
+        CHECK(r.summary.at("steps") == 1200);
+    }
+    REQUIRE_FALSE(progress.empty());
+    CHECK(progress.back().done == 4);
+    CHECK(progress.back().running == 0);
+
+    // Two seeds, two plate speeds: each packing settled once, the other run of it reads it.
+    for (const auto *results : {&a, &b}) {
+        int settled = 0, reused = 0;
+        for (const auto &[id, r] : *results) {
+            const std::string log = readFile(r.log);
+            settled += count(log, "particles, settled");
+            reused += count(log, "reusing cached packing");
+        }
+        CHECK(settled == 2);
+        CHECK(reused == 2);
+    }
+
+    // The table's means are the replicates' means of the points' own summaries.
+    const TableFiles files = writeTables(serial, run(serial, localPool(1, one)));
+    CHECK(files.warnings.empty());
+    std::map<std::string, std::vector<double>> forces;
+    for (const auto &[id, r] : a)
+        forces[r.point.settings[0].second].push_back(
+            r.summary["bodies"]["plate"]["force_N"][2].get<double>());
+    const std::string table = readFile(files.table_csv);
+    for (const auto &[speed, values] : forces) {
+        char mean[40];
+        std::snprintf(mean, sizeof mean, "%.10g", (values[0] + values[1]) / 2.0);
+        INFO(table);
+        CHECK_THAT(table, Catch::Contains("\"" + speed + "\",2,2," + mean + ","));
+    }
+
+    // The plot script reads the same table: one panel per observable and varied key.
+    std::string plotted;
+    REQUIRE(runToEnd({"/usr/bin/python3", kSource + "/tools/plot_study.py", one / "study"},
+                     one.path.string(), plotted) == 0);
+    CHECK_THAT(plotted, Catch::Contains("2 observables x 1 varied key, 2 design points"));
+    CHECK(fs::exists(one / "study/study.png"));
+}
+
+TEST_CASE("a failed point is reported with its error and log while the others go on, and it is "
+          "rerun only when asked",
+          "[study][local]") {
+    TempFolder folder("failed");
+    // An overlap limit no settling bed keeps: a valid scenario whose run stops.
+    writeFile(folder / "failing.yaml",
+              "name: failing\nbase: {kind: dem, scenario: " + kData +
+                  "/plate.yaml}\n"
+                  "design:\n  vary:\n"
+                  "    - {key: simulation.max_overlap_ratio, values: [0.4, 1.0e-6]}\n"
+                  "observables: [final_time_s]\n");
+    const Study s = loadStudy(folder / "failing.yaml", folder / "study");
+    const std::vector<PointResult> first = run(s, localPool(1, folder));
+    REQUIRE(first.size() == 2);
+    CHECK(first[0].status == PointStatus::Done);
+    REQUIRE(first[1].status == PointStatus::Failed);
+    CHECK_THAT(first[1].error, Catch::Contains("exit code 1: grainlink: error:"));
+    CHECK_THAT(first[1].error, Catch::Contains("overlap"));
+    CHECK(first[1].log == folder / ("study/points/" + first[1].point.id + ".failed/log.txt"));
+    CHECK_THAT(readFile(first[1].log), Catch::Contains("overlap"));
+    CHECK_FALSE(fs::exists(folder / ("study/points/" + first[1].point.id)));
+
+    const std::vector<PointResult> again = run(s, localPool(1, folder));
+    CHECK(again[1].status == PointStatus::Failed);
+    CHECK_FALSE(again[1].ran_now);
+    CHECK_FALSE(again[0].ran_now);
+    ExecutorOptions retry = localPool(1, folder);
+    retry.retry_failed = true;
+    const std::vector<PointResult> retried = run(s, retry);
+    CHECK(retried[1].status == PointStatus::Failed);
+    CHECK(retried[1].ran_now);
+    CHECK_FALSE(retried[0].ran_now);
+}
+
+TEST_CASE("a study killed mid-run, started again, runs only the unfinished points and leaves "
+          "the finished ones as they were",
+          "[study][local]") {
+    TempFolder folder("resume");
+    writeFile(folder / "six.yaml",
+              "name: six\nbase: {kind: dem, scenario: " + kData +
+                  "/plate.yaml}\n"
+                  "design:\n  vary:\n"
+                  "    - {key: bodies.0.motion.0.velocity_m_s, values: [[0, 0, -0.1], "
+                  "[0, 0, -0.05]]}\n"
+                  "  replicates: 3\nobservables: [bodies.plate.force_N.2]\n");
+    const std::vector<std::string> command{
+        kGrainlink, "study", folder / "six.yaml", "--out", folder / "study", "--jobs", "1"};
+    const fs::path study = folder / "study";
+    std::map<std::string, std::map<std::string, std::string>> before; // id: file: bytes
+    {
+        Process killed(command, folder.path, folder / "killed.log");
+        REQUIRE(waitUntil([&] { return finishedPoints(study).size() >= 2; }, 60.0));
+        kill(killed.pid(), SIGKILL);
+        killed.wait();
+    }
+    // Its running point's process died with it (nothing is written after the kill).
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    const std::vector<std::string> finished = finishedPoints(study);
+    REQUIRE(finished.size() < 6);
+    for (const std::string &id : finished)
+        for (const auto &e : fs::directory_iterator(study / "points" / id))
+            before[id][e.path().filename().string()] = readFile(e.path());
+
+    std::string output;
+    REQUIRE(runToEnd(command, folder.path.string(), output) == 0);
+    INFO(output);
+    CHECK_THAT(output, Catch::Contains("6 points: 6 done (" + std::to_string(6 - finished.size()) +
+                                       " run now), 0 failed, 0 unfinished"));
+    CHECK(finishedPoints(study).size() == 6);
+    for (const auto &[id, files] : before)
+        for (const auto &[name, bytes] : files) {
+            INFO(id << "/" << name);
+            CHECK(readFile(study / "points" / id / name) == bytes); // log and wall time too
+        }
+    for (const auto &e : fs::directory_iterator(study / "points"))
+        CHECK(e.path().filename().string().find(".tmp-") == std::string::npos);
+}
+
+namespace {
+
+/// The child processes of `pid` (every thread's), from /proc.
+std::vector<pid_t> childrenOf(pid_t pid) {
+    std::vector<pid_t> children;
+    const fs::path tasks = "/proc/" + std::to_string(pid) + "/task";
+    std::error_code missing;
+    for (const auto &task : fs::directory_iterator(tasks, missing)) {
+        std::ifstream in(task.path() / "children");
+        for (pid_t child; in >> child;)
+            children.push_back(child);
+    }
+    return children;
+}
+
+} // namespace
+
+TEST_CASE("a run killed from outside leaves its point unfinished while the study goes on; the "
+          "next start runs just that point",
+          "[study][local]") {
+    TempFolder folder("killed-run");
+    // The test scenario with a longer run (the plate rests after 0.12 s), so its process is
+    // there to be killed.
+    std::string scenario = readFile(kData + "/plate.yaml");
+    const std::string run = "run: {duration_s: 0.12}";
+    scenario.replace(scenario.find(run), run.size(), "run: {duration_s: 0.8}");
+    writeFile(folder / "plate.yaml", scenario);
+    writeFile(folder / "three.yaml", "name: three\nbase: {kind: dem, scenario: plate.yaml}\n"
+                                     "design:\n  replicates: 3\n"
+                                     "observables: [bodies.plate.force_N.2]\n");
+    const std::vector<std::string> command{
+        kGrainlink, "study", folder / "three.yaml", "--out", folder / "study", "--jobs", "1"};
+    Process study(command, folder.path, folder / "first.log");
+    std::vector<pid_t> runs;
+    REQUIRE(waitUntil([&] { return !(runs = childrenOf(study.pid())).empty(); }, 30.0));
+    REQUIRE(runs.size() == 1);
+    kill(runs[0], SIGKILL);
+    CHECK(study.wait() == 0); // the others went on; nothing failed
+    const std::string first = readFile(folder / "first.log");
+    INFO(first);
+    CHECK_THAT(first, Catch::Contains("3 points: 2 done (2 run now), 0 failed, 1 unfinished"));
+    CHECK_THAT(first, Catch::Contains("interrupted (killed by signal 9"));
+
+    std::string output;
+    REQUIRE(runToEnd(command, folder.path.string(), output) == 0);
+    CHECK_THAT(output, Catch::Contains("3 points: 3 done (1 run now), 0 failed, 0 unfinished"));
+}
