@@ -1,6 +1,8 @@
 #include "Codec.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace grainlink::coupling::codec {
 
@@ -58,13 +60,13 @@ BodyDescription fromWire(const pb::BodyDescription &body) {
                               body.mesh().triangle_indices().end());
         if (mesh.triangles.size() % 3 != 0)
             throw ProtocolError(pb::Error::CODE_MALFORMED,
-                                "body '" + body.name() + "': triangle index count " +
+                                "body '" + printable(body.name()) + "': triangle index count " +
                                     std::to_string(mesh.triangles.size()) +
                                     " is not a multiple of 3");
         for (auto i : mesh.triangles)
             if (i >= mesh.vertices_m.size())
                 throw ProtocolError(pb::Error::CODE_MALFORMED,
-                                    "body '" + body.name() + "': triangle index " +
+                                    "body '" + printable(body.name()) + "': triangle index " +
                                         std::to_string(i) + " beyond " +
                                         std::to_string(mesh.vertices_m.size()) + " vertices");
         out.geometry = std::move(mesh);
@@ -102,11 +104,11 @@ void toWire(const BodyState &state, pb::BodyState *out) {
 
 BodyState fromWire(const pb::BodyState &state) {
     if (state.frame() != pb::FRAME_WORLD)
-        throw ProtocolError(pb::Error::CODE_MALFORMED,
-                            "state of body '" + state.body() + "' is not in the world frame");
+        throw ProtocolError(pb::Error::CODE_MALFORMED, "state of body '" + printable(state.body()) +
+                                                           "' is not in the world frame");
     if (!state.has_orientation())
         throw ProtocolError(pb::Error::CODE_MALFORMED,
-                            "state of body '" + state.body() + "' has no orientation");
+                            "state of body '" + printable(state.body()) + "' has no orientation");
     BodyState out;
     out.body = state.body();
     out.position_m = fromWire(state.position_m());
@@ -115,7 +117,7 @@ BodyState fromWire(const pb::BodyState &state) {
     const double norm = out.orientation.norm();
     if (!(std::abs(norm - 1.0) < 1e-6))
         throw ProtocolError(pb::Error::CODE_MALFORMED,
-                            "orientation of body '" + state.body() +
+                            "orientation of body '" + printable(state.body()) +
                                 "' is not a unit quaternion (|q| = " + std::to_string(norm) + ")");
     out.linear_velocity_m_s = fromWire(state.linear_velocity_m_s());
     out.angular_velocity_rad_s = fromWire(state.angular_velocity_rad_s());
@@ -159,8 +161,9 @@ void toWire(const Wrench &wrench, pb::BodyWrench *out) {
 
 Wrench fromWire(const pb::BodyWrench &wrench) {
     if (wrench.frame() != pb::FRAME_WORLD)
-        throw ProtocolError(pb::Error::CODE_MALFORMED,
-                            "wrench on body '" + wrench.body() + "' is not in the world frame");
+        throw ProtocolError(pb::Error::CODE_MALFORMED, "wrench on body '" +
+                                                           printable(wrench.body()) +
+                                                           "' is not in the world frame");
     Wrench out;
     out.body = wrench.body();
     out.force_N = fromWire(wrench.force_n());
@@ -279,6 +282,43 @@ pb::Envelope &ScratchEnvelope::fresh() {
 std::string bodyName(const pb::Envelope &envelope) {
     const auto *field = pb::Envelope::descriptor()->FindFieldByNumber(envelope.body_case());
     return field ? field->name() : "nothing";
+}
+
+std::string describe(const pb::Envelope &envelope) {
+    return bodyName(envelope) + " for window " + std::to_string(envelope.window());
+}
+
+std::string printable(std::string_view text, std::size_t max_bytes) {
+    const std::size_t shown = std::min(text.size(), max_bytes);
+    std::string out;
+    out.reserve(shown);
+    for (std::size_t i = 0; i < shown; ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c >= 0x20 && c < 0x7f && c != '\\') {
+            out += static_cast<char>(c);
+        } else {
+            char escaped[5];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+            out += escaped;
+        }
+    }
+    if (shown < text.size())
+        out += "... (" + std::to_string(text.size()) + " bytes)";
+    return out;
+}
+
+void checkHeader(const pb::Envelope &e, const std::string &name, std::uint64_t last_sequence) {
+    if (e.sender() != name)
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "sent a message signed '" + printable(e.sender()) + "'");
+    if (e.sequence() <= last_sequence)
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "sent message " + std::to_string(e.sequence()) + " again (duplicate; " +
+                                "last was " + std::to_string(last_sequence) + ")");
+    if (e.sequence() != last_sequence + 1)
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "sent message " + std::to_string(e.sequence()) + " after " +
+                                std::to_string(last_sequence) + " (out of order)");
 }
 
 } // namespace grainlink::coupling::codec

@@ -8,6 +8,7 @@
 
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace grainlink::coupling::codec {
@@ -85,5 +86,17 @@ private:
 
 /// The name of the envelope's body ("hello", "advance_to", ...), for messages.
 std::string bodyName(const pb::Envelope &envelope);
+
+/// "window_done for window 5": what a message is, for "sent ... while ... waited for ...".
+std::string describe(const pb::Envelope &envelope);
+
+/// Text a peer sent, fit for one log line or error message: bytes outside printable ASCII as
+/// `\xNN` (a newline cannot forge a log line), and at most `max_bytes` of it, then how long it was.
+std::string printable(std::string_view text, std::size_t max_bytes = 64);
+
+/// Checks the envelope's header against the peer it came from: signed with its `name`, and
+/// numbered `last_sequence + 1` (a repeat is a duplicate, a gap out of order).
+void checkHeader(const pb::Envelope &envelope, const std::string &name,
+                 std::uint64_t last_sequence);
 
 } // namespace grainlink::coupling::codec

@@ -1,6 +1,7 @@
 #include "grainlink/coupling/Participant.hpp"
 
 #include "Codec.hpp"
+#include "HandshakeWatch.hpp"
 #include "Sockets.hpp"
 
 #include <algorithm>
@@ -55,6 +56,7 @@ struct Participant::Impl {
     sockets::ContextFor own_context{config.endpoint};
     zmq::context_t &context = own_context.get();
     zmq::socket_t socket; ///< main connection, used by the calling thread only
+    std::optional<HandshakeWatch> handshake_watch; ///< on `socket` until the Welcome
     State state = State::Created;
     RunInfo run;
     WindowInputs inputs;
@@ -146,6 +148,10 @@ struct Participant::Impl {
                 received_sequence = e.sequence();
                 return e;
             }
+            // Keys the coordinator refuses, or CURVE on one side only: fail at once, saying so.
+            if (handshake_watch)
+                if (auto why = handshake_watch->failure())
+                    throw CouplingError(who() + ": " + *why);
             if (shutdown_heard) {
                 std::lock_guard<std::mutex> lock(shutdown_mutex);
                 throw CouplingError(who() +
@@ -243,7 +249,10 @@ Participant::~Participant() {
 const RunInfo &Participant::initialize() {
     auto &s = *impl_;
     s.expect(State::Created, "initialize()", "it can be called once");
-    s.socket = sockets::connectDealer(s.context, s.config.endpoint, s.config.curve, 2000);
+    // The handshake watch attaches before the connection, so that it misses no attempt.
+    s.socket = sockets::makeDealer(s.context, s.config.curve, 2000);
+    s.handshake_watch.emplace(s.context, s.socket, s.config.curve, s.config.endpoint);
+    s.socket.connect(s.config.endpoint);
     s.heartbeat_interval_s = s.config.heartbeat_interval_s;
     s.peer_timeout_s = s.config.peer_timeout_s;
     s.startHeartbeats();
@@ -266,6 +275,7 @@ const RunInfo &Participant::initialize() {
     sockets::send(s.socket, hello);
 
     const pb::Envelope &reply = s.receive(s.config.handshake_timeout_s, "Welcome");
+    s.handshake_watch.reset(); // the connection is up
     if (!reply.has_welcome())
         s.stopped(reply);
     const auto &w = reply.welcome();

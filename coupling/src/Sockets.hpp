@@ -49,14 +49,22 @@ inline void makeCurveClient(zmq::socket_t &socket, const CurveClientKeys &keys) 
     socket.set(zmq::sockopt::curve_secretkey, keys.participant.secret_key);
 }
 
-/// A connected DEALER (participant side); linger bounds how long unsent messages keep a process.
-inline zmq::socket_t connectDealer(zmq::context_t &context, const std::string &endpoint,
-                                   const std::optional<CurveClientKeys> &curve, int linger_ms) {
+/// A DEALER (participant side), not yet connected; linger bounds how long unsent messages keep
+/// a process.
+inline zmq::socket_t makeDealer(zmq::context_t &context,
+                                const std::optional<CurveClientKeys> &curve, int linger_ms) {
     zmq::socket_t socket(context, zmq::socket_type::dealer);
     socket.set(zmq::sockopt::linger, linger_ms);
     socket.set(zmq::sockopt::rcvtimeo, 50);
     if (curve)
         makeCurveClient(socket, *curve);
+    return socket;
+}
+
+/// The same, connected.
+inline zmq::socket_t connectDealer(zmq::context_t &context, const std::string &endpoint,
+                                   const std::optional<CurveClientKeys> &curve, int linger_ms) {
+    zmq::socket_t socket = makeDealer(context, curve, linger_ms);
     socket.connect(endpoint);
     return socket;
 }
