@@ -2,6 +2,7 @@
 
 #include "Codec.hpp"
 #include "HandshakeWatch.hpp"
+#include "OutputCheck.hpp"
 #include "Sockets.hpp"
 
 #include <algorithm>
@@ -372,62 +373,20 @@ void Participant::checkpointWritten() {
     s.state = State::Ready;
 }
 
-namespace {
-
-bool finite(const Vec3 &v) {
-    return v.allFinite();
-}
-
-/// The bodies of `items`, checked against `expected`: each exactly once.
-template <typename T>
-void checkBodies(const std::string &who, const char *what, const std::vector<T> &items,
-                 const std::vector<std::string> &expected) {
-    bool in_order = items.size() == expected.size();
-    for (std::size_t i = 0; in_order && i < items.size(); ++i)
-        in_order = items[i].body == expected[i];
-    if (in_order) // the usual case: the same names in the same order
-        return;
-    std::vector<std::string> names, sorted_expected = expected;
-    for (const auto &x : items)
-        names.push_back(x.body);
-    std::sort(names.begin(), names.end());
-    std::sort(sorted_expected.begin(), sorted_expected.end());
-    if (names == sorted_expected)
-        return;
-    std::ostringstream os;
-    os << who << ": writeOutputs() got " << what << " for {";
-    for (const auto &n : names)
-        os << ' ' << n;
-    os << " } but must give exactly one for each of {";
-    for (const auto &n : sorted_expected)
-        os << ' ' << n;
-    os << " }";
-    throw CouplingError(os.str());
-}
-
-} // namespace
-
 void Participant::writeOutputs(WindowOutputs outputs) {
     auto &s = *impl_;
     if (s.state != State::WindowOpen)
         throw LifecycleError(s.who() + ": writeOutputs() called in state '" + stateName(s.state) +
                              "'; " + s.whatToDoNow());
-    if (s.config.role == Role::Multibody) {
-        for (const auto &st : outputs.states) {
-            if (!finite(st.position_m) || !finite(st.linear_velocity_m_s) ||
-                !finite(st.angular_velocity_rad_s) || !std::isfinite(st.orientation.norm()))
-                throw CouplingError(s.who() + ": non-finite state of body '" + st.body +
-                                    "' in window " + std::to_string(s.inputs.window));
-        }
-        checkBodies(s.who(), "states", outputs.states, s.expected_bodies);
-    } else {
-        for (const auto &w : outputs.wrenches) {
-            if (!finite(w.force_N) || !finite(w.torque_N_m))
-                throw CouplingError(s.who() + ": non-finite wrench on body '" + w.body +
-                                    "' in window " + std::to_string(s.inputs.window));
-        }
-        checkBodies(s.who(), "wrenches", outputs.wrenches, s.expected_bodies);
-    }
+    // The same check the coordinator runs on arrival (OutputCheck), worded for this call.
+    const auto problem = s.config.role == Role::Multibody
+                             ? checkOutputs(outputs.states, s.expected_bodies)
+                             : checkOutputs(outputs.wrenches, s.expected_bodies);
+    if (problem)
+        throw CouplingError(s.who() + ": " +
+                            (problem->kind == OutputProblem::Kind::NonFinite
+                                 ? problem->text + " in window " + std::to_string(s.inputs.window)
+                                 : "writeOutputs() got " + problem->text));
     s.outputs = std::move(outputs);
     s.state = State::OutputsWritten;
 }
