@@ -142,7 +142,7 @@ Lobby::Answer Lobby::receive(const std::string &id, std::string_view bytes, std:
     }
     pb::Envelope e;
     try {
-        e = codec::decode(bytes.data(), bytes.size(), "a new connection");
+        e = codec::decode(bytes.data(), bytes.size(), "a new connection", limits_.maxParts());
     } catch (const ProtocolError &error) {
         if (error.code == pb::Error::CODE_VERSION_MISMATCH)
             return fromVersion(error);

@@ -1,5 +1,8 @@
 #include "Codec.hpp"
 
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/wire_format_lite.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -248,13 +251,66 @@ std::string encode(const pb::Envelope &envelope) {
     return bytes;
 }
 
-pb::Envelope decode(const void *data, std::size_t size, const std::string &from) {
+namespace {
+
+using google::protobuf::Descriptor;
+using google::protobuf::FieldDescriptor;
+using google::protobuf::io::CodedInputStream;
+using Wire = google::protobuf::internal::WireFormatLite;
+
+/// Walks the bytes as `type` without building it, counting the sub-messages and strings parsing
+/// would make; false once more than `budget` are left. Malformed bytes end the walk with true:
+/// the parser that follows names them. The schema has no recursive types, so neither has this.
+bool withinParts(const Descriptor *type, CodedInputStream &in, std::size_t &budget) {
+    for (std::uint32_t tag = in.ReadTag(); tag != 0; tag = in.ReadTag()) {
+        if (Wire::GetTagWireType(tag) != Wire::WIRETYPE_LENGTH_DELIMITED) {
+            if (!Wire::SkipField(&in, tag))
+                return true;
+            continue;
+        }
+        std::uint32_t length = 0;
+        if (!in.ReadVarint32(&length))
+            return true;
+        const FieldDescriptor *field = type->FindFieldByNumber(Wire::GetTagFieldNumber(tag));
+        const bool message = field && field->type() == FieldDescriptor::TYPE_MESSAGE;
+        const bool text = field && (field->type() == FieldDescriptor::TYPE_STRING ||
+                                    field->type() == FieldDescriptor::TYPE_BYTES);
+        if ((message || text) && budget-- == 0)
+            return false;
+        if (!message) {
+            if (!in.Skip(static_cast<int>(length)))
+                return true;
+            continue;
+        }
+        const auto limit = in.PushLimit(static_cast<int>(length));
+        if (!withinParts(field->message_type(), in, budget))
+            return false;
+        in.PopLimit(limit);
+    }
+    return true;
+}
+
+} // namespace
+
+pb::Envelope decode(const void *data, std::size_t size, const std::string &from,
+                    std::size_t max_parts) {
     pb::Envelope envelope;
-    decode(data, size, from, envelope);
+    decode(data, size, from, envelope, max_parts);
     return envelope;
 }
 
-void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &envelope) {
+void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &envelope,
+            std::size_t max_parts) {
+    if (max_parts != SIZE_MAX) {
+        CodedInputStream in(static_cast<const std::uint8_t *>(data), static_cast<int>(size));
+        std::size_t budget = max_parts;
+        if (!withinParts(pb::Envelope::descriptor(), in, budget))
+            throw ProtocolError(pb::Error::CODE_MALFORMED,
+                                "message from " + from + " (" + std::to_string(size) +
+                                    " bytes) would unpack into more than " +
+                                    std::to_string(max_parts) +
+                                    " sub-messages and strings (limits.max_message_bytes / 16)");
+    }
     if (!envelope.ParseFromArray(data, static_cast<int>(size)))
         throw ProtocolError(pb::Error::CODE_MALFORMED,
                             "malformed message from " + from + " (" + std::to_string(size) +

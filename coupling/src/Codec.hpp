@@ -6,6 +6,7 @@
 
 #include <google/protobuf/arena.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <string_view>
@@ -60,11 +61,15 @@ SchemeKind fromWire(pb::Scheme scheme);
 std::string encode(const pb::Envelope &envelope);
 
 /// Parses and checks an envelope: well-formed bytes, our major version, a body set.
-/// `from` names the peer in error messages.
-pb::Envelope decode(const void *data, std::size_t size, const std::string &from);
+/// `from` names the peer in error messages. With `max_parts`, bytes that would unpack into more
+/// sub-messages and strings than that are refused before any is made: a few bytes each on the
+/// wire, ~70 bytes each in memory, so the message size alone does not bound what parsing takes.
+pb::Envelope decode(const void *data, std::size_t size, const std::string &from,
+                    std::size_t max_parts = SIZE_MAX);
 
 /// The same into `out` (an empty envelope, e.g. ScratchEnvelope::fresh()).
-void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &out);
+void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &out,
+            std::size_t max_parts = SIZE_MAX);
 
 /// An envelope whose memory is kept from one message to the next: it lives on an arena with a
 /// fixed first block that is reset for each message, so building or parsing the messages of a

@@ -256,7 +256,7 @@ struct Coordinator::Impl {
                                " frames (a participant sends one)");
         pb::Envelope &e = incoming.fresh();
         try {
-            codec::decode(payload.data(), payload.size(), peer.who, e);
+            codec::decode(payload.data(), payload.size(), peer.who, e, config.limits.maxParts());
         } catch (const codec::ProtocolError &error) {
             fail(peer.who, std::string("sent a bad message: ") + error.what());
         }

@@ -88,6 +88,39 @@ TEST_CASE("Codec: an envelope must parse, speak our major version and carry a bo
     }
 }
 
+TEST_CASE("Codec: a message that would unpack into too many parts is refused unparsed",
+          "[coupling][codec]") {
+    // Two bytes on the wire make an empty body description of ~70 bytes in memory: the part
+    // count, not the size, bounds what parsing takes. Here: the sender and the Hello's
+    // participant (strings), the Hello and its ten bodies (messages): 13 parts.
+    pb::Envelope e;
+    e.set_version(kProtocolMajor);
+    e.set_sender("soil");
+    e.set_sequence(1);
+    e.mutable_hello()->set_participant("soil");
+    for (int i = 0; i < 10; ++i)
+        e.mutable_hello()->add_provides();
+    const std::string bytes = bytesOf(e);
+    CHECK(
+        codec::decode(bytes.data(), bytes.size(), "a new connection", 13).hello().provides_size() ==
+        10);
+    const auto error =
+        protocolError([&] { codec::decode(bytes.data(), bytes.size(), "a new connection", 12); });
+    CHECK(error.code == pb::Error::CODE_MALFORMED);
+    CHECK(std::string(error.what()) ==
+          "message from a new connection (" + std::to_string(bytes.size()) +
+              " bytes) would unpack into more than 12 sub-messages and strings "
+              "(limits.max_message_bytes / 16)");
+    // Packed numbers are no parts: a mesh's indices cost their bytes, not objects.
+    pb::Envelope mesh = e;
+    mesh.mutable_hello()->clear_provides();
+    auto *indices = mesh.mutable_hello()->add_provides()->mutable_mesh();
+    for (std::uint32_t i = 0; i < 3000; ++i)
+        indices->add_triangle_indices(i);
+    const std::string mesh_bytes = bytesOf(mesh);
+    CHECK_NOTHROW(codec::decode(mesh_bytes.data(), mesh_bytes.size(), "a new connection", 5));
+}
+
 TEST_CASE("Codec: the header names its participant and counts 1, 2, 3, ...", "[coupling][codec]") {
     pb::Envelope e;
     e.set_sender("soil");

@@ -30,6 +30,10 @@ struct CoordinatorLimits {
     /// The largest message (frame) the coordinator receives: ZeroMQ's ZMQ_MAXMSGSIZE on its
     /// socket, which disconnects a sender before it buffers a larger one.
     std::int64_t max_message_bytes = 16 * 1024 * 1024;
+    /// The most sub-messages and strings one message may unpack into, counted before parsing
+    /// makes any: parsing makes ~70 bytes of each (a few on the wire), so this bounds a message's
+    /// memory to ~5 times max_message_bytes.
+    std::size_t maxParts() const { return static_cast<std::size_t>(max_message_bytes / 16); }
     std::size_t max_bodies = 1000;    ///< bodies one Hello may provide or consume
     std::size_t max_name_bytes = 128; ///< a body's name (participant names come from the file)
     /// A connection that is not a joined participant's main one (a heartbeat connection, or a
