@@ -1,5 +1,7 @@
 #include "Authenticator.hpp"
 
+#include "Sockets.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <cstring>
@@ -27,8 +29,7 @@ Authenticator::Authenticator(zmq::context_t &context, zmq::socket_t &router,
     // ZeroMQ asks whatever is bound here whether to admit each CURVE client.
     zmq::socket_t handler(context, zmq::socket_type::rep);
     handler.bind("inproc://zeromq.zap.01");
-    const std::string watch =
-        "inproc://grainlink-handshakes-" + std::to_string(reinterpret_cast<std::uintptr_t>(this));
+    const std::string watch = sockets::monitorAddress("handshakes");
     if (zmq_socket_monitor(router.handle(), watch.c_str(),
                            ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL |
                                ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL) != 0)

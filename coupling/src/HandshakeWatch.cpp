@@ -1,5 +1,7 @@
 #include "HandshakeWatch.hpp"
 
+#include "Sockets.hpp"
+
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
@@ -10,8 +12,7 @@ HandshakeWatch::HandshakeWatch(zmq::context_t &context, zmq::socket_t &socket,
                                const std::optional<CurveClientKeys> &curve, std::string endpoint)
     : socket_(socket), monitor_(context, zmq::socket_type::pair), curve_(curve.has_value()),
       public_key_(curve ? curve->participant.public_key : ""), endpoint_(std::move(endpoint)) {
-    const std::string address =
-        "inproc://grainlink-handshake-" + std::to_string(reinterpret_cast<std::uintptr_t>(this));
+    const std::string address = sockets::monitorAddress("handshake");
     if (zmq_socket_monitor(socket.handle(), address.c_str(),
                            ZMQ_EVENT_HANDSHAKE_SUCCEEDED | ZMQ_EVENT_HANDSHAKE_FAILED_NO_DETAIL |
                                ZMQ_EVENT_HANDSHAKE_FAILED_PROTOCOL |

@@ -5,6 +5,7 @@
 
 #include <zmq.hpp>
 
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
@@ -38,6 +39,13 @@ public:
 private:
     std::unique_ptr<zmq::context_t> own_;
 };
+
+/// A fresh inproc:// address for a socket monitor. Numbered, never an object's address: a
+/// closed socket gives its address back only later, so a reused one could still be taken.
+inline std::string monitorAddress(const char *what) {
+    static std::atomic<unsigned long> next{0};
+    return std::string("inproc://grainlink-") + what + "-" + std::to_string(++next);
+}
 
 inline double secondsSince(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
