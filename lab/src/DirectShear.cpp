@@ -4,6 +4,7 @@
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
 #include "grainlink/lab/LabBed.hpp"
+#include "grainlink/lab/LabConfig.hpp"
 
 #include <Eigen/Dense>
 
@@ -104,12 +105,9 @@ dem::DemScenario boxedSoil(const dem::DemScenario &soil, const DirectShearSpec &
 DirectShearScenario parseDirectShear(const config::ConfigNode &root) {
     DirectShearScenario s;
     s.name = root["name"].text();
-    if (root["soil"].has("walls"))
-        root["soil"]["walls"].fail("the direct shear test builds its own box; remove soil.walls");
-    s.soil = dem::parseScenario(root["soil"], true);
-    if (!s.soil.bodies.empty())
-        root["soil"]["bodies"].fail("the direct shear test adds its own frames; remove "
-                                    "soil.bodies");
+    s.soil = parseLabSoil(root, {"the direct shear test adds its own frames",
+                                 "the direct shear test builds its own box",
+                                 {}});
     const auto b = root["direct_shear"];
     DirectShearSpec &t = s.test;
     t.length_m = b["length_m"].positive();
@@ -148,26 +146,20 @@ DirectShearScenario parseDirectShear(const config::ConfigNode &root) {
             b["start_clearance_m"].fail("must be >= 0");
     }
     const auto servo = b["servo"];
-    t.servo_gain_m_s_per_N = servo["gain_m_s_per_N"].positive();
-    t.servo_max_speed_m_s = servo["max_speed_m_s"].positive();
-    if (servo.has("deadband_N")) {
-        t.servo_deadband_N = servo["deadband_N"].number();
-        if (t.servo_deadband_N < 0.0)
-            servo["deadband_N"].fail("must be >= 0");
+    t.servo = parseServo(servo, t.servo, s.warnings);
+    if (const auto old = servo.optional("max_consolidation_time_s")) {
+        if (servo.has("max_load_time_s"))
+            old->fail("give max_load_time_s only (max_consolidation_time_s is its old name)");
+        s.warnings.push_back(deprecationWarning(*old, "direct_shear.servo.max_load_time_s"));
+        t.servo.max_load_time_s = old->positive();
     }
-    if (servo.has("integral_gain_m_s2_per_N")) {
-        t.servo_integral_gain_m_s2_per_N = servo["integral_gain_m_s2_per_N"].number();
-        if (t.servo_integral_gain_m_s2_per_N < 0.0)
-            servo["integral_gain_m_s2_per_N"].fail("must be >= 0");
-    }
+    // Shearing starts only after the load was held this long: 0 would shear an unloaded box.
+    if (!(t.servo.hold_s > 0.0))
+        servo["hold_s"].fail("must be > 0");
     if (servo.has("control_interval_s"))
         t.control_interval_s = servo["control_interval_s"].positive();
     if (servo.has("tolerance"))
         t.consolidation_tolerance = servo["tolerance"].positive();
-    if (servo.has("hold_s"))
-        t.consolidation_hold_s = servo["hold_s"].positive();
-    if (servo.has("max_consolidation_time_s"))
-        t.max_consolidation_time_s = servo["max_consolidation_time_s"].positive();
     servo.finish();
     if (t.sample_interval_s < t.control_interval_s)
         b["sample_interval_s"].fail("must be >= servo.control_interval_s");
@@ -323,13 +315,7 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
     });
     sys.prepare();
 
-    LoadServo servo;
-    servo.target_force_N = run.target_force_N;
-    servo.gain_m_s_per_N = t.servo_gain_m_s_per_N;
-    servo.max_speed_m_s = t.servo_max_speed_m_s;
-    servo.deadband_N = t.servo_deadband_N;
-    servo.integral_gain_m_s2_per_N = t.servo_integral_gain_m_s2_per_N;
-    servo.validate();
+    LoadServo servo = t.servo.loadServo(run.target_force_N);
     const auto control_steps = std::max<std::uint64_t>(1, std::llround(t.control_interval_s / dt));
     const double control_dt = double(control_steps) * dt;
     // Runs one control interval; returns the plate's and the upper frame's mean reactions.
@@ -337,11 +323,8 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
         Vec3 plate_N, upper_N;
     };
     auto control = [&]() {
-        sys.body(plate_id).resetAccumulatedImpulse();
-        sys.body(upper_id).resetAccumulatedImpulse();
-        sys.run(control_steps);
-        const auto &p = sys.body(plate_id), &u = sys.body(upper_id);
-        Reaction r{p.impulse_N_s / p.accumulated_time_s, u.impulse_N_s / u.accumulated_time_s};
+        const auto loads = observeInterval(sys, control_steps, {plate_id, upper_id});
+        Reaction r{loads[0].force_N, loads[1].force_N};
         // Servo on the top plate's vertical speed, physics.md §12.11.
         motion->plate_z_ref_m = motion->plateZ(sys.time());
         motion->plate_t_ref_s = sys.time();
@@ -358,22 +341,22 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
         dem::Progress progress(label + " load", progress_interval_s);
         const double t0 = sys.time();
         double held = 0.0;
-        while (held < t.consolidation_hold_s - 1e-12) {
+        while (held < t.servo.hold_s - 1e-12) {
             const Reaction r = control();
             const double error = std::abs(r.plate_N.z() - run.target_force_N) / run.target_force_N;
             held = error < t.consolidation_tolerance ? held + control_dt : 0.0;
             run.consolidation_s = sys.time() - t0;
-            if (run.consolidation_s > t.max_consolidation_time_s) {
+            if (run.consolidation_s > t.servo.max_load_time_s) {
                 std::ostringstream msg;
                 msg << "direct shear at " << sigma << " Pa: the top plate did not hold "
                     << run.target_force_N << " N within " << t.consolidation_tolerance * 100
-                    << " % for " << t.consolidation_hold_s << " s within "
-                    << t.max_consolidation_time_s << " s (last N = " << r.plate_N.z()
+                    << " % for " << t.servo.hold_s << " s within " << t.servo.max_load_time_s
+                    << " s (last N = " << r.plate_N.z()
                     << " N); tune servo.gain_m_s_per_N (stable for gain <= 1 / (k dt), k the "
-                       "bed's stiffness) or raise servo.max_consolidation_time_s";
+                       "bed's stiffness) or raise servo.max_load_time_s";
                 throw std::runtime_error(msg.str());
             }
-            progress.update(sys.time(), run.consolidation_s / t.max_consolidation_time_s,
+            progress.update(sys.time(), run.consolidation_s / t.servo.max_load_time_s,
                             (sys.stepCount()) * sys.particles().size(),
                             "N " + std::to_string(r.plate_N.z()) + " N");
         }
@@ -456,63 +439,57 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
     return run;
 }
 
+/// The direct shear box's steps of the lab skeleton (LabExperiment.hpp): one normal stress per
+/// condition.
+struct DirectShearExperiment {
+    using Result = DirectShearResult;
+    const DirectShearScenario &scenario;
+
+    LabBed prepareBed(double progress_interval_s) const {
+        const DirectShearSpec &t = scenario.test;
+        LabBed bed = prepareLabBed(boxedSoil(scenario.soil, t), {t.length_m * t.width_m, 0.0},
+                                   progress_interval_s);
+        const double height = bed.summary.surface_m - bed.summary.floor_m;
+        if (height < t.lower_height_m + 4.0 * bed.summary.largest_radius_m)
+            throw std::runtime_error(
+                "direct shear: the settled bed is " + std::to_string(height) +
+                " m high, less than two grain diameters above the shear plane (" +
+                std::to_string(t.lower_height_m) +
+                " m); deposit more grains or lower lower_height_m");
+        return bed;
+    }
+    Result start(const LabBed &) const { return {}; }
+    std::vector<double> conditions() const { return scenario.test.normal_stresses_Pa; }
+    BoxShearRun run(const LabBed &bed, double sigma, double progress_interval_s) const {
+        return shearOnce(*bed.system, scenario.test, sigma, progress_interval_s);
+    }
+    void fit(Result &result) const {
+        std::vector<double> s_peak, t_peak, s_res, t_res;
+        for (const auto &r : result.runs) {
+            s_peak.push_back(r.peak_normal_stress_Pa);
+            t_peak.push_back(r.peak_shear_stress_Pa);
+            s_res.push_back(r.residual_normal_stress_Pa);
+            t_res.push_back(r.residual_shear_stress_Pa);
+        }
+        result.peak_fit = fitMohrCoulomb(s_peak, t_peak, scenario.test.fit_cohesion);
+        result.residual_fit = fitMohrCoulomb(s_res, t_res, scenario.test.fit_cohesion);
+    }
+};
+
 } // namespace
 
 DirectShearResult runDirectShear(const DirectShearScenario &scenario,
-                                 const DirectShearOptions &options) {
-    const auto start = std::chrono::steady_clock::now();
-    const DirectShearSpec &t = scenario.test;
-    DirectShearResult result;
-    const LabBed bed = prepareLabBed(boxedSoil(scenario.soil, t), options.progress_interval_s);
-    result.packing_from_cache = bed.from_cache;
-    result.preparation_wall_s = bed.preparation_wall_s;
-    const auto &grains = bed.system->particles();
-    result.particles = bed.particles;
-    result.largest_radius_m = bed.largest_radius_m;
-    result.time_step_s = bed.time_step_s;
-    result.bed_height_m = bed.surface_m;
-    // Bulk density of the settled bed, docs/physics.md §12.15.
-    double mass = 0.0;
-    for (double m : grains.mass)
-        mass += m;
-    result.bulk_density_kg_m3 = mass / (t.length_m * t.width_m * result.bed_height_m);
-    result.packing_fraction = result.bulk_density_kg_m3 / scenario.soil.material.density_kg_m3;
-    if (result.bed_height_m < t.lower_height_m + 4.0 * result.largest_radius_m)
-        throw std::runtime_error(
-            "direct shear: the settled bed is " + std::to_string(result.bed_height_m) +
-            " m high, less than two grain diameters above the shear plane (" +
-            std::to_string(t.lower_height_m) + " m); deposit more grains or lower lower_height_m");
-
-    for (double sigma : t.normal_stresses_Pa)
-        result.runs.push_back(shearOnce(*bed.system, t, sigma, options.progress_interval_s));
-
-    std::vector<double> s_peak, t_peak, s_res, t_res;
-    for (const auto &r : result.runs) {
-        s_peak.push_back(r.peak_normal_stress_Pa);
-        t_peak.push_back(r.peak_shear_stress_Pa);
-        s_res.push_back(r.residual_normal_stress_Pa);
-        t_res.push_back(r.residual_shear_stress_Pa);
-    }
-    try {
-        result.peak_fit = fitMohrCoulomb(s_peak, t_peak, t.fit_cohesion);
-        result.residual_fit = fitMohrCoulomb(s_res, t_res, t.fit_cohesion);
-    } catch (const std::invalid_argument &e) {
-        result.fit_note = e.what();
-    }
-    result.wall_s = secondsSince(start);
-    if (!options.output_directory.empty())
-        writeDirectShearOutputs(result, options.output_directory);
-    return result;
+                                 const LabRunOptions &options) {
+    return runLabExperiment(DirectShearExperiment{scenario}, options);
 }
 
 std::string DirectShearResult::report() const {
     std::ostringstream out;
     out << std::setprecision(4);
     out << "Direct shear box\n";
-    writeBedLine(out, particles, largest_radius_m, time_step_s, packing_from_cache,
-                 preparation_wall_s);
-    out << "  settled bed " << bed_height_m * 1e3 << " mm high: bulk density " << bulk_density_kg_m3
-        << " kg/m^3, packing fraction " << packing_fraction << "\n";
+    writeBedLine(out, bed);
+    out << "  settled bed " << (bed.surface_m - bed.floor_m) * 1e3 << " mm high: bulk density "
+        << bed.bulk_density_kg_m3 << " kg/m^3, packing fraction " << bed.packing_fraction << "\n";
     for (const auto &r : runs)
         out << "  sigma " << kPa(r.target_normal_stress_Pa) << " (N " << r.target_force_N
             << " N, held to " << r.max_normal_force_error * 100 << " % while shearing; grains "
@@ -531,15 +508,67 @@ std::string DirectShearResult::report() const {
     return out.str();
 }
 
-void writeDirectShearOutputs(const DirectShearResult &result, const std::string &directory) {
-    fs::create_directories(directory);
+LabSummary DirectShearResult::summary() const {
+    LabSummary s{kTest, scenario, "target_normal_stress_Pa", bed, {}, fit_note, {}, wall_s};
+    for (const auto &[law, fit] : {std::pair{"mohr_coulomb_peak", &peak_fit},
+                                   std::pair{"mohr_coulomb_residual", &residual_fit}}) {
+        if (!*fit)
+            continue;
+        const MohrCoulombFit &f = **fit;
+        LabFit x{law, f.degrees_of_freedom, {}};
+        x.parameters.push_back(
+            {"psi", "deg", f.friction_angle_deg, f.friction_angle_half_width_95_deg});
+        if (f.cohesion_fitted)
+            x.parameters.push_back({"c", "Pa", f.cohesion_Pa, f.cohesion_half_width_95_Pa});
+        s.fits.push_back(x);
+    }
+    for (const auto &r : runs) {
+        LabRunSummary x;
+        x.values = {{"target_normal_stress_Pa", r.target_normal_stress_Pa},
+                    {"target_force_N", r.target_force_N},
+                    {"grains_above_weight_N", r.grains_above_weight_N},
+                    {"consolidation_s", r.consolidation_s},
+                    {"peak_shear_stress_Pa", r.peak_shear_stress_Pa},
+                    {"peak_normal_stress_Pa", r.peak_normal_stress_Pa},
+                    {"peak_displacement_m", r.peak_displacement_m},
+                    {"residual_shear_stress_Pa", r.residual_shear_stress_Pa},
+                    {"residual_normal_stress_Pa", r.residual_normal_stress_Pa},
+                    {"mean_normal_force_N", r.mean_normal_force_N},
+                    {"max_normal_force_error", r.max_normal_force_error},
+                    {"steps", double(r.steps)},
+                    {"wall_s", r.wall_s}};
+        std::vector<double> time, d, shear, normal, area, tau, sigma, rise;
+        for (const auto &p : r.samples) {
+            time.push_back(p.time_s);
+            d.push_back(p.displacement_m);
+            shear.push_back(p.shear_force_N);
+            normal.push_back(p.normal_force_N);
+            area.push_back(p.area_m2);
+            tau.push_back(p.shear_stress_Pa);
+            sigma.push_back(p.normal_stress_Pa);
+            rise.push_back(p.plate_height_m);
+        }
+        x.curves = {{"time_s", time},
+                    {"displacement_m", d},
+                    {"shear_force_N", shear},
+                    {"normal_force_N", normal},
+                    {"area_m2", area},
+                    {"shear_stress_Pa", tau},
+                    {"normal_stress_Pa", sigma},
+                    {"plate_height_m", rise}};
+        s.runs.push_back(x);
+    }
+    return s;
+}
+
+void DirectShearResult::writeCsvs(const std::string &directory) const {
     const fs::path dir(directory);
     {
         auto csv =
             openCsv(dir, "shear_curves.csv",
                     "target_normal_stress_Pa,time_s,displacement_m,shear_force_N,normal_force_N,"
                     "area_m2,shear_stress_Pa,normal_stress_Pa,plate_height_m");
-        for (const auto &r : result.runs)
+        for (const auto &r : runs)
             for (const auto &s : r.samples)
                 csv << r.target_normal_stress_Pa << ',' << s.time_s << ',' << s.displacement_m
                     << ',' << s.shear_force_N << ',' << s.normal_force_N << ',' << s.area_m2 << ','
@@ -562,13 +591,12 @@ void writeDirectShearOutputs(const DirectShearResult &result, const std::string 
             else
                 csv << ",,,,\n";
         };
-        for (const auto &r : result.runs)
-            row("peak", r, r.peak_normal_stress_Pa, r.peak_shear_stress_Pa, result.peak_fit);
-        for (const auto &r : result.runs)
+        for (const auto &r : runs)
+            row("peak", r, r.peak_normal_stress_Pa, r.peak_shear_stress_Pa, peak_fit);
+        for (const auto &r : runs)
             row("residual", r, r.residual_normal_stress_Pa, r.residual_shear_stress_Pa,
-                result.residual_fit);
+                residual_fit);
     }
-    std::ofstream(dir / "report.txt") << result.report();
 }
 
 } // namespace grainlink::lab

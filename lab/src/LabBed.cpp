@@ -9,30 +9,48 @@
 
 namespace grainlink::lab {
 
-LabBed prepareLabBed(const dem::DemScenario &soil, double progress_interval_s) {
+BedFootprint regionFootprint(const dem::DemScenario &soil) {
+    const auto &d = soil.deposition;
+    return {(d.region_upper_m.x() - d.region_lower_m.x()) *
+                (d.region_upper_m.y() - d.region_lower_m.y()),
+            d.region_lower_m.z()};
+}
+
+LabBed prepareLabBed(const dem::DemScenario &soil, const BedFootprint &footprint,
+                     double progress_interval_s) {
     const auto start = std::chrono::steady_clock::now();
     LabBed bed;
-    bed.system = dem::prepareSoil(soil, progress_interval_s, &bed.from_cache);
-    bed.preparation_wall_s = secondsSince(start);
-    bed.particles = bed.system->particles().size();
+    bool from_cache = false;
+    bed.system = dem::prepareSoil(soil, progress_interval_s, &from_cache);
+    const double wall_s = secondsSince(start);
+    bed.summary = measureBed(*bed.system, soil, footprint);
+    bed.summary.from_cache = from_cache;
+    bed.summary.wall_s = wall_s;
+    return bed;
+}
+
+LabBedSummary measureBed(const dem::DemSystem &system, const dem::DemScenario &soil,
+                         const BedFootprint &footprint) {
+    const dem::ParticleStore &grains = system.particles();
+    LabBedSummary bed;
+    bed.grains = grains.size();
     bed.largest_radius_m = soil.deposition.radius.largest();
-    bed.time_step_s = bed.system->settings().time_step_s;
-    bed.surface_m = dem::bedSurface(bed.system->particles());
+    bed.time_step_s = system.settings().time_step_s;
+    bed.floor_m = footprint.floor_m;
+    bed.surface_m = dem::bedSurface(grains);
+    bed.footprint_m2 = footprint.area_m2;
+    bed.seed = soil.deposition.seed;
+    // Bulk density of the settled bed, docs/physics.md §12.15.
+    double mass = 0.0;
+    for (double m : grains.mass)
+        mass += m;
+    bed.bulk_density_kg_m3 = mass / (footprint.area_m2 * (bed.surface_m - bed.floor_m));
+    bed.packing_fraction = bed.bulk_density_kg_m3 / soil.material.density_kg_m3;
     return bed;
 }
 
 double secondsSince(std::chrono::steady_clock::time_point since) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - since).count();
-}
-
-std::optional<Eigen::Vector2d> parseCentre(const config::ConfigNode &section) {
-    const auto c = section.optional("centre_m");
-    if (!c)
-        return std::nullopt;
-    const auto xy = c->numbers();
-    if (xy.size() != 2)
-        c->fail("expected [x, y]");
-    return Eigen::Vector2d(xy[0], xy[1]);
 }
 
 Eigen::Vector2d testCentre(const dem::DemScenario &soil,
@@ -63,11 +81,10 @@ std::ofstream openCsv(const std::filesystem::path &directory, const std::string 
     return csv;
 }
 
-void writeBedLine(std::ostream &out, std::size_t particles, double largest_radius_m,
-                  double time_step_s, bool from_cache, double preparation_wall_s) {
-    out << "  bed: " << particles << " grains, largest radius " << largest_radius_m * 1e3
-        << " mm, time step " << time_step_s << " s, packing "
-        << (from_cache ? "from the cache" : "deposited") << " in " << preparation_wall_s << " s\n";
+void writeBedLine(std::ostream &out, const LabBedSummary &bed) {
+    out << "  bed: " << bed.grains << " grains, largest radius " << bed.largest_radius_m * 1e3
+        << " mm, time step " << bed.time_step_s << " s, packing "
+        << (bed.from_cache ? "from the cache" : "deposited") << " in " << bed.wall_s << " s\n";
 }
 
 } // namespace grainlink::lab

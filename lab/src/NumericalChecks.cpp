@@ -147,6 +147,13 @@ CheckRequest parseCheckRequest(const std::string &check, double factor) {
     return request;
 }
 
+LabRunOptions checkRunOptions(const LabRunOptions &options, const std::string &name) {
+    LabRunOptions o = options;
+    if (!o.output_directory.empty())
+        o.output_directory = (fs::path(o.output_directory) / ("check_" + name)).string();
+    return o;
+}
+
 std::vector<NumericalCheck>
 runNumericalChecks(const CheckRequest &request, const Quantities &baseline,
                    const std::function<Quantities(CheckKind, double, const std::string &)> &rerun) {
@@ -228,7 +235,7 @@ void writeNumericalChecks(const std::vector<NumericalCheck> &checks, const std::
 
 Quantities bevameterQuantities(const BevameterResult &result, double max_sinkage_m) {
     Quantities q;
-    for (const PlateRun &p : result.plates) {
+    for (const PlateRun &p : result.runs) {
         const PressureSinkageCurve c = p.curve();
         for (double fraction : {0.25, 0.5, 0.75, 1.0}) {
             const double z = fraction * max_sinkage_m;
@@ -247,18 +254,15 @@ Quantities bevameterQuantities(const BevameterResult &result, double max_sinkage
 std::vector<NumericalCheck> checkBevameter(const BevameterScenario &scenario,
                                            const BevameterResult &baseline,
                                            const CheckRequest &request,
-                                           const BevameterOptions &options) {
+                                           const LabRunOptions &options) {
     const double z_max = scenario.test.max_sinkage_m;
-    return runNumericalChecks(
-        request, bevameterQuantities(baseline, z_max),
-        [&](CheckKind kind, double factor, const std::string &name) {
-            BevameterScenario changed = scenario;
-            changed.soil = checkedSoil(scenario.soil, kind, factor);
-            BevameterOptions o = options;
-            if (!o.output_directory.empty())
-                o.output_directory = (fs::path(o.output_directory) / ("check_" + name)).string();
-            return bevameterQuantities(runBevameter(changed, o), z_max);
-        });
+    return runNumericalChecks(request, bevameterQuantities(baseline, z_max),
+                              [&](CheckKind kind, double factor, const std::string &name) {
+                                  BevameterScenario changed = scenario;
+                                  changed.soil = checkedSoil(scenario.soil, kind, factor);
+                                  return bevameterQuantities(
+                                      runBevameter(changed, checkRunOptions(options, name)), z_max);
+                              });
 }
 
 Quantities reposeQuantities(const ReposeResult &result) {
@@ -268,19 +272,16 @@ Quantities reposeQuantities(const ReposeResult &result) {
 
 std::vector<NumericalCheck> checkRepose(const ReposeScenario &scenario,
                                         const ReposeResult &baseline, const CheckRequest &request,
-                                        const ReposeOptions &options) {
-    return runNumericalChecks(
-        request, reposeQuantities(baseline),
-        [&](CheckKind kind, double factor, const std::string &name) {
-            ReposeScenario changed = scenario;
-            changed.soil = checkedSoil(scenario.soil, kind, factor);
-            if (kind == CheckKind::Walls) // the tube holds the widened fill
-                changed.test.tube_radius_m *= factor;
-            ReposeOptions o = options;
-            if (!o.output_directory.empty())
-                o.output_directory = (fs::path(o.output_directory) / ("check_" + name)).string();
-            return reposeQuantities(runRepose(changed, o));
-        });
+                                        const LabRunOptions &options) {
+    return runNumericalChecks(request, reposeQuantities(baseline),
+                              [&](CheckKind kind, double factor, const std::string &name) {
+                                  ReposeScenario changed = scenario;
+                                  changed.soil = checkedSoil(scenario.soil, kind, factor);
+                                  if (kind == CheckKind::Walls) // the tube holds the widened fill
+                                      changed.test.tube_radius_m *= factor;
+                                  return reposeQuantities(
+                                      runRepose(changed, checkRunOptions(options, name)));
+                              });
 }
 
 Quantities directShearQuantities(const DirectShearResult &result) {
@@ -294,14 +295,14 @@ Quantities directShearQuantities(const DirectShearResult &result) {
         if ((*fit)->cohesion_fitted)
             q.push_back({std::string(label) + " cohesion c", "Pa", (*fit)->cohesion_Pa});
     }
-    q.push_back({"packing fraction", "-", result.packing_fraction});
+    q.push_back({"packing fraction", "-", result.bed.packing_fraction});
     return q;
 }
 
 std::vector<NumericalCheck> checkDirectShear(const DirectShearScenario &scenario,
                                              const DirectShearResult &baseline,
                                              const CheckRequest &request,
-                                             const DirectShearOptions &options) {
+                                             const LabRunOptions &options) {
     return runNumericalChecks(
         request, directShearQuantities(baseline),
         [&](CheckKind kind, double factor, const std::string &name) {
@@ -312,15 +313,12 @@ std::vector<NumericalCheck> checkDirectShear(const DirectShearScenario &scenario
                 auto &t = changed.test;
                 t.length_m *= factor;
                 t.width_m *= factor;
-                t.servo_gain_m_s_per_N /= factor * factor;
-                t.servo_deadband_N *= factor * factor;
+                t.servo.gain_m_s_per_N /= factor * factor;
+                t.servo.deadband_N *= factor * factor;
             } else {
                 changed.soil = refinedSoil(scenario.soil, factor);
             }
-            DirectShearOptions o = options;
-            if (!o.output_directory.empty())
-                o.output_directory = (fs::path(o.output_directory) / ("check_" + name)).string();
-            return directShearQuantities(runDirectShear(changed, o));
+            return directShearQuantities(runDirectShear(changed, checkRunOptions(options, name)));
         });
 }
 

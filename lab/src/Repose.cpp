@@ -4,6 +4,7 @@
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
 #include "grainlink/lab/LabBed.hpp"
+#include "grainlink/lab/LabConfig.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -54,7 +55,9 @@ double meanKineticEnergy(const dem::DemSystem &sys) {
 ReposeScenario parseRepose(const config::ConfigNode &root) {
     ReposeScenario s;
     s.name = root["name"].text();
-    s.soil = dem::parseScenario(root["soil"], true);
+    s.soil = parseLabSoil(root, {"the repose test adds its own tube",
+                                 {},
+                                 "the fill is never cached (the tube stands in it)"});
     const auto r = root["repose"];
     ReposeSpec &t = s.test;
     t.tube_radius_m = r["tube_radius_m"].positive();
@@ -73,8 +76,6 @@ ReposeScenario parseRepose(const config::ConfigNode &root) {
         t.bin_width_m = r["bin_width_m"].positive();
     t.centre_m = parseCentre(r);
     r.finish();
-    if (!s.soil.bodies.empty())
-        root["soil"]["bodies"].fail("the repose test adds its own tube; remove soil.bodies");
 
     // The grains are inserted inside the tube: every corner of the region must be.
     const auto &d = s.soil.deposition;
@@ -163,19 +164,52 @@ void measureHeap(const std::vector<Eigen::Vector3d> &positions, const std::vecto
         studentT975(int(x.size()) - 2) * se / (1.0 + slope * slope) * 180.0 / kPi;
 }
 
-ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &options) {
+namespace {
+
+/// The fill: the grains settled in the standing tube (body 0), whose lift starts at
+/// *lift_start_s.
+struct ReposeFill : LabBed {
+    std::shared_ptr<double> lift_start_s;
+};
+
+/// The repose test's steps of the lab skeleton (LabExperiment.hpp): the fill is the bed, the
+/// lift the one run, the heap's flank line the fit.
+struct ReposeExperiment {
+    using Result = ReposeResult;
+    const ReposeScenario &scenario;
+
+    ReposeFill prepareBed(double progress_interval_s) const;
+    Result start(const ReposeFill &) const { return {}; }
+    std::vector<double> conditions() const { return {scenario.test.lift_speed_m_s}; }
+    ReposeRun run(const ReposeFill &fill, double lift_speed_m_s, double progress_interval_s) const;
+    void fit(Result &result) const {
+        const ReposeRun &lift = result.runs.front();
+        const double bin = scenario.test.bin_width_m > 0.0 ? scenario.test.bin_width_m
+                                                           : 2.0 * result.bed.largest_radius_m;
+        measureHeap(lift.positions_m, lift.radii_m,
+                    testCentre(scenario.soil, scenario.test.centre_m), bin, result);
+        if (!result.heapFormed())
+            throw std::invalid_argument("no heap: the grains spread out (" +
+                                        std::to_string(result.flank_bins) +
+                                        " profile bins on a flank, 3 needed for an angle)");
+    }
+};
+
+ReposeFill ReposeExperiment::prepareBed(double progress_interval_s) const {
     const auto start = std::chrono::steady_clock::now();
     const ReposeSpec &t = scenario.test;
     const auto &d = scenario.soil.deposition;
     const Eigen::Vector2d centre = testCentre(scenario.soil, t.centre_m);
-    auto sys = dem::makeSystem(scenario.soil);
-    const double dt = sys->settings().time_step_s;
+    ReposeFill fill;
+    fill.system = dem::makeSystem(scenario.soil);
+    dem::DemSystem &sys = *fill.system;
 
     dem::RigidBodyState initial;
     initial.position_m = Vec3(centre.x(), centre.y(), d.region_lower_m.z());
     auto lift_start = std::make_shared<double>(std::numeric_limits<double>::infinity());
+    fill.lift_start_s = lift_start;
     const double v = t.lift_speed_m_s;
-    sys->addBody(
+    sys.addBody(
         dem::MeshBody("tube", tubeMesh(t.tube_radius_m, t.tube_height_m, t.tube_segments), initial),
         [initial, lift_start, v](double time_s) {
             dem::RigidBodyState s = initial;
@@ -189,62 +223,79 @@ ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &opti
     // Fill the tube and let the column settle (the tube stands still meanwhile), under the
     // deposition's rolling law if it has its own: one fill for several laws.
     if (d.rolling)
-        sys->setRolling(*d.rolling);
-    dem::Progress fill("repose fill", options.progress_interval_s);
-    const auto report = dem::deposit(*sys, d, [&](const dem::DepositionReport &r) {
-        fill.update(sys->time(), std::min(1.0, r.settle_time_s / d.max_settle_time_s),
-                    sys->stepCount() * sys->particles().size());
+        sys.setRolling(*d.rolling);
+    dem::Progress progress("repose fill", progress_interval_s);
+    const auto report = dem::deposit(sys, d, [&](const dem::DepositionReport &r) {
+        progress.update(sys.time(), std::min(1.0, r.settle_time_s / d.max_settle_time_s),
+                        sys.stepCount() * sys.particles().size());
     });
     std::fprintf(stderr, "[repose] %zu grains settled in the tube (%.3f s simulated)\n",
                  report.inserted, report.settle_time_s);
     if (d.rolling)
-        sys->setRolling(scenario.soil.law.rolling);
+        sys.setRolling(scenario.soil.law.rolling);
+    fill.summary = measureBed(sys, scenario.soil,
+                              {kPi * t.tube_radius_m * t.tube_radius_m, d.region_lower_m.z()});
+    fill.summary.wall_s = secondsSince(start);
+    return fill;
+}
+
+ReposeRun ReposeExperiment::run(const ReposeFill &fill, double lift_speed_m_s,
+                                double progress_interval_s) const {
+    const auto start = std::chrono::steady_clock::now();
+    const ReposeSpec &t = scenario.test;
+    dem::DemSystem sys = *fill.system; // the tube's motion reads *fill.lift_start_s
+    const double dt = sys.settings().time_step_s;
+    ReposeRun run;
+    run.lift_speed_m_s = lift_speed_m_s;
 
     // Lift the tube by its own height: its bottom then clears any column it held.
-    *lift_start = sys->time();
-    const auto lift_steps = std::uint64_t(std::ceil(t.tube_height_m / (v * dt)));
-    dem::Progress lift("repose lift", options.progress_interval_s);
+    *fill.lift_start_s = sys.time();
+    const auto lift_steps = std::uint64_t(std::ceil(t.tube_height_m / (lift_speed_m_s * dt)));
+    dem::Progress lift("repose lift", progress_interval_s);
     const std::uint64_t chunk = std::max<std::uint64_t>(1, std::llround(0.01 / dt));
     for (std::uint64_t done = 0; done < lift_steps;) {
         const std::uint64_t n = std::min(chunk, lift_steps - done);
-        sys->run(n);
+        sys.run(n);
         done += n;
-        lift.update(sys->time(), double(done) / double(lift_steps), done * sys->particles().size());
+        lift.update(sys.time(), double(done) / double(lift_steps), done * sys.particles().size());
     }
     // Let the heap come to rest.
-    ReposeResult result;
-    const double settle_start = sys->time();
+    const double settle_start = sys.time();
     while (true) {
-        sys->run(chunk);
-        result.final_kinetic_energy_per_grain_J = meanKineticEnergy(*sys);
-        result.settle_time_s = sys->time() - settle_start;
-        if (result.final_kinetic_energy_per_grain_J < t.settle_kinetic_energy_J) {
-            result.settled = true;
+        sys.run(chunk);
+        run.final_kinetic_energy_per_grain_J = meanKineticEnergy(sys);
+        run.settle_time_s = sys.time() - settle_start;
+        if (run.final_kinetic_energy_per_grain_J < t.settle_kinetic_energy_J) {
+            run.settled = true;
             break;
         }
-        if (result.settle_time_s >= t.max_settle_time_s)
+        if (run.settle_time_s >= t.max_settle_time_s)
             break;
     }
+    run.positions_m = sys.particles().position;
+    run.radii_m = sys.particles().radius;
+    run.wall_s = secondsSince(start);
+    return run;
+}
 
-    const auto &p = sys->particles();
-    result.particles = p.size();
-    result.largest_radius_m = d.radius.largest();
-    measureHeap(p.position, p.radius, centre,
-                t.bin_width_m > 0.0 ? t.bin_width_m : 2.0 * result.largest_radius_m, result);
-    result.wall_s = secondsSince(start);
-    if (!options.output_directory.empty())
-        writeReposeOutputs(result, options.output_directory);
-    return result;
+} // namespace
+
+ReposeResult runRepose(const ReposeScenario &scenario, const LabRunOptions &options) {
+    return runLabExperiment(ReposeExperiment{scenario}, options);
 }
 
 std::string ReposeResult::report() const {
     std::ostringstream out;
     out << std::setprecision(4);
     out << "Angle of repose (lifted cylinder)\n";
-    out << "  " << particles << " grains, largest radius " << largest_radius_m * 1e3 << " mm\n";
-    out << "  heap " << heap_height_m * 1e3 << " mm high; "
-        << (settled ? "settled" : "NOT settled (time limit)") << " " << settle_time_s
-        << " s after the lift, mean KE per grain " << final_kinetic_energy_per_grain_J << " J\n";
+    out << "  " << bed.grains << " grains, largest radius " << bed.largest_radius_m * 1e3
+        << " mm\n";
+    out << "  heap " << heap_height_m * 1e3 << " mm high";
+    for (const ReposeRun &lift : runs) // the one lift (none: a heap measured from positions)
+        out << "; " << (lift.settled ? "settled" : "NOT settled (time limit)") << " "
+            << lift.settle_time_s << " s after the lift, mean KE per grain "
+            << lift.final_kinetic_energy_per_grain_J << " J";
+    out << "\n";
     if (heapFormed())
         out << "  angle of repose " << angle_deg << " +- " << angle_half_width_95_deg
             << " deg (95 %, slope regression over " << flank_bins << " flank bins)\n";
@@ -255,12 +306,37 @@ std::string ReposeResult::report() const {
     return out.str();
 }
 
-void writeReposeOutputs(const ReposeResult &result, const std::string &directory) {
-    fs::create_directories(directory);
+LabSummary ReposeResult::summary() const {
+    LabSummary s{kTest, scenario, "lift_speed_m_s", bed, {}, fit_note, {}, wall_s};
+    if (heapFormed())
+        s.fits.push_back({"repose",
+                          int(flank_bins) - 2,
+                          {{"angle", "deg", angle_deg, angle_half_width_95_deg}}});
+    for (const ReposeRun &lift : runs) {
+        LabRunSummary r;
+        r.values = {{"lift_speed_m_s", lift.lift_speed_m_s},
+                    {"settle_time_s", lift.settle_time_s},
+                    {"settled", lift.settled ? 1.0 : 0.0},
+                    {"final_kinetic_energy_per_grain_J", lift.final_kinetic_energy_per_grain_J},
+                    {"heap_height_m", heap_height_m},
+                    {"flank_bins", double(flank_bins)},
+                    {"wall_s", lift.wall_s}};
+        std::vector<double> radius, height, grains;
+        for (const auto &b : profile) {
+            radius.push_back(b.radius_m);
+            height.push_back(b.height_m);
+            grains.push_back(double(b.grains));
+        }
+        r.curves = {{"radius_m", radius}, {"height_m", height}, {"grains", grains}};
+        s.runs.push_back(r);
+    }
+    return s;
+}
+
+void ReposeResult::writeCsvs(const std::string &directory) const {
     auto csv = openCsv(directory, "heap_profile.csv", "radius_m,height_m,grains");
-    for (const auto &b : result.profile)
+    for (const auto &b : profile)
         csv << b.radius_m << ',' << b.height_m << ',' << b.grains << '\n';
-    std::ofstream(fs::path(directory) / "report.txt") << result.report();
 }
 
 } // namespace grainlink::lab

@@ -4,6 +4,7 @@
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
 #include "grainlink/lab/LabBed.hpp"
+#include "grainlink/lab/LabConfig.hpp"
 #include "grainlink/lab/LoadServo.hpp"
 
 #include <algorithm>
@@ -259,7 +260,7 @@ std::string JanosiFit::describe() const {
 ShearAnnulusScenario parseShearAnnulus(const config::ConfigNode &root) {
     ShearAnnulusScenario s;
     s.name = root["name"].text();
-    s.soil = dem::parseScenario(root["soil"], true);
+    s.soil = parseLabSoil(root, {"the shear test adds its own annulus", {}, {}});
     const auto b = root["bevameter_shear"];
     ShearAnnulusSpec &t = s.test;
     AnnulusGeometry &g = t.annulus;
@@ -295,26 +296,21 @@ ShearAnnulusScenario parseShearAnnulus(const config::ConfigNode &root) {
     t.max_shear_displacement_m = b["max_shear_displacement_m"].positive();
     if (b.has("approach_speed_m_s"))
         t.approach_speed_m_s = b["approach_speed_m_s"].positive();
-    t.servo_gain_m_s_per_N = b["servo_gain_m_s_per_N"].positive();
-    if (b.has("servo_max_speed_m_s"))
-        t.servo_max_speed_m_s = b["servo_max_speed_m_s"].positive();
-    if (b.has("servo_integral_gain_m_s2_per_N")) {
-        t.servo_integral_gain_m_s2_per_N = b["servo_integral_gain_m_s2_per_N"].number();
-        if (t.servo_integral_gain_m_s2_per_N < 0.0)
-            b["servo_integral_gain_m_s2_per_N"].fail("must be >= 0");
+    if (b.has("servo")) {
+        const auto servo = b["servo"];
+        t.servo = parseServo(servo, t.servo, s.warnings);
+        servo.finish();
+    } else if (b.has("servo_gain_m_s_per_N")) {
+        // The spelling before the servo: block, with its defaults (a 0.01 m/s clamp).
+        ServoSpec old = t.servo;
+        old.max_speed_m_s = 0.01;
+        t.servo = parseServo(b, old, s.warnings,
+                             ServoKeys{"servo_gain_m_s_per_N", "servo_max_speed_m_s",
+                                       "servo_deadband_N", "servo_integral_gain_m_s2_per_N",
+                                       "load_hold_s", "max_load_time_s"});
+    } else {
+        (void)b["servo"]; // throws: missing key bevameter_shear.servo
     }
-    if (b.has("servo_deadband_N")) {
-        t.servo_deadband_N = b["servo_deadband_N"].number();
-        if (t.servo_deadband_N < 0.0)
-            b["servo_deadband_N"].fail("must be >= 0");
-    }
-    if (b.has("load_hold_s")) {
-        t.load_hold_s = b["load_hold_s"].number();
-        if (t.load_hold_s < 0.0)
-            b["load_hold_s"].fail("must be >= 0");
-    }
-    if (b.has("max_load_time_s"))
-        t.max_load_time_s = b["max_load_time_s"].positive();
     if (b.has("start_clearance_m")) {
         t.start_clearance_m = b["start_clearance_m"].number();
         if (t.start_clearance_m < 0.0)
@@ -331,8 +327,6 @@ ShearAnnulusScenario parseShearAnnulus(const config::ConfigNode &root) {
         t.min_resolution = b["min_resolution"].positive();
     t.centre_m = parseCentre(b);
     b.finish();
-    if (!s.soil.bodies.empty())
-        root["soil"]["bodies"].fail("the shear test adds its own annulus; remove soil.bodies");
 
     // Resolution, seed eq. 11 with L_min = R_o - R_i (the annulus width).
     const double r_max = s.soil.deposition.radius.largest();
@@ -362,189 +356,186 @@ ShearCurve ShearRun::curve() const {
     return c;
 }
 
-ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
-                                   const ShearAnnulusOptions &options) {
-    const auto start = std::chrono::steady_clock::now();
+namespace {
+
+/// The shear annulus's steps of the lab skeleton (LabExperiment.hpp): one normal pressure per
+/// condition.
+struct ShearAnnulusExperiment {
+    using Result = ShearAnnulusResult;
+    const ShearAnnulusScenario &scenario;
+
+    LabBed prepareBed(double progress_interval_s) const {
+        return prepareLabBed(scenario.soil, regionFootprint(scenario.soil), progress_interval_s);
+    }
+    Result start(const LabBed &bed) const {
+        const AnnulusGeometry &g = scenario.test.annulus;
+        Result result;
+        result.annulus = g;
+        result.resolution =
+            (g.outer_radius_m - g.inner_radius_m) / (2.0 * bed.summary.largest_radius_m);
+        return result;
+    }
+    std::vector<double> conditions() const { return scenario.test.normal_pressures_Pa; }
+    ShearRun run(const LabBed &bed, double pressure, double progress_interval_s) const;
+    void fit(Result &result) const {
+        std::vector<ShearCurve> curves;
+        for (const auto &r : result.runs)
+            curves.push_back(r.curve());
+        result.fit = fitJanosi(curves);
+    }
+};
+
+ShearRun ShearAnnulusExperiment::run(const LabBed &bed, double pressure,
+                                     double progress_interval_s) const {
+    const auto run_start = std::chrono::steady_clock::now();
     const ShearAnnulusSpec &t = scenario.test;
     const AnnulusGeometry &g = t.annulus;
-    ShearAnnulusResult result;
-    result.annulus = g;
-    const LabBed bed = prepareLabBed(scenario.soil, options.progress_interval_s);
-    result.packing_from_cache = bed.from_cache;
-    result.preparation_wall_s = bed.preparation_wall_s;
-    result.particles = bed.particles;
-    result.largest_radius_m = bed.largest_radius_m;
-    result.resolution = (g.outer_radius_m - g.inner_radius_m) / (2.0 * result.largest_radius_m);
-    const double dt = bed.time_step_s;
-    result.time_step_s = dt;
-    const double surface = bed.surface_m;
+    const double dt = bed.summary.time_step_s;
+    const double surface = bed.summary.surface_m;
     const Vec3 lower = scenario.soil.deposition.region_lower_m;
     const Vec3 upper = scenario.soil.deposition.region_upper_m;
     const Eigen::Vector2d centre = testCentre(scenario.soil, t.centre_m);
-    const dem::TriangleMesh mesh = makeShearAnnulus(g);
     const auto steps_per_sample =
         std::max<std::uint64_t>(1, std::llround(t.sample_interval_s / dt));
     const double area = g.area_m2(), torque_factor = g.torqueFactor_m3(), r_mean = g.meanRadius_m();
     const double interval_s = double(steps_per_sample) * dt; // the servo's real interval
 
-    for (double pressure : t.normal_pressures_Pa) {
-        const auto run_start = std::chrono::steady_clock::now();
-        dem::DemSystem sys = *bed.system; // every pressure shears its own copy of the settled bed
-        ShearRun run;
-        run.target_pressure_Pa = pressure;
-        run.target_force_N = pressure * area;
-        run.surface_m = surface;
-        run.wall_gap_m = std::min(
-            {centre.x() - g.outer_radius_m - lower.x(), upper.x() - centre.x() - g.outer_radius_m,
-             centre.y() - g.outer_radius_m - lower.y(), upper.y() - centre.y() - g.outer_radius_m});
-        // Grouser tips start above every grain under the annulus.
-        const double highest =
-            highestGrainUnder(sys.particles(), centre, g.outer_radius_m, surface);
-        auto drive = std::make_shared<AnnulusDrive>();
-        drive->initial.position_m =
-            Vec3(centre.x(), centre.y(), highest + t.start_clearance_m + g.grouser_height_m);
-        drive->t_ref = sys.time();
-        drive->z_ref = drive->initial.position_m.z();
-        drive->v_z = -t.approach_speed_m_s;
-        dem::MeshBody annulus("annulus", mesh, drive->at(sys.time()));
-        annulus.friction_coefficient = t.friction_coefficient;
-        sys.addBody(std::move(annulus), [drive](double time_s) { return drive->at(time_s); });
-        sys.prepare();
+    dem::DemSystem sys = *bed.system; // every pressure shears its own copy of the settled bed
+    ShearRun run;
+    run.target_pressure_Pa = pressure;
+    run.target_force_N = pressure * area;
+    run.surface_m = surface;
+    run.wall_gap_m = std::min(
+        {centre.x() - g.outer_radius_m - lower.x(), upper.x() - centre.x() - g.outer_radius_m,
+         centre.y() - g.outer_radius_m - lower.y(), upper.y() - centre.y() - g.outer_radius_m});
+    // Grouser tips start above every grain under the annulus.
+    const double highest = highestGrainUnder(sys.particles(), centre, g.outer_radius_m, surface);
+    auto drive = std::make_shared<AnnulusDrive>();
+    drive->initial.position_m =
+        Vec3(centre.x(), centre.y(), highest + t.start_clearance_m + g.grouser_height_m);
+    drive->t_ref = sys.time();
+    drive->z_ref = drive->initial.position_m.z();
+    drive->v_z = -t.approach_speed_m_s;
+    dem::MeshBody annulus("annulus", makeShearAnnulus(g), drive->at(sys.time()));
+    annulus.friction_coefficient = t.friction_coefficient;
+    sys.addBody(std::move(annulus), [drive](double time_s) { return drive->at(time_s); });
+    sys.prepare();
 
-        LoadServo servo;
-        servo.target_force_N = run.target_force_N;
-        servo.gain_m_s_per_N = t.servo_gain_m_s_per_N;
-        servo.max_speed_m_s = t.servo_max_speed_m_s;
-        servo.deadband_N = t.servo_deadband_N;
-        servo.integral_gain_m_s2_per_N = t.servo_integral_gain_m_s2_per_N;
-        servo.validate();
+    LoadServo servo = t.servo.loadServo(run.target_force_N);
 
-        char label[64];
-        std::snprintf(label, sizeof label, "bevameter_shear sigma=%.0fPa", pressure);
-        dem::Progress progress(label, options.progress_interval_s);
-        const double t0 = sys.time();
-        sys.body(0).resetAccumulatedImpulse();
-        // One sample interval: run it, return the mean vertical force and z torque of the soil
-        // on the annulus, and the body height at its middle.
-        struct Interval {
-            double force_N, torque_N_m, z_mid_m, t_mid_s;
-        };
-        auto interval = [&]() {
-            const double t_start = sys.time();
-            sys.run(steps_per_sample);
-            dem::MeshBody &body = sys.body(0);
-            Interval out;
-            out.force_N = body.impulse_N_s.z() / body.accumulated_time_s;
-            out.torque_N_m = -body.angular_impulse_N_m_s.z() / body.accumulated_time_s;
-            out.t_mid_s = 0.5 * (t_start + sys.time());
-            out.z_mid_m = drive->z(out.t_mid_s);
-            body.resetAccumulatedImpulse();
-            run.steps += steps_per_sample;
-            return out;
-        };
+    char label[64];
+    std::snprintf(label, sizeof label, "bevameter_shear sigma=%.0fPa", pressure);
+    dem::Progress progress(label, progress_interval_s);
+    const double t0 = sys.time();
+    // One sample interval: run it, return the mean vertical force and z torque of the soil on
+    // the annulus, and the body height at its middle.
+    struct Interval {
+        double force_N, torque_N_m, z_mid_m, t_mid_s;
+    };
+    auto interval = [&]() {
+        const double t_start = sys.time();
+        const MeanLoad load = observeInterval(sys, steps_per_sample, {0})[0];
+        Interval out;
+        out.force_N = load.force_N.z();
+        out.torque_N_m = -load.torque_N_m.z();
+        out.t_mid_s = 0.5 * (t_start + sys.time());
+        out.z_mid_m = drive->z(out.t_mid_s);
+        run.steps += steps_per_sample;
+        return out;
+    };
 
-        // Approach at constant speed until the load is first reached.
-        for (;;) {
-            const Interval s = interval();
-            progress.update(sys.time() - t0, 0.0, run.steps * sys.particles().size(),
-                            "approach, F " + std::to_string(s.force_N) + " N");
-            if (s.force_N >= run.target_force_N) {
-                drive->retarget(sys.time(), -servo.update(s.force_N, interval_s), 0.0);
-                break;
-            }
-            if (sys.time() - t0 > t.max_load_time_s) {
-                std::ostringstream msg;
-                msg << "bevameter_shear: the annulus did not reach " << run.target_force_N
-                    << " N (sigma = " << pressure
-                    << " Pa) within max_load_time_s = " << t.max_load_time_s << " s (last "
-                    << s.force_N << " N, grouser tips "
-                    << surface - (s.z_mid_m - g.grouser_height_m)
-                    << " m below the surface); raise max_load_time_s or approach_speed_m_s, "
-                       "or lower the pressure";
-                throw std::runtime_error(msg.str());
-            }
-        }
-        // Hold: the servo alone.
-        const double hold_end = sys.time() + t.load_hold_s;
-        while (sys.time() < hold_end - 0.5 * dt) {
-            const Interval s = interval();
+    // Approach at constant speed until the load is first reached.
+    for (;;) {
+        const Interval s = interval();
+        progress.update(sys.time() - t0, 0.0, run.steps * sys.particles().size(),
+                        "approach, F " + std::to_string(s.force_N) + " N");
+        if (s.force_N >= run.target_force_N) {
             drive->retarget(sys.time(), -servo.update(s.force_N, interval_s), 0.0);
+            break;
         }
-        run.load_time_s = sys.time() - t0;
-        run.sinkage_at_load_m = surface - (drive->z(sys.time()) - g.grouser_height_m);
-
-        // Shear: constant angular speed, the servo holding the load.
-        const double t_shear = sys.time();
-        drive->retarget(t_shear, drive->v_z, t.angular_speed_rad_s);
-        double err2 = 0.0;
-        for (;;) {
-            const Interval s = interval();
-            drive->retarget(sys.time(), -servo.update(s.force_N, interval_s),
-                            t.angular_speed_rad_s);
-            ShearSample x;
-            x.time_s = s.t_mid_s - t_shear;
-            x.rotation_rad = t.angular_speed_rad_s * x.time_s;
-            x.shear_displacement_m = x.rotation_rad * r_mean;
-            x.normal_force_N = s.force_N;
-            x.normal_pressure_Pa = s.force_N / area;
-            x.torque_N_m = s.torque_N_m;
-            x.shear_stress_Pa = s.torque_N_m / torque_factor;
-            x.sinkage_m = surface - (s.z_mid_m - g.grouser_height_m);
-            run.samples.push_back(x);
-            const double err = std::abs(s.force_N - run.target_force_N) / run.target_force_N;
-            run.max_load_error = std::max(run.max_load_error, err);
-            err2 += err * err;
-            const double j_end = t.angular_speed_rad_s * (sys.time() - t_shear) * r_mean;
-            progress.update(sys.time() - t0, j_end / t.max_shear_displacement_m,
-                            run.steps * sys.particles().size(),
-                            "j " + std::to_string(x.shear_displacement_m * 1e3) + " mm, tau " +
-                                std::to_string(x.shear_stress_Pa) + " Pa");
-            if (j_end >= t.max_shear_displacement_m - 1e-12)
-                break;
+        if (sys.time() - t0 > t.servo.max_load_time_s) {
+            std::ostringstream msg;
+            msg << "bevameter_shear: the annulus did not reach " << run.target_force_N
+                << " N (sigma = " << pressure
+                << " Pa) within servo.max_load_time_s = " << t.servo.max_load_time_s << " s (last "
+                << s.force_N << " N, grouser tips " << surface - (s.z_mid_m - g.grouser_height_m)
+                << " m below the surface); raise servo.max_load_time_s or approach_speed_m_s, "
+                   "or lower the pressure";
+            throw std::runtime_error(msg.str());
         }
-        const double count = double(run.samples.size());
-        run.rms_load_error = std::sqrt(err2 / count);
-        for (const auto &x : run.samples)
-            run.mean_pressure_Pa += x.normal_pressure_Pa / count;
-        // tau_max: the largest mean over 5 consecutive samples (a DEM torque rattles).
-        const std::size_t w = std::min<std::size_t>(5, run.samples.size());
-        for (std::size_t i = 0; i + w <= run.samples.size(); ++i) {
-            double sum = 0.0;
-            for (std::size_t k = i; k < i + w; ++k)
-                sum += run.samples[k].shear_stress_Pa;
-            run.max_shear_stress_Pa = std::max(run.max_shear_stress_Pa, sum / double(w));
-        }
-        run.wall_s = secondsSince(run_start);
-        std::fprintf(stderr,
-                     "[bevameter_shear] sigma = %.4g Pa: loaded in %.3f s (grouser tips %.2f mm "
-                     "deep), %llu steps in %.1f s, tau_max %.4g Pa, load held within %.1f %% "
-                     "(rms %.1f %%)\n",
-                     pressure, run.load_time_s, run.sinkage_at_load_m * 1e3,
-                     static_cast<unsigned long long>(run.steps), run.wall_s,
-                     run.max_shear_stress_Pa, 100 * run.max_load_error, 100 * run.rms_load_error);
-        result.runs.push_back(std::move(run));
     }
-
-    std::vector<ShearCurve> curves;
-    for (const auto &r : result.runs)
-        curves.push_back(r.curve());
-    try {
-        result.fit = fitJanosi(curves);
-    } catch (const std::invalid_argument &e) {
-        result.fit_note = e.what();
+    // Hold: the servo alone.
+    const double hold_end = sys.time() + t.servo.hold_s;
+    while (sys.time() < hold_end - 0.5 * dt) {
+        const Interval s = interval();
+        drive->retarget(sys.time(), -servo.update(s.force_N, interval_s), 0.0);
     }
-    result.wall_s = secondsSince(start);
-    if (!options.output_directory.empty())
-        writeShearAnnulusOutputs(result, options.output_directory);
-    return result;
+    run.load_time_s = sys.time() - t0;
+    run.sinkage_at_load_m = surface - (drive->z(sys.time()) - g.grouser_height_m);
+
+    // Shear: constant angular speed, the servo holding the load.
+    const double t_shear = sys.time();
+    drive->retarget(t_shear, drive->v_z, t.angular_speed_rad_s);
+    double err2 = 0.0;
+    for (;;) {
+        const Interval s = interval();
+        drive->retarget(sys.time(), -servo.update(s.force_N, interval_s), t.angular_speed_rad_s);
+        ShearSample x;
+        x.time_s = s.t_mid_s - t_shear;
+        x.rotation_rad = t.angular_speed_rad_s * x.time_s;
+        x.shear_displacement_m = x.rotation_rad * r_mean;
+        x.normal_force_N = s.force_N;
+        x.normal_pressure_Pa = s.force_N / area;
+        x.torque_N_m = s.torque_N_m;
+        x.shear_stress_Pa = s.torque_N_m / torque_factor;
+        x.sinkage_m = surface - (s.z_mid_m - g.grouser_height_m);
+        run.samples.push_back(x);
+        const double err = std::abs(s.force_N - run.target_force_N) / run.target_force_N;
+        run.max_load_error = std::max(run.max_load_error, err);
+        err2 += err * err;
+        const double j_end = t.angular_speed_rad_s * (sys.time() - t_shear) * r_mean;
+        progress.update(sys.time() - t0, j_end / t.max_shear_displacement_m,
+                        run.steps * sys.particles().size(),
+                        "j " + std::to_string(x.shear_displacement_m * 1e3) + " mm, tau " +
+                            std::to_string(x.shear_stress_Pa) + " Pa");
+        if (j_end >= t.max_shear_displacement_m - 1e-12)
+            break;
+    }
+    const double count = double(run.samples.size());
+    run.rms_load_error = std::sqrt(err2 / count);
+    for (const auto &x : run.samples)
+        run.mean_pressure_Pa += x.normal_pressure_Pa / count;
+    // tau_max: the largest mean over 5 consecutive samples (a DEM torque rattles).
+    const std::size_t w = std::min<std::size_t>(5, run.samples.size());
+    for (std::size_t i = 0; i + w <= run.samples.size(); ++i) {
+        double sum = 0.0;
+        for (std::size_t k = i; k < i + w; ++k)
+            sum += run.samples[k].shear_stress_Pa;
+        run.max_shear_stress_Pa = std::max(run.max_shear_stress_Pa, sum / double(w));
+    }
+    run.wall_s = secondsSince(run_start);
+    std::fprintf(stderr,
+                 "[bevameter_shear] sigma = %.4g Pa: loaded in %.3f s (grouser tips %.2f mm "
+                 "deep), %llu steps in %.1f s, tau_max %.4g Pa, load held within %.1f %% "
+                 "(rms %.1f %%)\n",
+                 pressure, run.load_time_s, run.sinkage_at_load_m * 1e3,
+                 static_cast<unsigned long long>(run.steps), run.wall_s, run.max_shear_stress_Pa,
+                 100 * run.max_load_error, 100 * run.rms_load_error);
+    return run;
+}
+
+} // namespace
+
+ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
+                                   const LabRunOptions &options) {
+    return runLabExperiment(ShearAnnulusExperiment{scenario}, options);
 }
 
 std::string ShearAnnulusResult::report() const {
     std::ostringstream out;
     out << std::setprecision(5);
     out << "Virtual bevameter (shear annulus)\n";
-    writeBedLine(out, particles, largest_radius_m, time_step_s, packing_from_cache,
-                 preparation_wall_s);
+    writeBedLine(out, bed);
     out << "  annulus R_i = " << annulus.inner_radius_m * 1e3
         << " mm, R_o = " << annulus.outer_radius_m * 1e3 << " mm, " << annulus.grouser_count
         << " grousers of " << annulus.grouser_height_m * 1e3
@@ -568,37 +559,76 @@ std::string ShearAnnulusResult::report() const {
     return out.str();
 }
 
-void writeShearAnnulusOutputs(const ShearAnnulusResult &result, const std::string &directory) {
-    fs::create_directories(directory);
+LabSummary ShearAnnulusResult::summary() const {
+    LabSummary s{kTest, scenario, "target_pressure_Pa", bed, {}, fit_note, {}, wall_s};
+    if (fit) {
+        const auto &f = *fit;
+        s.fits.push_back({"janosi",
+                          f.degrees_of_freedom,
+                          {{"c", "Pa", f.parameters.cohesion_Pa, f.half_width_95[0]},
+                           {"phi", "deg", f.parameters.friction_angle_deg, f.half_width_95[1]},
+                           {"K", "m", f.parameters.shear_modulus_m, f.half_width_95[2]}}});
+    }
+    for (const auto &r : runs) {
+        LabRunSummary x;
+        x.values = {{"target_pressure_Pa", r.target_pressure_Pa},
+                    {"target_force_N", r.target_force_N},
+                    {"mean_pressure_Pa", r.mean_pressure_Pa},
+                    {"max_shear_stress_Pa", r.max_shear_stress_Pa},
+                    {"load_time_s", r.load_time_s},
+                    {"sinkage_at_load_m", r.sinkage_at_load_m},
+                    {"max_load_error", r.max_load_error},
+                    {"rms_load_error", r.rms_load_error},
+                    {"surface_m", r.surface_m},
+                    {"wall_gap_m", r.wall_gap_m},
+                    {"steps", double(r.steps)},
+                    {"wall_s", r.wall_s}};
+        std::vector<double> time, rotation, j, force, sigma, torque, tau, sinkage;
+        for (const auto &p : r.samples) {
+            time.push_back(p.time_s);
+            rotation.push_back(p.rotation_rad);
+            j.push_back(p.shear_displacement_m);
+            force.push_back(p.normal_force_N);
+            sigma.push_back(p.normal_pressure_Pa);
+            torque.push_back(p.torque_N_m);
+            tau.push_back(p.shear_stress_Pa);
+            sinkage.push_back(p.sinkage_m);
+        }
+        x.curves = {
+            {"time_s", time},          {"rotation_rad", rotation},    {"shear_displacement_m", j},
+            {"normal_force_N", force}, {"normal_pressure_Pa", sigma}, {"torque_N_m", torque},
+            {"shear_stress_Pa", tau},  {"sinkage_m", sinkage}};
+        s.runs.push_back(x);
+    }
+    return s;
+}
+
+void ShearAnnulusResult::writeCsvs(const std::string &directory) const {
     const fs::path dir(directory);
     {
         auto csv =
             openCsv(dir, "shear_displacement.csv",
                     "target_pressure_Pa,time_s,rotation_rad,shear_displacement_m,normal_force_N,"
                     "normal_pressure_Pa,torque_N_m,shear_stress_Pa,sinkage_m");
-        for (const auto &r : result.runs)
+        for (const auto &r : runs)
             for (const auto &s : r.samples)
                 csv << r.target_pressure_Pa << ',' << s.time_s << ',' << s.rotation_rad << ','
                     << s.shear_displacement_m << ',' << s.normal_force_N << ','
                     << s.normal_pressure_Pa << ',' << s.torque_N_m << ',' << s.shear_stress_Pa
                     << ',' << s.sinkage_m << '\n';
     }
-    {
-        auto csv =
-            openCsv(dir, "janosi_fit.csv", "parameter,value,standard_error,half_width_95,unit");
-        if (result.fit) {
-            const auto &f = *result.fit;
-            csv << "c," << f.parameters.cohesion_Pa << ',' << f.standard_error[0] << ','
-                << f.half_width_95[0] << ",Pa\n";
-            csv << "phi," << f.parameters.friction_angle_deg << ',' << f.standard_error[1] << ','
-                << f.half_width_95[1] << ",deg\n";
-            csv << "K," << f.parameters.shear_modulus_m << ',' << f.standard_error[2] << ','
-                << f.half_width_95[2] << ",m\n";
-            for (const auto &r : result.runs)
-                csv << "sigma_mean," << r.mean_pressure_Pa << ",,,Pa\n";
-        }
+    auto csv = openCsv(dir, "janosi_fit.csv", "parameter,value,standard_error,half_width_95,unit");
+    if (fit) {
+        const auto &f = *fit;
+        csv << "c," << f.parameters.cohesion_Pa << ',' << f.standard_error[0] << ','
+            << f.half_width_95[0] << ",Pa\n";
+        csv << "phi," << f.parameters.friction_angle_deg << ',' << f.standard_error[1] << ','
+            << f.half_width_95[1] << ",deg\n";
+        csv << "K," << f.parameters.shear_modulus_m << ',' << f.standard_error[2] << ','
+            << f.half_width_95[2] << ",m\n";
+        for (const auto &r : runs)
+            csv << "sigma_mean," << r.mean_pressure_Pa << ",,,Pa\n";
     }
-    std::ofstream(dir / "report.txt") << result.report();
 }
 
 Quantities shearAnnulusQuantities(const ShearAnnulusResult &result) {
@@ -619,7 +649,7 @@ Quantities shearAnnulusQuantities(const ShearAnnulusResult &result) {
 std::vector<NumericalCheck> checkShearAnnulus(const ShearAnnulusScenario &scenario,
                                               const ShearAnnulusResult &baseline,
                                               const CheckRequest &request,
-                                              const ShearAnnulusOptions &options) {
+                                              const LabRunOptions &options) {
     return runNumericalChecks(
         request, shearAnnulusQuantities(baseline),
         [&](CheckKind kind, double factor, const std::string &name) {
@@ -628,10 +658,7 @@ std::vector<NumericalCheck> checkShearAnnulus(const ShearAnnulusScenario &scenar
             changed.soil = kind == CheckKind::Walls
                                ? widenedSoil(scenario.soil, factor, scenario.test.centre_m)
                                : refinedSoil(scenario.soil, factor);
-            ShearAnnulusOptions o = options;
-            if (!o.output_directory.empty())
-                o.output_directory = (fs::path(o.output_directory) / ("check_" + name)).string();
-            return shearAnnulusQuantities(runShearAnnulus(changed, o));
+            return shearAnnulusQuantities(runShearAnnulus(changed, checkRunOptions(options, name)));
         });
 }
 

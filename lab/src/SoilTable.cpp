@@ -120,6 +120,11 @@ std::vector<SoilTableRow> generateSoilTable(const SoilTableSpec &spec,
     std::optional<ReposeScenario> repose;
     if (!spec.repose_path.empty())
         repose = loadRepose(spec.repose_path);
+    for (const std::string &warning : shear.warnings) // deprecated spellings of the scenarios
+        std::fprintf(stderr, "%s\n", warning.c_str());
+    if (repose)
+        for (const std::string &warning : repose->warnings)
+            std::fprintf(stderr, "%s\n", warning.c_str());
     const auto start = std::chrono::steady_clock::now();
     std::vector<SoilTableRow> rows;
     const fs::path out(options.output_csv);
@@ -155,7 +160,7 @@ std::vector<SoilTableRow> generateSoilTable(const SoilTableSpec &spec,
             row.gamma_deg = gamma;
             DirectShearScenario s = shear;
             s.soil = soilWithGrainParameters(shear.soil, phi, gamma);
-            DirectShearOptions so;
+            LabRunOptions so;
             so.progress_interval_s = options.progress_interval_s;
             if (!options.runs_directory.empty())
                 so.output_directory =
@@ -168,12 +173,12 @@ std::vector<SoilTableRow> generateSoilTable(const SoilTableSpec &spec,
             row.psi_half_width_95_deg = result.peak_fit->friction_angle_half_width_95_deg;
             row.cohesion_Pa = result.peak_fit->cohesion_Pa;
             row.cohesion_half_width_95_Pa = result.peak_fit->cohesion_half_width_95_Pa;
-            row.bulk_density_kg_m3 = result.bulk_density_kg_m3;
-            row.packing_fraction = result.packing_fraction;
+            row.bulk_density_kg_m3 = result.bed.bulk_density_kg_m3;
+            row.packing_fraction = result.bed.packing_fraction;
             if (repose) {
                 ReposeScenario r = *repose;
                 r.soil = soilWithGrainParameters(repose->soil, phi, gamma);
-                ReposeOptions ro;
+                LabRunOptions ro;
                 ro.progress_interval_s = options.progress_interval_s;
                 if (!options.runs_directory.empty())
                     ro.output_directory =

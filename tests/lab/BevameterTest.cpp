@@ -42,8 +42,8 @@ TEST_CASE("Bevameter on a tiny bed: pressure grows with sinkage for both plates,
           "[lab][bevameter]") {
     const auto result = lab::runBevameter(parse(kTiny), {});
     INFO(result.report());
-    REQUIRE(result.plates.size() == 2);
-    for (const auto &plate : result.plates) {
+    REQUIRE(result.runs.size() == 2);
+    for (const auto &plate : result.runs) {
         // A DEM p(z) rattles from sample to sample as grains jam and slip, so monotonic is
         // judged on the mean pressure over four equal sinkage spans of the loaded part
         // (z > 1 mm, past the surface's grain-scale roughness): each span's mean must be above
@@ -72,7 +72,7 @@ TEST_CASE("Bevameter on a tiny bed: pressure grows with sinkage for both plates,
     WARN(result.report());
     // The fit describes the curves: rms residual below a quarter of the largest pressure.
     double p_max = 0.0;
-    for (const auto &plate : result.plates)
+    for (const auto &plate : result.runs)
         for (const auto &s : plate.samples)
             p_max = std::max(p_max, s.pressure_Pa);
     CHECK(result.fit->rms_residual_Pa < 0.25 * p_max);

@@ -133,8 +133,8 @@ TEST_CASE("Direct shear on a tiny box: the servo holds sigma and strength grows 
     // Friction grains with rolling resistance: a macroscopic angle between 15 and 45 deg.
     CHECK(result.peak_fit->friction_angle_deg > 15.0);
     CHECK(result.peak_fit->friction_angle_deg < 45.0);
-    CHECK(result.packing_fraction > 0.45);
-    CHECK(result.packing_fraction < 0.65);
+    CHECK(result.bed.packing_fraction > 0.45);
+    CHECK(result.bed.packing_fraction < 0.65);
 }
 
 TEST_CASE("Direct shear: the servo's integral term removes the dilation lag",
@@ -165,7 +165,7 @@ TEST_CASE("Direct shear: the servo's integral term removes the dilation lag",
     REQUIRE(proportional.runs.size() == 1);
     REQUIRE(integral.runs.size() == 1);
     // Mean relative load error and the proportional lag rise / (T g N_target) of a run.
-    const double gain = scenario.test.servo_gain_m_s_per_N;
+    const double gain = scenario.test.servo.gain_m_s_per_N;
     const double sample_s = scenario.test.sample_interval_s;
     auto meanError = [](const lab::BoxShearRun &run) {
         return (run.mean_normal_force_N - run.target_force_N) / run.target_force_N;

@@ -1,6 +1,7 @@
-// The lab tests' shared pieces (lab/include/grainlink/lab/LabBed.hpp): the highest grain under a
+// The lab tests' shared pieces (LabBed.hpp, LabConfig.hpp): the highest grain under a
 // round tool, the test's centre and the `centre_m` key.
 #include "grainlink/lab/LabBed.hpp"
+#include "grainlink/lab/LabConfig.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -236,7 +236,7 @@ TEST_CASE("Bevameter quantities: p at quarter sinkages per plate and the Bekker 
         s.pressure_Pa = 1e6 * s.sinkage_m;
         plate.samples.push_back(s);
     }
-    result.plates.push_back(plate);
+    result.runs.push_back(plate);
     const auto q = lab::bevameterQuantities(result, 0.02);
     REQUIRE(q.size() == 4); // no fit: no Bekker quantities
     CHECK(q[0].name == "p(5 mm), R = 25 mm");

@@ -2,7 +2,7 @@
 #include "grainlink/lab/Repose.hpp"
 
 #include "TextEdit.hpp"
-#include "TinyBed.hpp"
+#include "TinyRepose.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -16,30 +16,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-/// 600 grains of 1.8-2 mm in a tube of 21 mm radius on a rough floor, lifted at 0.1 m/s; the
-/// profile in bins of r_max (the default 2 r_max leaves 3-7 bins on so small a heap's flank).
-/// The insertion region fills the tube's height: 0.09 m held all 600 grains for seed 3 only of
-/// seeds 1-10.
-const std::string kTiny = R"(name: tiny-repose
-soil:
-  simulation: {time_step_s: 6.0e-5, threads: 1}
-)" + kTinyGrainContacts + R"(  walls:
-    - {name: floor, type: plane, point_m: [0, 0, 0], normal: [0, 0, 1], friction_coefficient: 0.6}
-  deposition:
-    region: {lower_m: [-0.014, -0.014, 0], upper_m: [0.014, 0.014, 0.1]}
-    count: 600
-    radius: {distribution: uniform, min_m: 0.0018, max_m: 0.002}
-    seed: 3
-    settle_kinetic_energy_J: 1.0e-8
-    max_settle_time_s: 0.4
-  packing_cache_directory: ""
-repose:
-  tube_radius_m: 0.021
-  tube_height_m: 0.1
-  lift_speed_m_s: 0.1
-  max_settle_time_s: 0.6
-  bin_width_m: 0.002
-)";
+const std::string &kTiny = kTinyRepose;
 
 lab::ReposeScenario parse(const std::string &text) {
     return lab::parseRepose(config::ConfigNode::loadString(text, "repose.yaml"));
@@ -143,7 +120,7 @@ TEST_CASE("Angle of repose: more rolling resistance builds a steeper heap", "[la
 
 TEST_CASE("Repose input errors name the key and the line", "[lab][repose]") {
     CHECK_THROWS_WITH(parse(edited("tube_radius_m: 0.021", "tube_radius_m: 0.015")),
-                      Contains("repose.yaml:20:") && Contains("repose.tube_radius_m") &&
+                      Contains("repose.yaml:19:") && Contains("repose.tube_radius_m") &&
                           Contains("inside the tube"));
     CHECK_THROWS_WITH(parse(edited("lift_speed_m_s: 0.1", "lift_speed_m_s: 0")),
                       Contains("repose.lift_speed_m_s") && Contains("must be > 0"));

@@ -32,9 +32,7 @@ const std::string kTiny =
   angular_speed_rad_s: 4
   max_shear_displacement_m: 0.012
   approach_speed_m_s: 0.05
-  servo_gain_m_s_per_N: 0.1
-  servo_integral_gain_m_s2_per_N: 5
-  servo_max_speed_m_s: 0.05
+  servo: {gain_m_s_per_N: 0.1, integral_gain_m_s2_per_N: 5, max_speed_m_s: 0.05}
   sample_interval_s: 0.001
   min_resolution: 3
 )";
@@ -232,8 +230,8 @@ TEST_CASE("Shear annulus input errors name the key and the line", "[lab][shear_a
                           Contains("must exceed inner_radius_m"));
     CHECK_THROWS_WITH(parse(edited("[1000, 2000]", "[1000, -5]")),
                       Contains("bevameter_shear.normal_pressures_Pa") && Contains("> 0"));
-    CHECK_THROWS_WITH(parse(edited("  servo_gain_m_s_per_N: 0.1\n", "")),
-                      Contains("servo_gain_m_s_per_N"));
+    CHECK_THROWS_WITH(parse(edited("gain_m_s_per_N: 0.1, ", "")),
+                      Contains("missing key 'bevameter_shear.servo.gain_m_s_per_N'"));
     CHECK_THROWS_WITH(parse(edited("  min_resolution: 3\n", "  min_resolution: 3\n  torque: 1\n")),
                       Contains("unknown key 'bevameter_shear.torque'"));
 }

@@ -3,6 +3,7 @@
 // bed, p(z) per plate size, and Bekker's law fitted over the sizes (docs/lab.md).
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
+#include "grainlink/lab/LabExperiment.hpp"
 
 #include <optional>
 #include <string>
@@ -29,6 +30,7 @@ struct BevameterScenario {
     std::string name = "bevameter";
     dem::DemScenario soil;
     BevameterSpec test;
+    std::vector<std::string> warnings; ///< deprecated spellings read (file:line: what to write)
 };
 
 /// Reads `name`, `soil:` (the DEM soil keys of docs/scenario.md) and `bevameter:`.
@@ -54,28 +56,19 @@ struct PlateRun {
     PressureSinkageCurve curve() const;
 };
 
-struct BevameterResult {
-    std::size_t particles = 0;
-    double largest_radius_m = 0.0;
-    double time_step_s = 0.0;
-    bool packing_from_cache = false;
-    double preparation_wall_s = 0.0; ///< deposition or cache read
-    double wall_s = 0.0;             ///< everything
-    std::vector<PlateRun> plates;
+struct BevameterResult : LabResult {
+    static constexpr const char *kTest = "bevameter";
+    static constexpr const char *kCsvFiles = "pressure_sinkage.csv,bekker_fit.csv";
+    std::vector<PlateRun> runs; ///< one per plate, in the scenario's order
     std::optional<BekkerFit> fit;
-    std::string fit_note; ///< why there is no fit
     std::string report() const;
+    LabSummary summary() const;
+    /// pressure_sinkage.csv and bekker_fit.csv.
+    void writeCsvs(const std::string &directory) const;
 };
 
-struct BevameterOptions {
-    std::string output_directory; ///< empty: nothing written
-    double progress_interval_s = 5.0;
-};
-
-/// Settles (or reads) the bed once, runs every plate on a copy of it, fits Bekker's law.
-BevameterResult runBevameter(const BevameterScenario &scenario, const BevameterOptions &options);
-
-/// Writes pressure_sinkage.csv, bekker_fit.csv and report.txt into `directory`.
-void writeBevameterOutputs(const BevameterResult &result, const std::string &directory);
+/// Settles (or reads) the bed once, runs every plate on a copy of it, fits Bekker's law
+/// (runLabExperiment); writes its outputs into options.output_directory unless empty.
+BevameterResult runBevameter(const BevameterScenario &scenario, const LabRunOptions &options);
 
 } // namespace grainlink::lab

@@ -4,7 +4,8 @@
 // per normal stress, peak and residual strength, and the Mohr-Coulomb line tau = c + sigma tan psi
 // fitted with its confidence intervals (docs/lab.md, docs/physics.md §12.15).
 #include "grainlink/dem/Scenario.hpp"
-#include "grainlink/lab/LoadServo.hpp"
+#include "grainlink/lab/LabConfig.hpp"
+#include "grainlink/lab/LabExperiment.hpp"
 
 #include <Eigen/Core>
 
@@ -29,15 +30,11 @@ struct DirectShearSpec {
     std::optional<double> wall_friction_coefficient; ///< frames and plate; unset: the grains'
     double plate_clearance_m = 0.0005; ///< [m] gap between the top plate's edge and the frame
     double start_clearance_m = 0.001;  ///< [m] plate bottom above the highest grain at start
-    // Top-plate force servo (LoadServo, physics.md §12.11).
-    double servo_gain_m_s_per_N = 0.0;
-    double servo_max_speed_m_s = 0.0;
-    double servo_deadband_N = 0.0;
-    double servo_integral_gain_m_s2_per_N = 0.0; ///< [m/(s^2 N)] 0: proportional only
-    double control_interval_s = 0.0005;          ///< [s] servo update period
-    double consolidation_tolerance = 0.05; ///< [-] |N - N_target| / N_target to start shearing
-    double consolidation_hold_s = 0.02;    ///< [s] ... held this long
-    double max_consolidation_time_s = 0.3; ///< [s] else the run stops with an error
+    /// Top-plate force servo (LabConfig.hpp, physics.md §12.11): shearing starts once N stayed
+    /// within consolidation_tolerance for hold_s, which must happen within max_load_time_s.
+    ServoSpec servo{0.0, 0.0, 0.0, 0.0, 0.02, 0.3}; // hold 0.02 s, 0.3 s to load
+    double control_interval_s = 0.0005;    ///< [s] servo update period (`servo.control_interval_s`)
+    double consolidation_tolerance = 0.05; ///< [-] |N - N_target| / N_target (`servo.tolerance`)
     bool fit_cohesion = true;              ///< false: tau = sigma tan psi through the origin
 };
 
@@ -45,10 +42,12 @@ struct DirectShearScenario {
     std::string name = "direct_shear";
     dem::DemScenario soil;
     DirectShearSpec test;
+    std::vector<std::string> warnings; ///< deprecated spellings read (file:line: what to write)
 };
 
 /// Reads `name`, `soil:` (DEM soil keys of docs/scenario.md, without `walls`: the test builds
-/// its box) and `direct_shear:`; the deposition region must lie inside the box.
+/// its box) and `direct_shear:`; the deposition region must lie inside the box. The servo's old
+/// `max_consolidation_time_s` still reads as `max_load_time_s`, with a line in `warnings`.
 DirectShearScenario parseDirectShear(const config::ConfigNode &root);
 DirectShearScenario loadDirectShear(const std::string &path);
 
@@ -102,32 +101,19 @@ struct MohrCoulombFit {
 MohrCoulombFit fitMohrCoulomb(const std::vector<double> &normal_stress_Pa,
                               const std::vector<double> &shear_stress_Pa, bool with_cohesion);
 
-struct DirectShearResult {
-    std::size_t particles = 0;
-    double largest_radius_m = 0.0;
-    double time_step_s = 0.0;
-    bool packing_from_cache = false;
-    double bed_height_m = 0.0;       ///< [m] settled surface (bedSurface) above the floor
-    double bulk_density_kg_m3 = 0.0; ///< [kg/m^3] grain mass / (L W bed height)
-    double packing_fraction = 0.0;   ///< [-] bulk density / grain density
-    double preparation_wall_s = 0.0;
-    double wall_s = 0.0;
-    std::vector<BoxShearRun> runs;
+struct DirectShearResult : LabResult {
+    static constexpr const char *kTest = "direct_shear";
+    static constexpr const char *kCsvFiles = "shear_curves.csv,mohr_coulomb.csv";
+    std::vector<BoxShearRun> runs; ///< one per normal stress, in the scenario's order
     std::optional<MohrCoulombFit> peak_fit, residual_fit;
-    std::string fit_note; ///< why there is no fit
     std::string report() const;
+    LabSummary summary() const;
+    /// shear_curves.csv and mohr_coulomb.csv.
+    void writeCsvs(const std::string &directory) const;
 };
 
-struct DirectShearOptions {
-    std::string output_directory; ///< empty: nothing written
-    double progress_interval_s = 5.0;
-};
-
-/// Settles (or reads) the bed once in the closed box, then shears a copy of it per stress.
-DirectShearResult runDirectShear(const DirectShearScenario &scenario,
-                                 const DirectShearOptions &options);
-
-/// Writes shear_curves.csv, mohr_coulomb.csv and report.txt into `directory`.
-void writeDirectShearOutputs(const DirectShearResult &result, const std::string &directory);
+/// Settles (or reads) the bed once in the closed box, then shears a copy of it per stress
+/// (runLabExperiment); writes its outputs into options.output_directory unless empty.
+DirectShearResult runDirectShear(const DirectShearScenario &scenario, const LabRunOptions &options);
 
 } // namespace grainlink::lab

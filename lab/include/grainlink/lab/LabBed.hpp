@@ -1,10 +1,10 @@
 #pragma once
-// What every lab test on a settled bed shares (docs/lab.md): the bed settled once through the
-// packing cache and copied per run, the test's axis in the deposition region, the highest grain
-// under a round tool, and the wall clock.
-#include "grainlink/config/ConfigNode.hpp"
+// The prepared bed of the lab tests (docs/lab.md): settled once through the packing cache and
+// copied per run, measured for summary.json; the test's axis in the deposition region, the
+// highest grain under a round tool, the lab CSVs and the wall clock.
 #include "grainlink/dem/DemSystem.hpp"
 #include "grainlink/dem/Scenario.hpp"
+#include "grainlink/lab/LabSummary.hpp"
 
 #include <Eigen/Core>
 
@@ -19,30 +19,36 @@
 
 namespace grainlink::lab {
 
+/// The horizontal area a bed fills and the floor it stands on, for its packing fraction.
+struct BedFootprint {
+    double area_m2 = 0.0; ///< [m^2]
+    double floor_m = 0.0; ///< [m] z of the floor
+};
+/// The deposition region's: its x-y area and its lower z.
+BedFootprint regionFootprint(const dem::DemScenario &soil);
+
 /// A settled bed, prepared once; each run copies `system` (`dem::DemSystem sys = *bed.system`).
 struct LabBed {
     std::unique_ptr<dem::DemSystem> system; ///< the settled bed, never stepped by the test
-    bool from_cache = false;                ///< the packing came from the packing cache
-    double preparation_wall_s = 0.0;        ///< [s] wall time to deposit or read the packing
-    std::size_t particles = 0;              ///< grains in the bed
-    double largest_radius_m = 0.0;          ///< [m] largest grain radius of the deposition
-    double time_step_s = 0.0;               ///< [s] the bed's DEM time step
-    double surface_m = 0.0;                 ///< [m] bed surface, dem::bedSurface (98th percentile)
+    LabBedSummary summary;                  ///< its grains, surface, packing, seed, wall time
 };
 
 /// Settles `soil` (or reads it from the packing cache) via dem::prepareSoil.
-LabBed prepareLabBed(const dem::DemScenario &soil, double progress_interval_s);
+LabBed prepareLabBed(const dem::DemScenario &soil, const BedFootprint &footprint,
+                     double progress_interval_s);
+
+/// The bed settled in `system` from `soil` on `footprint`: grains, time step, surface, bulk
+/// density and packing fraction (docs/physics.md §12.15), the deposition's seed. Leaves
+/// from_cache and wall_s to the caller.
+LabBedSummary measureBed(const dem::DemSystem &system, const dem::DemScenario &soil,
+                         const BedFootprint &footprint);
 
 /// The reports' "  bed: ..." line (grains, largest radius, time step, where the packing came
 /// from and how long it took), in the stream's own precision.
-void writeBedLine(std::ostream &out, std::size_t particles, double largest_radius_m,
-                  double time_step_s, bool from_cache, double preparation_wall_s);
+void writeBedLine(std::ostream &out, const LabBedSummary &bed);
 
 /// Seconds on the steady clock since `since`.
 double secondsSince(std::chrono::steady_clock::time_point since);
-
-/// The optional `centre_m: [x, y]` [m] of a test section; fails naming the key unless two numbers.
-std::optional<Eigen::Vector2d> parseCentre(const config::ConfigNode &section);
 
 /// The test's axis (x, y) [m]: `centre` when set, else the middle of the deposition region.
 Eigen::Vector2d testCentre(const dem::DemScenario &soil,

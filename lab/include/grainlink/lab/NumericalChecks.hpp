@@ -75,6 +75,9 @@ struct CheckRequest {
 /// (the factor of that check; not allowed with `both`, which takes both defaults).
 CheckRequest parseCheckRequest(const std::string &check, double factor);
 
+/// A rerun's options: the baseline's, writing into options.output_directory/check_<name>.
+LabRunOptions checkRunOptions(const LabRunOptions &options, const std::string &name);
+
 /// Reruns a test for every requested check and compares its quantities with the baseline's.
 /// `rerun(kind, factor, directory_name)` runs the test on the changed scenario (use
 /// checkedSoil for its soil, plus whatever the test's own geometry needs) and returns the same
@@ -99,14 +102,14 @@ Quantities bevameterQuantities(const BevameterResult &result, double max_sinkage
 std::vector<NumericalCheck> checkBevameter(const BevameterScenario &scenario,
                                            const BevameterResult &baseline,
                                            const CheckRequest &request,
-                                           const BevameterOptions &options);
+                                           const LabRunOptions &options);
 
 /// Repose answers: the angle (not the heap height, which the widened fill changes by design).
 Quantities reposeQuantities(const ReposeResult &result);
 /// Reruns the repose test (the widened one with its tube radius widened too) and compares.
 std::vector<NumericalCheck> checkRepose(const ReposeScenario &scenario,
                                         const ReposeResult &baseline, const CheckRequest &request,
-                                        const ReposeOptions &options);
+                                        const LabRunOptions &options);
 
 /// Direct shear answers: psi and c of the peak and of the residual Mohr-Coulomb fits (those
 /// that exist) and the bed's packing fraction.
@@ -118,6 +121,6 @@ Quantities directShearQuantities(const DirectShearResult &result);
 std::vector<NumericalCheck> checkDirectShear(const DirectShearScenario &scenario,
                                              const DirectShearResult &baseline,
                                              const CheckRequest &request,
-                                             const DirectShearOptions &options);
+                                             const LabRunOptions &options);
 
 } // namespace grainlink::lab

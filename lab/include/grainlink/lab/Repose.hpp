@@ -2,6 +2,7 @@
 // Angle of repose by the lifted-cylinder test: grains settle in an open tube standing on a rough
 // floor, the tube is lifted slowly, the heap that forms is measured (docs/lab.md).
 #include "grainlink/dem/Scenario.hpp"
+#include "grainlink/lab/LabExperiment.hpp"
 
 #include <optional>
 #include <string>
@@ -25,10 +26,11 @@ struct ReposeScenario {
     std::string name = "repose";
     dem::DemScenario soil;
     ReposeSpec test;
+    std::vector<std::string> warnings; ///< deprecated spellings read (file:line: what to write)
 };
 
-/// Reads `name`, `soil:` (DEM soil keys, docs/scenario.md) and `repose:`; the deposition region
-/// must lie inside the tube.
+/// Reads `name`, `soil:` (DEM soil keys, docs/scenario.md, without `packing_cache_directory`:
+/// the fill is never cached) and `repose:`; the deposition region must lie inside the tube.
 ReposeScenario parseRepose(const config::ConfigNode &root);
 ReposeScenario loadRepose(const std::string &path);
 
@@ -39,27 +41,34 @@ struct ProfileBin {
     std::size_t grains = 0;
 };
 
-struct ReposeResult {
-    std::size_t particles = 0;
-    double largest_radius_m = 0.0;
-    double heap_height_m = 0.0;           ///< [m] highest grain top near the axis
+/// The lift: the tube drawn off the fill at lift_speed_m_s, the heap left to come to rest.
+struct ReposeRun {
+    double lift_speed_m_s = 0.0; ///< [m/s]
+    double settle_time_s = 0.0;  ///< [s] after the tube left the heap
+    bool settled = false;
+    double final_kinetic_energy_per_grain_J = 0.0;
+    std::vector<Eigen::Vector3d> positions_m; ///< [m] the grains at the end: the heap
+    std::vector<double> radii_m;              ///< [m]
+    double wall_s = 0.0;
+};
+
+struct ReposeResult : LabResult {
+    static constexpr const char *kTest = "repose";
+    static constexpr const char *kCsvFiles = "heap_profile.csv";
+    std::vector<ReposeRun> runs; ///< the one lift
+    // The heap measured from the lift's grains (measureHeap): the test's fit.
+    double heap_height_m = 0.0; ///< [m] highest grain top near the axis
     /// [deg] atan of the flank slope; NaN when no heap formed (fewer than 3 flank bins: the
     /// grains spread out, as frictionless or freely rolling spheres do)
     double angle_deg = 0.0;
     double angle_half_width_95_deg = 0.0; ///< [deg] from the slope's regression interval
     std::size_t flank_bins = 0; ///< bins fitted (height in (max(0.2 top, 3 r_max), 0.8 top))
     bool heapFormed() const { return flank_bins >= 3; }
-    double settle_time_s = 0.0; ///< [s] after the tube left the heap
-    bool settled = false;
-    double final_kinetic_energy_per_grain_J = 0.0;
     std::vector<ProfileBin> profile;
-    double wall_s = 0.0;
     std::string report() const;
-};
-
-struct ReposeOptions {
-    std::string output_directory; ///< empty: nothing written
-    double progress_interval_s = 5.0;
+    LabSummary summary() const;
+    /// heap_profile.csv.
+    void writeCsvs(const std::string &directory) const;
 };
 
 /// Heap profile and angle from grain positions (exposed for tests): bins of `bin_width_m` around
@@ -69,9 +78,9 @@ void measureHeap(const std::vector<Eigen::Vector3d> &positions_m,
                  const std::vector<double> &radii_m, const Eigen::Vector2d &centre_m,
                  double bin_width_m, ReposeResult &result);
 
-ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &options);
-
-/// Writes heap_profile.csv and report.txt into `directory`.
-void writeReposeOutputs(const ReposeResult &result, const std::string &directory);
+/// Fills the tube, lifts it, measures the heap (runLabExperiment: the fill is the bed, the lift
+/// the one run, the heap's flank line the fit; no heap leaves the angle NaN and says so in
+/// fit_note). Writes its outputs into options.output_directory unless empty.
+ReposeResult runRepose(const ReposeScenario &scenario, const LabRunOptions &options);
 
 } // namespace grainlink::lab

@@ -4,6 +4,8 @@
 // pressure and the Janosi-Hanamoto law fitted over the pressures (docs/lab.md, physics.md §12.12).
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/dem/TriangleMesh.hpp"
+#include "grainlink/lab/LabConfig.hpp"
+#include "grainlink/lab/LabExperiment.hpp"
 #include "grainlink/lab/NumericalChecks.hpp"
 
 #include <Eigen/Core>
@@ -36,30 +38,31 @@ dem::TriangleMesh makeShearAnnulus(const AnnulusGeometry &geometry);
 /// The `bevameter_shear:` section.
 struct ShearAnnulusSpec {
     AnnulusGeometry annulus;
-    std::vector<double> normal_pressures_Pa;     ///< [Pa] one run per normal pressure
-    double angular_speed_rad_s = 0.0;            ///< [rad/s] during the shear phase
-    double max_shear_displacement_m = 0.0;       ///< [m] the shear phase ends at j = theta R_mean
-    double approach_speed_m_s = 0.05;            ///< [m/s] downward until the load is first reached
-    double servo_gain_m_s_per_N = 0.0;           ///< [m/(s N)] LoadServo gain; required
-    double servo_max_speed_m_s = 0.01;           ///< [m/s] LoadServo clamp
-    double servo_integral_gain_m_s2_per_N = 0.0; ///< [m/(s^2 N)] 0: proportional only
-    double servo_deadband_N = 0.0;               ///< [N]
-    double load_hold_s = 0.02;        ///< [s] servo alone at the load before the rotation starts
-    double max_load_time_s = 1.0;     ///< [s] the approach must reach the load within this
-    double start_clearance_m = 0.001; ///< [m] grouser tips above the highest grain
-    double sample_interval_s = 0.002; ///< [s] servo update and CSV row
-    std::optional<double> friction_coefficient; ///< annulus-grain; unset: the grains' angles
-    double min_resolution = 3.0;                ///< [-] required (R_o - R_i) / (2 r_max)
-    std::optional<Eigen::Vector2d> centre_m;    ///< [m] axis (x, y); unset: region centre
+    std::vector<double> normal_pressures_Pa; ///< [Pa] one run per normal pressure
+    double angular_speed_rad_s = 0.0;        ///< [rad/s] during the shear phase
+    double max_shear_displacement_m = 0.0;   ///< [m] the shear phase ends at j = theta R_mean
+    double approach_speed_m_s = 0.05;        ///< [m/s] downward until the load is first reached
+    /// The load servo (LabConfig.hpp): hold_s before the rotation starts, max_load_time_s for the
+    /// approach to first reach the load.
+    ServoSpec servo{0.0, 0.0, 0.0, 0.0, 0.02, 1.0}; // hold 0.02 s, 1 s to load
+    double start_clearance_m = 0.001;               ///< [m] grouser tips above the highest grain
+    double sample_interval_s = 0.002;               ///< [s] servo update and CSV row
+    std::optional<double> friction_coefficient;     ///< annulus-grain; unset: the grains' angles
+    double min_resolution = 3.0;                    ///< [-] required (R_o - R_i) / (2 r_max)
+    std::optional<Eigen::Vector2d> centre_m;        ///< [m] axis (x, y); unset: region centre
 };
 
 struct ShearAnnulusScenario {
     std::string name = "bevameter_shear";
     dem::DemScenario soil;
     ShearAnnulusSpec test;
+    std::vector<std::string> warnings; ///< deprecated spellings read (file:line: what to write)
 };
 
-/// Reads `name`, `soil:` (the DEM soil keys of docs/scenario.md) and `bevameter_shear:`.
+/// Reads `name`, `soil:` (the DEM soil keys of docs/scenario.md) and `bevameter_shear:`. The
+/// servo's keys before the `servo:` block (servo_gain_m_s_per_N, servo_max_speed_m_s,
+/// servo_integral_gain_m_s2_per_N, servo_deadband_N, load_hold_s, max_load_time_s) still read,
+/// each with a line in `warnings`.
 ShearAnnulusScenario parseShearAnnulus(const config::ConfigNode &root);
 ShearAnnulusScenario loadShearAnnulus(const std::string &path);
 
@@ -123,32 +126,23 @@ struct ShearRun {
     ShearCurve curve() const; ///< at the mean measured pressure
 };
 
-struct ShearAnnulusResult {
-    std::size_t particles = 0;
-    double largest_radius_m = 0.0;
-    double time_step_s = 0.0;
-    double resolution = 0.0; ///< (R_o - R_i) / (2 r_max)
-    bool packing_from_cache = false;
-    double preparation_wall_s = 0.0;
-    double wall_s = 0.0;
+struct ShearAnnulusResult : LabResult {
+    static constexpr const char *kTest = "bevameter_shear";
+    static constexpr const char *kCsvFiles = "shear_displacement.csv,janosi_fit.csv";
     AnnulusGeometry annulus;
-    std::vector<ShearRun> runs;
+    double resolution = 0.0;    ///< (R_o - R_i) / (2 r_max)
+    std::vector<ShearRun> runs; ///< one per normal pressure, in the scenario's order
     std::optional<JanosiFit> fit;
-    std::string fit_note; ///< why there is no fit
     std::string report() const;
+    LabSummary summary() const;
+    /// shear_displacement.csv and janosi_fit.csv.
+    void writeCsvs(const std::string &directory) const;
 };
 
-struct ShearAnnulusOptions {
-    std::string output_directory; ///< empty: nothing written
-    double progress_interval_s = 5.0;
-};
-
-/// Settles (or reads) the bed once, runs every normal pressure on a copy of it, fits Janosi.
+/// Settles (or reads) the bed once, runs every normal pressure on a copy of it, fits Janosi
+/// (runLabExperiment); writes its outputs into options.output_directory unless empty.
 ShearAnnulusResult runShearAnnulus(const ShearAnnulusScenario &scenario,
-                                   const ShearAnnulusOptions &options);
-
-/// Writes shear_displacement.csv, janosi_fit.csv and report.txt into `directory`.
-void writeShearAnnulusOutputs(const ShearAnnulusResult &result, const std::string &directory);
+                                   const LabRunOptions &options);
 
 /// Shear annulus answers for the numerical checks: tau_max per normal pressure and the Janosi
 /// c, phi and K when the result has a fit.
@@ -160,6 +154,6 @@ Quantities shearAnnulusQuantities(const ShearAnnulusResult &result);
 std::vector<NumericalCheck> checkShearAnnulus(const ShearAnnulusScenario &scenario,
                                               const ShearAnnulusResult &baseline,
                                               const CheckRequest &request,
-                                              const ShearAnnulusOptions &options);
+                                              const LabRunOptions &options);
 
 } // namespace grainlink::lab
