@@ -152,11 +152,11 @@ int run(const fs::path &dir, const std::string &which, int threads, std::uint64_
     if (which == "cylinder") {
         RigidBodyState start;
         start.position_m = placeCylinder(*sys);
-        start.velocity_m_s = Vec3(kSpeed, 0, 0);
+        start.linear_velocity_m_s = Vec3(kSpeed, 0, 0);
         start.angular_velocity_rad_s = Vec3(0, kSpin, 0);
         sys->addBody(
             MeshBody("cylinder", makeCylinder(kCylinderRadius, kCylinderWidth, 360), start),
-            [start](double t) { return constantVelocityMotion(start, t); });
+            constantVelocity(start));
     } else if (which != "settle") {
         std::fprintf(stderr, "unknown case '%s' (settle | cylinder)\n", which.c_str());
         return 2;

@@ -36,10 +36,10 @@ public:
     void item(const RigidBodyState &s) {
         item(s.position_m);
         item(s.orientation);
-        item(s.velocity_m_s);
+        item(s.linear_velocity_m_s);
         item(s.angular_velocity_rad_s);
     }
-    void item(const DemSystem::MeshContactSlot &s) {
+    void item(const MeshContactSlot &s) {
         pod<std::int32_t>(s.body);
         pod<std::int32_t>(s.triangle);
         item(s.normal);
@@ -90,10 +90,10 @@ public:
     void item(RigidBodyState &s) {
         item(s.position_m);
         item(s.orientation);
-        item(s.velocity_m_s);
+        item(s.linear_velocity_m_s);
         item(s.angular_velocity_rad_s);
     }
-    void item(DemSystem::MeshContactSlot &s) {
+    void item(MeshContactSlot &s) {
         s.body = pod<std::int32_t>();
         s.triangle = pod<std::int32_t>();
         item(s.normal);

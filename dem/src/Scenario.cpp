@@ -4,27 +4,6 @@
 
 namespace grainlink::dem {
 
-RigidBodyState segmentedMotion(const RigidBodyState &start,
-                               const std::vector<MotionSegment> &motion, double t_s) {
-    RigidBodyState s = start;
-    s.velocity_m_s.setZero();
-    s.angular_velocity_rad_s.setZero();
-    double remaining = std::max(t_s, 0.0);
-    for (const MotionSegment &seg : motion) {
-        const double span = std::min(remaining, seg.duration_s);
-        s.position_m += seg.velocity_m_s * span;
-        s.orientation = rotationFromVector(seg.angular_velocity_rad_s * span) * s.orientation;
-        remaining -= span;
-        if (remaining <= 0.0) {
-            s.velocity_m_s = seg.velocity_m_s;
-            s.angular_velocity_rad_s = seg.angular_velocity_rad_s;
-            break;
-        }
-    }
-    s.orientation.normalize();
-    return s;
-}
-
 namespace {
 
 Vec3 gravityOf(const ConfigNode &node) {

@@ -15,8 +15,6 @@ namespace grainlink::dem {
 
 namespace fs = std::filesystem;
 
-namespace {} // namespace
-
 double bedSurface(const ParticleStore &p) {
     if (p.empty())
         return 0.0;
@@ -103,7 +101,7 @@ std::string seriesRow(DemSystem &sys, double run_time_s) {
         const double span = body.accumulated_time_s > 0.0 ? body.accumulated_time_s : 1.0;
         const Vec3 f = body.impulse_N_s / span, t = body.angular_impulse_N_m_s / span;
         row << ',' << s.position_m.x() << ',' << s.position_m.y() << ',' << s.position_m.z() << ','
-            << s.velocity_m_s.x() << ',' << s.velocity_m_s.z() << ','
+            << s.linear_velocity_m_s.x() << ',' << s.linear_velocity_m_s.z() << ','
             << s.angular_velocity_rad_s.y() << ',' << f.x() << ',' << f.y() << ',' << f.z() << ','
             << t.x() << ',' << t.y() << ',' << t.z();
         body.resetAccumulatedImpulse();
@@ -142,10 +140,7 @@ void addBody(DemSystem &sys, const BodySpec &spec, const RigidBodyState &start,
     MeshBody body(spec.name, spec.mesh, start);
     body.friction_coefficient = spec.friction_coefficient;
     body.record_triangle_loads = spec.record_triangle_loads;
-    const auto motion = spec.motion;
-    sys.addBody(std::move(body), [start, motion, run_start_s](double t) {
-        return segmentedMotion(start, motion, t - run_start_s);
-    });
+    sys.addBody(std::move(body), SegmentedMotion{start, run_start_s, spec.motion});
 }
 
 /// Start poses: a clearance above the bed puts the lowest mesh point that far above the surface.

@@ -25,11 +25,4 @@ void MeshBody::resetAccumulatedImpulse() {
     accumulated_time_s = 0.0;
 }
 
-RigidBodyState constantVelocityMotion(const RigidBodyState &initial, double t_s) {
-    RigidBodyState s = initial;
-    s.position_m = initial.position_m + initial.velocity_m_s * t_s;
-    s.orientation = rotationFromVector(initial.angular_velocity_rad_s * t_s) * initial.orientation;
-    return s;
-}
-
 } // namespace grainlink::dem

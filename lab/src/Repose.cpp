@@ -173,18 +173,9 @@ ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &opti
 
     dem::RigidBodyState initial;
     initial.position_m = Vec3(centre.x(), centre.y(), d.region_lower_m.z());
-    auto lift_start = std::make_shared<double>(std::numeric_limits<double>::infinity());
     const double v = t.lift_speed_m_s;
-    sys->addBody(
-        dem::MeshBody("tube", tubeMesh(t.tube_radius_m, t.tube_height_m, t.tube_segments), initial),
-        [initial, lift_start, v](double time_s) {
-            dem::RigidBodyState s = initial;
-            if (time_s > *lift_start) {
-                s.position_m.z() += v * (time_s - *lift_start);
-                s.velocity_m_s = Vec3(0.0, 0.0, v);
-            }
-            return s;
-        });
+    sys->addBody(dem::MeshBody("tube", tubeMesh(t.tube_radius_m, t.tube_height_m, t.tube_segments),
+                               initial));
 
     // Fill the tube and let the column settle (the tube stands still meanwhile), under the
     // deposition's rolling law if it has its own: one fill for several laws.
@@ -201,7 +192,9 @@ ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &opti
         sys->setRolling(scenario.soil.law.rolling);
 
     // Lift the tube by its own height: its bottom then clears any column it held.
-    *lift_start = sys->time();
+    dem::RigidBodyState lifting = initial;
+    lifting.linear_velocity_m_s = Vec3(0.0, 0.0, v);
+    sys->setBodyMotion(0, dem::constantVelocity(lifting, sys->time()));
     const auto lift_steps = std::uint64_t(std::ceil(t.tube_height_m / (v * dt)));
     dem::Progress lift("repose lift", options.progress_interval_s);
     const std::uint64_t chunk = std::max<std::uint64_t>(1, std::llround(0.01 / dt));

@@ -72,10 +72,9 @@ std::unique_ptr<DemSystem> busySystem(int threads) {
     insertRandom(*sys, spec, random, spec.count, spec.region_lower_m, spec.region_upper_m);
     RigidBodyState start;
     start.position_m = Vec3(-0.03, 0.03, 0.035); // enters the box from the side
-    start.velocity_m_s = Vec3(0.2, 0, 0);
+    start.linear_velocity_m_s = Vec3(0.2, 0, 0);
     start.angular_velocity_rad_s = Vec3(0, 10, 0);
-    sys->addBody(MeshBody("drum", makeCylinder(0.025, 0.04, 24), start),
-                 [start](double t) { return constantVelocityMotion(start, t); });
+    sys->addBody(MeshBody("drum", makeCylinder(0.025, 0.04, 24), start), constantVelocity(start));
     return sys;
 }
 
@@ -119,7 +118,7 @@ TEST_CASE("a run restarted from a checkpoint continues bit-identically", "[dem][
 TEST_CASE("a bed read from a checkpoint runs as the live bed when a tool is added afterwards",
           "[dem][checkpoint]") {
     // The lab tests and coupled runs settle a bed (or read it from the packing cache) and then
-    // add their tool: adding a body re-initialises the system, which must keep the contact
+    // add their tool: adding a body re-initializes the system, which must keep the contact
     // pass's thread split of the last rebuild in both cases (re-estimating it in one case only
     // made cached and fresh beds differ by round-off that grew over a bevameter run).
     const Scratch scratch("checkpoint-tool");
@@ -127,7 +126,7 @@ TEST_CASE("a bed read from a checkpoint runs as the live bed when a tool is adde
     RigidBodyState start;
     start.position_m = Vec3(0.05, 0.03, 0.5); // far above: only its addition matters here
     const auto plunger = [&] { return MeshBody("plunger", makeCylinder(0.02, 0.01, 16), start); };
-    const auto motion = [start](double t) { return constantVelocityMotion(start, t); };
+    const SegmentedMotion motion = constantVelocity(start);
 
     auto live = busySystem(2);
     live->run(2500);

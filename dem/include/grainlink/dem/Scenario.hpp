@@ -15,25 +15,13 @@ namespace grainlink::dem {
 using config::ConfigError;
 using config::ConfigNode;
 
-/// A stretch of constant linear and angular velocity of a prescribed body.
-struct MotionSegment {
-    double duration_s = 0.0;
-    Vec3 velocity_m_s = Vec3::Zero();
-    Vec3 angular_velocity_rad_s = Vec3::Zero();
-};
-
-/// Pose at time t (from the start of the run phase) of piecewise-constant velocity motion;
-/// the body rests after the last segment.
-RigidBodyState segmentedMotion(const RigidBodyState &start,
-                               const std::vector<MotionSegment> &motion, double t_s);
-
 struct BodySpec {
     std::string name;
     TriangleMesh mesh;
     RigidBodyState start;
     /// If set, the body's lowest point starts this far above the settled bed's surface.
     std::optional<double> clearance_above_bed_m;
-    std::vector<MotionSegment> motion;
+    std::vector<MotionSegment> motion; ///< from the start of the run phase (BodyMotion.hpp)
     std::optional<double> friction_coefficient;
     bool record_triangle_loads = false;
 };

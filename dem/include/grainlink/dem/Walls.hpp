@@ -1,6 +1,7 @@
 #pragma once
 // Boundaries the particles touch: infinite planes (with an optional friction track) and rigid
-// bodies carrying triangle meshes whose motion is set from outside every step.
+// bodies carrying triangle meshes, moved by their BodyMotion (BodyMotion.hpp).
+#include "grainlink/dem/BodyMotion.hpp"
 #include "grainlink/dem/ContactLaw.hpp"
 #include "grainlink/dem/TriangleMesh.hpp"
 
@@ -31,18 +32,6 @@ struct PlaneWall {
     Material material; ///< wall elasticity; defaults to the particles' material
 };
 
-/// Pose and velocity of a rigid body, world frame, about the body's origin.
-struct RigidBodyState {
-    Vec3 position_m = Vec3::Zero();
-    Quat orientation = Quat::Identity(); ///< body frame -> world frame
-    Vec3 velocity_m_s = Vec3::Zero();
-    Vec3 angular_velocity_rad_s = Vec3::Zero();
-    /// Velocity of the body-fixed point now at world position p.
-    Vec3 pointVelocity(const Vec3 &p) const {
-        return velocity_m_s + angular_velocity_rad_s.cross(p - position_m);
-    }
-};
-
 /// Rigid body carrying a triangle mesh (wheel, plate, mole hull). Its state is imposed; the
 /// particles' reaction is accumulated as a wrench about the body origin.
 class MeshBody {
@@ -52,7 +41,7 @@ public:
     const std::string &name() const { return name_; }
     const TriangleMesh &mesh() const { return mesh_; }
     const RigidBodyState &state() const { return state_; }
-    /// Imposes pose and velocity (prescribed motion now, the coupling later).
+    /// Imposes pose and velocity (DemSystem does it every step from the body's motion).
     void setState(const RigidBodyState &state);
 
     std::optional<double> friction_coefficient; ///< unset: particle law's Coulomb angles
@@ -80,8 +69,5 @@ private:
     std::vector<Vec3> world_vertices_;
     double bounding_radius_ = 0.0;
 };
-
-/// Body state at time t for constant linear and angular velocity from an initial pose.
-RigidBodyState constantVelocityMotion(const RigidBodyState &initial, double t_s);
 
 } // namespace grainlink::dem
