@@ -15,13 +15,13 @@ SimulationError::SimulationError(std::uint64_t step_, ParticleId particle_,
                          std::to_string(particle_) + ": " + quantity_ + " " + detail),
       step(step_), particle(particle_), quantity(quantity_) {}
 
-DemSystem::DemSystem(ContactLaw law, std::vector<Material> materials, DemSettings settings)
-    : settings_(settings), law_(std::move(law)), materials_(std::move(materials)) {
+DemSystem::DemSystem(ContactLaws laws, std::vector<Material> materials, DemSettings settings)
+    : settings_(settings), laws_(std::move(laws)), materials_(std::move(materials)) {
     if (materials_.empty())
         throw std::invalid_argument("DemSystem needs at least one material");
     for (const Material &m : materials_)
         m.validate();
-    law_.finalize();
+    laws_.finalize();
     if (!(settings_.time_step_s > 0.0))
         throw std::invalid_argument("time_step_s must be > 0, got " +
                                     std::to_string(settings_.time_step_s));
@@ -80,11 +80,11 @@ void DemSystem::initialize() {
     const std::size_t n = particles_.size();
     // Each part's properties and per-thread buffers; histories may already be restored from a
     // checkpoint and are kept where their layout fits.
-    pairs_.prepare(materials_, law_, threads);
-    planes_.prepare(materials_, law_, n, threads);
-    meshes_.prepare(materials_, law_, n, threads);
+    pairs_.prepare(materials_, laws_.grain_grain, threads);
+    planes_.prepare(materials_, laws_.grain_wall, n, threads);
+    meshes_.prepare(materials_, laws_.grain_tool, n, threads);
     worst_.assign(std::size_t(threads), WorstOverlap{});
-    if (const auto *shape = std::get_if<RollingGrainShape>(&law_.rolling))
+    if (const auto *shape = std::get_if<RollingGrainShape>(&laws_.grain_grain.rolling))
         if (shape->inertia == RollingGrainShape::Inertia::SeedEq12)
             for (std::size_t i = 0; i < n; ++i) {
                 // Seed eq. 12 per local axis (docs/physics.md §2.6.1); idempotent.
@@ -142,14 +142,18 @@ double DemSystem::stableTimeStepEstimate() const {
         // and blows up at 0.71 T_R (IntegratorStabilityTest), so T_R itself is not safe.
         estimate = std::min(estimate, 0.5 * rayleigh);
     }
-    // An explicit dashpot c is stable only for dt < 2 m*/c (lightest pair, m* = m/2).
-    if (const auto *viscous = std::get_if<DampingViscous>(&law_.damping)) {
-        const double m_min = *std::min_element(particles_.mass.begin(), particles_.mass.end());
-        if (viscous->coefficient_N_s_m > 0.0)
-            estimate = std::min(estimate, m_min / viscous->coefficient_N_s_m);
-    }
-    if (law_.background_damping_1_s > 0.0)
-        estimate = std::min(estimate, 2.0 / law_.background_damping_1_s);
+    // An explicit dashpot c is stable only for dt < 2 m*/c: the lightest pair (m* = m/2), the
+    // lightest grain on a wall or a tool (m* = m), each under its type's c.
+    const double m_min = *std::min_element(particles_.mass.begin(), particles_.mass.end());
+    for (ContactType type :
+         {ContactType::GrainGrain, ContactType::GrainWall, ContactType::GrainTool})
+        if (const auto *viscous = std::get_if<DampingViscous>(&laws_.of(type).damping))
+            if (viscous->coefficient_N_s_m > 0.0)
+                estimate = std::min(estimate, (type == ContactType::GrainGrain ? 1.0 : 2.0) *
+                                                  m_min / viscous->coefficient_N_s_m);
+    const double k_h = laws_.grain_grain.background_damping_1_s;
+    if (k_h > 0.0)
+        estimate = std::min(estimate, 2.0 / k_h);
     return estimate;
 }
 
@@ -164,10 +168,18 @@ void DemSystem::setTimeStep(double dt_s) {
 }
 
 void DemSystem::setRolling(RollingModel rolling) {
-    const auto *old_shape = std::get_if<RollingGrainShape>(&law_.rolling);
+    ContactLaws laws;
+    laws.grain_grain.rolling = laws.grain_wall.rolling = laws.grain_tool.rolling = rolling;
+    setRolling(laws);
+}
+
+void DemSystem::setRolling(const ContactLaws &rolling) {
+    const auto *old_shape = std::get_if<RollingGrainShape>(&laws_.grain_grain.rolling);
     const bool had_eq12 = old_shape && old_shape->inertia == RollingGrainShape::Inertia::SeedEq12;
-    law_.rolling = std::move(rolling);
-    law_.finalize(); // the pair properties do not depend on the rolling slot
+    laws_.grain_grain.rolling = rolling.grain_grain.rolling;
+    laws_.grain_wall.rolling = rolling.grain_wall.rolling;
+    laws_.grain_tool.rolling = rolling.grain_tool.rolling;
+    laws_.finalize(); // the pair properties do not depend on the rolling slot
     // Histories of another law mean nothing to this one (a moment against an angle).
     pairs_.list().clearRollingHistory();
     planes_.clearRollingHistories();
@@ -341,7 +353,7 @@ void DemSystem::advanceAndClear() {
 inline void DemSystem::addBodyForces(std::size_t i) {
     auto &p = particles_;
     p.force[i] += p.mass[i] * settings_.gravity_m_s2;
-    const double k_h = law_.background_damping_1_s;
+    const double k_h = laws_.grain_grain.background_damping_1_s;
     if (k_h > 0.0) {
         // Background damping k_h (docs/physics.md §2.8); mean moment for anisotropic grains.
         p.force[i] -= (k_h * p.mass[i]) * p.velocity[i];
@@ -446,13 +458,16 @@ void DemSystem::pairContacts() {
     PhaseTimer::Scope scope(timer_, phase_.contacts);
     const int threads = settings_.threads;
     const double dt = settings_.time_step_s;
-    withConcreteLaw(law_, [&](const auto &law) {
+    withConcreteLaw(laws_.grain_grain, [&](const auto &grain_grain) {
+        // The wall law has the same models (ContactLaws::finalize), hence the same types.
+        using Law = std::decay_t<decltype(grain_grain)>;
+        const Law grain_wall = Law::of(laws_.grain_wall);
 #pragma omp parallel num_threads(threads)
         {
             const int t = omp_get_thread_num();
             auto plane_pass =
-                planes_.threadPass(t, pairs_.begin(t), pairs_.end(t), particles_, law, dt);
-            pairs_.threadPass(t, particles_, law, dt, worst_[std::size_t(t)], plane_pass);
+                planes_.threadPass(t, pairs_.begin(t), pairs_.end(t), particles_, grain_wall, dt);
+            pairs_.threadPass(t, particles_, grain_grain, dt, worst_[std::size_t(t)], plane_pass);
             pairs_.addSideContributions(t, threads, particles_);
         }
     });
@@ -464,8 +479,8 @@ void DemSystem::meshContacts() {
         return;
     PhaseTimer::Scope scope(timer_, phase_.meshes);
     const double dt = settings_.time_step_s;
-    withConcreteLaw(law_, [&](const auto &law) {
-        meshes_.compute(particles_, law, dt, worst_, settings_.threads);
+    withConcreteLaw(laws_.grain_tool, [&](const auto &grain_tool) {
+        meshes_.compute(particles_, grain_tool, dt, worst_, settings_.threads);
     });
     meshes_.sumLoads(dt, settings_.threads);
 }
@@ -514,8 +529,8 @@ Energies DemSystem::energies() const {
         e.gravitational_J -= p.mass[i] * settings_.gravity_m_s2.dot(p.position[i]);
     }
     // Stored elastic energy of the pair and plane contacts (docs/physics.md §2).
-    pairs_.addElasticEnergy(p, law_, e.elastic_J);
-    planes_.addElasticEnergy(p, law_, e.elastic_J);
+    pairs_.addElasticEnergy(p, laws_.grain_grain, e.elastic_J);
+    planes_.addElasticEnergy(p, laws_.grain_wall, e.elastic_J);
     return e;
 }
 

@@ -36,7 +36,7 @@ std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progr
         sys->setRolling(*settling_rolling);
     const auto runLaw = [&] {
         if (settling_rolling)
-            sys->setRolling(scenario.law.rolling);
+            sys->setRolling(contactLaws(scenario));
         return std::move(sys);
     };
     const std::string key = packingKey(scenario);

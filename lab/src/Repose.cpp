@@ -189,7 +189,7 @@ ReposeResult runRepose(const ReposeScenario &scenario, const ReposeOptions &opti
     std::fprintf(stderr, "[repose] %zu grains settled in the tube (%.3f s simulated)\n",
                  report.inserted, report.settle_time_s);
     if (d.rolling)
-        sys->setRolling(scenario.soil.law.rolling);
+        sys->setRolling(dem::contactLaws(scenario.soil));
 
     // Lift the tube by its own height: its bottom then clears any column it held.
     dem::RigidBodyState lifting = initial;

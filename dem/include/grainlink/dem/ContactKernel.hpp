@@ -265,6 +265,13 @@ template <class Damping, class Tangential, class Rolling, class Cohesion> struct
     /// The rolling slot keeps a per-contact history.
     static constexpr bool kRollingHistory = kGrainShape || std::is_same_v<Rolling, RollingEpsd>;
 
+    /// The same models with the parameters of `law` (ContactLaws::finalize checked that a
+    /// contact type's law has the grain-grain models).
+    static ConcreteLaw of(const ContactLaw &law) {
+        return {std::get<Damping>(law.damping), std::get<Tangential>(law.tangential),
+                std::get<Rolling>(law.rolling), std::get<Cohesion>(law.cohesion)};
+    }
+
     [[gnu::always_inline]] void evaluate(const PairProperties &pair, const ContactGeometry &g,
                                          double dt_s, ContactHistory &history,
                                          ContactResult &out) const {

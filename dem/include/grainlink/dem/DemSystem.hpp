@@ -57,11 +57,13 @@ struct Energies {
 /// (PairContacts), grain-plane (PlaneContacts) and grain-mesh (MeshContacts).
 class DemSystem {
 public:
-    DemSystem(ContactLaw law, std::vector<Material> materials, DemSettings settings);
+    /// `laws`: one ContactLaw for every contact type, or one per type (ContactLaws).
+    DemSystem(ContactLaws laws, std::vector<Material> materials, DemSettings settings);
 
     ParticleStore &particles() { return particles_; }
     const ParticleStore &particles() const { return particles_; }
-    const ContactLaw &law() const { return law_; }
+    const ContactLaws &laws() const { return laws_; }
+    const ContactLaw &law() const { return laws_.grain_grain; } ///< the grain-grain law
     const DemSettings &settings() const { return settings_; }
     const std::vector<Material> &materials() const { return materials_; }
 
@@ -97,10 +99,13 @@ public:
     }
     /// Changes the time step between steps (the clock stays exact in steps of the old size).
     void setTimeStep(double dt_s);
-    /// Replaces the rolling slot between steps, e.g. to test several rolling laws on one
-    /// settled packing (docs/scenario.md, deposition.rolling). Every rolling history starts
-    /// afresh; the moments of inertia follow the new law (seed eq. 12 or solid spheres).
+    /// Replaces the rolling slot of every contact type between steps, e.g. to test several
+    /// rolling laws on one settled packing (docs/scenario.md, deposition.rolling). Every
+    /// rolling history starts afresh; the moments of inertia follow the new grain-grain law
+    /// (seed eq. 12 or solid spheres).
     void setRolling(RollingModel rolling);
+    /// The same with each contact type's rolling slot from `laws` (back to a run's own laws).
+    void setRolling(const ContactLaws &laws);
 
     /// Largest safe step estimate: half the Rayleigh time of the smallest grain, the viscous
     /// dashpot limit m_min/k_n where one is set, 2/k_h (docs/physics.md §3.3).
@@ -141,7 +146,7 @@ private:
 
     // What the system is.
     DemSettings settings_;
-    ContactLaw law_;
+    ContactLaws laws_;
     std::vector<Material> materials_;
     // Its state: the particles and the contact parts.
     ParticleStore particles_;

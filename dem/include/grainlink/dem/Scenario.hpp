@@ -32,11 +32,26 @@ struct OutputSpec {
     double checkpoint_interval_s = 0.0; ///< 0: no periodic checkpoints
 };
 
+/// The slots a contact type sets for itself in `contact_wall` or `contact_tool`; the others are
+/// the grain-grain law's (`contact`). A slot given there is the grain-grain slot with the keys
+/// given replaced.
+struct ContactOverride {
+    std::optional<DampingModel> damping;
+    std::optional<TangentialModel> tangential;
+    std::optional<RollingModel> rolling;
+    std::optional<CohesionModel> cohesion;
+    bool any() const { return damping || tangential || rolling || cohesion; }
+    /// `law` with these slots in place of its own.
+    ContactLaw appliedTo(ContactLaw law) const;
+};
+
 struct DemScenario {
     std::string file;
     std::string name;
     DemSettings settings;
-    ContactLaw law;
+    ContactLaw law;               ///< `contact`: grain-grain contacts
+    ContactOverride contact_wall; ///< grain-wall contacts (planes, boxes)
+    ContactOverride contact_tool; ///< grain-tool contacts (mesh bodies)
     Material material;
     std::vector<PlaneWall> planes;
     DepositionSpec deposition;
@@ -51,6 +66,8 @@ DemScenario loadScenario(const std::string &path);
 /// `coupled`: the soil section of a coupled run (no `run:`; bodies come from the coupling).
 DemScenario parseScenario(const ConfigNode &root, bool coupled = false);
 
+/// The law of each contact type: `contact` with the overrides of `contact_wall`, `contact_tool`.
+ContactLaws contactLaws(const DemScenario &scenario);
 /// The system without mesh bodies (deposition runs without them).
 std::unique_ptr<DemSystem> makeSystem(const DemScenario &scenario);
 /// Key of the settled packing: everything that shapes it, nothing that does not.
