@@ -72,8 +72,8 @@ void DemSystem::initialize() {
             throw std::invalid_argument("particle refers to material " + std::to_string(m) +
                                         ", but only " + std::to_string(materials_.size()) +
                                         " are defined");
-    if (settings_.skin_m <= 0.0)
-        settings_.skin_m = 0.4 * particles_.minRadius();
+    if (skin_m_ <= 0.0) // chosen once: from the settings or the first particles' radii
+        skin_m_ = settings_.skin_m > 0.0 ? settings_.skin_m : 0.4 * particles_.minRadius();
     if (settings_.check_time_step)
         validateTimeStep();
     const int threads = settings_.threads;
@@ -99,8 +99,8 @@ void DemSystem::initialize() {
     } else {
         // Restored: the pair list is recreated at the saved reference so that the rebuild
         // schedule and the storage order continue exactly as in the run that saved it.
-        pairs_.rebuildAtReference(particles_, settings_.skin_m, threads);
-        planes_.updateCandidates(particles_.position, particles_.radius, settings_.skin_m, threads);
+        pairs_.rebuildAtReference(particles_, skin_m_, threads);
+        planes_.updateCandidates(pairs_.referencePositions(), particles_.radius, skin_m_, threads);
         // The thread split is estimated from the contacts at a rebuild, and only there: a
         // re-initialization (a body added, a checkpoint read) keeps the last rebuild's split,
         // saved in the checkpoint, or the summation order would change with it.
@@ -401,9 +401,9 @@ void DemSystem::updateNeighbours() {
         }
     }
     displacement_known_ = false;
-    if (2.0 * std::sqrt(max_displacement_sq_) > settings_.skin_m)
+    if (2.0 * std::sqrt(max_displacement_sq_) > skin_m_)
         rebuildNeighbours();
-    meshes_.update(particles_, max_mesh_displacement_sq_, settings_.skin_m, settings_.threads);
+    meshes_.update(particles_, max_mesh_displacement_sq_, skin_m_, settings_.threads);
 }
 
 namespace {
@@ -428,7 +428,7 @@ void DemSystem::rebuildNeighbours() {
     if (resort && n > 0) {
         // Spatial re-sort; every part's histories follow by index map.
         const std::vector<std::size_t> order =
-            spatialOrder(particles_, 2.0 * particles_.maxRadius() + settings_.skin_m);
+            spatialOrder(particles_, 2.0 * particles_.maxRadius() + skin_m_);
         old_to_new.resize(n);
         for (std::size_t k = 0; k < n; ++k)
             old_to_new[order[k]] = k;
@@ -436,9 +436,8 @@ void DemSystem::rebuildNeighbours() {
         planes_.permuteHistories(order);
         meshes_.permuteHistories(order);
     }
-    pairs_.rebuild(particles_, settings_.skin_m, old_to_new, settings_.threads);
-    planes_.updateCandidates(particles_.position, particles_.radius, settings_.skin_m,
-                             settings_.threads);
+    pairs_.rebuild(particles_, skin_m_, old_to_new, settings_.threads);
+    planes_.updateCandidates(particles_.position, particles_.radius, skin_m_, settings_.threads);
     balanceContactWork();
 }
 
@@ -551,6 +550,10 @@ DemSystem::Internals DemSystem::saveInternals() const {
     s.time_offset_s = time_offset_s_;
     s.max_overlap_ratio = max_overlap_ratio_;
     s.contact_split = pairs_.split();
+    s.skin_m = skin_m_;
+    for (int b = 0; b < meshes_.size(); ++b)
+        s.body_loads.push_back(meshes_.body(b).loads());
+    s.plane_force = planes_.forces();
     return s;
 }
 
@@ -568,7 +571,13 @@ void DemSystem::restoreInternals(const Internals &s) {
     max_overlap_ratio_ = s.max_overlap_ratio;
     planes_.setHistories(s.plane_history);
     for (std::size_t b = 0; b < s.body_states.size(); ++b)
-        meshes_.body(int(b)).setState(s.body_states[b]);
+        meshes_.body(int(b)).restoreState(s.body_states[b]);
+    for (std::size_t b = 0; b < s.body_loads.size() && b < s.body_states.size(); ++b)
+        meshes_.body(int(b)).setLoads(s.body_loads[b]);
+    if (s.plane_force.size() == planes_.size())
+        planes_.setForces(s.plane_force);
+    if (settings_.skin_m <= 0.0 && s.skin_m > 0.0)
+        skin_m_ = s.skin_m; // automatic: as the saving run chose it, not from today's radii
     meshes_.restore(s.mesh_slots, s.mesh_reference_position, s.body_reference);
     pairs_.restore(s.contacts, s.reference_position, s.neighbour_builds, s.contact_split);
     forces_valid_ = s.forces_valid;

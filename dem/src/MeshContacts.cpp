@@ -10,6 +10,7 @@ int MeshContacts::add(MeshBody body, BodyMotion motion, double time_s) {
     motions_.emplace_back();
     setMotion(int(bodies_.size() - 1), std::move(motion), time_s);
     stale_ = true;
+    restored_ = false;
     return int(bodies_.size() - 1);
 }
 
@@ -51,6 +52,8 @@ void MeshContacts::prepare(const std::vector<Material> &materials, const Contact
             per_thread.emplace_back(b.record_triangle_loads ? b.mesh().triangleCount() : 0,
                                     Vec3::Zero());
     slots_.resize(particles * kSlots);
+    if (reference_position_.size() != particles || body_reference_.size() != bodies_.size())
+        restored_ = false; // particles or bodies added since: rebuilt afresh
     body_reference_.resize(bodies_.size());
 }
 
@@ -61,12 +64,25 @@ void MeshContacts::permuteHistories(const std::vector<std::size_t> &order) {
             permuted[k * kSlots + s] = slots_[order[k] * kSlots + s];
     slots_.swap(permuted);
     stale_ = true;
+    restored_ = false;
 }
 
 void MeshContacts::update(const ParticleStore &p, double max_displacement_sq_m2, double skin_m,
                           int threads) {
     if (bodies_.empty())
         return;
+    if (restored_) {
+        // The candidates of the saved reference: the bodies' vertices where they were then.
+        std::vector<std::vector<Vec3>> placed(bodies_.size());
+        std::vector<const std::vector<Vec3> *> vertices;
+        for (std::size_t b = 0; b < bodies_.size(); ++b) {
+            bodies_[b].worldVerticesAt(body_reference_[b], placed[b]);
+            vertices.push_back(&placed[b]);
+        }
+        build(p, reference_position_, vertices, skin_m, threads);
+        restored_ = false;
+        stale_ = false;
+    }
     // A particle-triangle pair may approach by the particle's and the mesh's displacement.
     double body_move = 0.0;
     for (std::size_t b = 0; b < bodies_.size() && !stale_; ++b) {
@@ -77,14 +93,24 @@ void MeshContacts::update(const ParticleStore &p, double max_displacement_sq_m2,
         body_move = std::max(body_move, (now.position_m - ref.position_m).norm() +
                                             angle * bodies_[b].boundingRadius());
     }
-    if (stale_ || std::sqrt(max_displacement_sq_m2) + body_move > skin_m)
-        rebuild(p, skin_m, threads);
+    if (stale_ || std::sqrt(max_displacement_sq_m2) + body_move > skin_m) {
+        std::vector<const std::vector<Vec3> *> vertices;
+        for (const MeshBody &body : bodies_)
+            vertices.push_back(&body.worldVertices());
+        build(p, p.position, vertices, skin_m, threads);
+        reference_position_ = p.position;
+        for (std::size_t b = 0; b < bodies_.size(); ++b)
+            body_reference_[b] = bodies_[b].state();
+        stale_ = false;
+    }
 }
 
-void MeshContacts::rebuild(const ParticleStore &p, double skin_m, int threads) {
+void MeshContacts::build(const ParticleStore &p, const std::vector<Vec3> &positions,
+                         const std::vector<const std::vector<Vec3> *> &vertices, double skin_m,
+                         int threads) {
     const std::size_t n = p.size();
     const double r_max = p.maxRadius();
-    grid_.bin(p.position, 2.0 * r_max + skin_m);
+    grid_.bin(positions, 2.0 * r_max + skin_m);
     const auto &start = grid_.cellStart();
     const auto &members = grid_.cellParticles();
     // Triangles are shared out among threads; the sort below makes the result independent of
@@ -99,9 +125,8 @@ void MeshContacts::rebuild(const ParticleStore &p, double skin_m, int threads) {
     for (std::size_t k = 0; k < triangles.size(); ++k) {
         auto &found = found_by[std::size_t(omp_get_thread_num())];
         const auto [b, t] = triangles[k];
-        const MeshBody &body = bodies_[std::size_t(b)];
-        const auto &v = body.worldVertices();
-        const auto &tri = body.mesh().triangles[std::size_t(t)];
+        const auto &v = *vertices[std::size_t(b)];
+        const auto &tri = bodies_[std::size_t(b)].mesh().triangles[std::size_t(t)];
         const Vec3 &a = v[tri[0]], &bb = v[tri[1]], &c = v[tri[2]];
         const Vec3 pad = Vec3::Constant(r_max + skin_m);
         const Eigen::Vector3i lo = grid_.cellCoords(a.cwiseMin(bb).cwiseMin(c) - pad);
@@ -113,7 +138,7 @@ void MeshContacts::rebuild(const ParticleStore &p, double skin_m, int threads) {
                     const int cell = grid_.cellIndex({x, y, z});
                     for (int m = start[cell]; m < start[cell + 1]; ++m) {
                         const std::size_t i = std::size_t(members[m]);
-                        const Vec3 &x_i = p.position[i];
+                        const Vec3 &x_i = positions[i];
                         const double reach = p.radius[i] + skin_m;
                         // Cheap plane test first: most cell members are far off the plane.
                         if (std::abs((x_i - a).dot(normal)) >= reach)
@@ -149,10 +174,6 @@ void MeshContacts::rebuild(const ParticleStore &p, double skin_m, int threads) {
             first_.push_back(first[i]);
         }
     first_.push_back(first[n]);
-    reference_position_ = p.position;
-    for (std::size_t b = 0; b < bodies_.size(); ++b)
-        body_reference_[b] = bodies_[b].state();
-    stale_ = false;
 }
 
 void MeshContacts::sumLoads(double dt_s, int threads) {
@@ -182,6 +203,7 @@ void MeshContacts::restore(std::vector<MeshContactSlot> slots, std::vector<Vec3>
     reference_position_ = std::move(reference);
     body_reference_ = std::move(body_reference);
     stale_ = true;
+    restored_ = true;
 }
 
 void MeshContacts::clearRollingHistories() {

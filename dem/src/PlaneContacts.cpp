@@ -29,7 +29,7 @@ void PlaneContacts::prepare(const std::vector<Material> &materials, const Contac
             properties_[w].push_back(
                 pairProperties(materials[k], p.material, law, p.track->friction_coefficient));
     }
-    force_.assign(planes_.size(), Vec3::Zero());
+    force_.resize(planes_.size(), Vec3::Zero()); // a restored state keeps its last forces
     thread_force_.resize(std::size_t(threads));
     for (auto &sums : thread_force_)
         sums = perThreadSums(planes_.size());

@@ -27,7 +27,7 @@ struct DemSettings {
     double newmark_beta = 0.25; ///< beta = 0, gamma = 1/2 is velocity Verlet
     double newmark_gamma = 0.5;
     Vec3 gravity_m_s2 = Vec3(0.0, 0.0, -9.81);
-    double skin_m = 0.0;          ///< neighbour skin; 0 picks 0.4 * smallest radius
+    double skin_m = 0.0; ///< neighbour skin [m]; 0: 0.4 x the smallest radius at the first step
     int resort_every_builds = 25; ///< spatial re-sort every this many list builds (0: never)
     int threads = 1;
     double max_overlap_ratio = 0.4; ///< overlap / smaller radius beyond which the run stops
@@ -116,6 +116,9 @@ public:
     std::size_t neighbourPairs() const { return pairs_.list().pairCount(); }
     std::uint64_t neighbourBuilds() const { return pairs_.list().buildCount(); }
     double maxOverlapRatio() const { return max_overlap_ratio_; }
+    /// The neighbour skin in use [m]: settings().skin_m, or if that is 0 chosen from the
+    /// particles' radii at the first step (0 before it).
+    double skin() const { return skin_m_; }
     PhaseTimer &timer() { return timer_; }
 
     /// Everything a checkpoint needs beyond the particle arrays (see Checkpoint.hpp).
@@ -158,6 +161,7 @@ private:
     std::uint64_t step_offset_ = 0; ///< steps taken before the last time-step change
     double time_offset_s_ = 0.0;
     // The step's bookkeeping.
+    double skin_m_ = 0.0; ///< neighbour skin in use [m] (skin())
     bool initialized_ = false;
     bool forces_valid_ = false;
     std::size_t prepared_particles_ = 0;    ///< particle count the lists were built for
@@ -189,6 +193,11 @@ struct DemSystem::Internals {
     double max_overlap_ratio = 0.0;
     /// Contact-pass thread split (thread count + 1 entries); empty in version-1 checkpoints.
     std::vector<std::size_t> contact_split;
+    /// The neighbour skin in use, set from the first particles' radii at the first step and
+    /// kept since [m]; 0 in version-1 and -2 checkpoints (then derived again).
+    double skin_m = 0.0;
+    std::vector<BodyLoads> body_loads; ///< per body; empty before version 3
+    std::vector<Vec3> plane_force;     ///< of the last step, per plane; empty before version 3
 };
 
 } // namespace grainlink::dem

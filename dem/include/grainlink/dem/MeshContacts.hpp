@@ -48,7 +48,7 @@ public:
     /// The candidates are rebuilt before the next contact pass.
     void markStale() { stale_ = true; }
     /// Whether particle displacements are measured against referencePositions().
-    bool tracksDisplacement() const { return !bodies_.empty() && !stale_; }
+    bool tracksDisplacement() const { return !bodies_.empty() && (!stale_ || restored_); }
     const std::vector<Vec3> &referencePositions() const { return reference_position_; }
     /// Rebuilds the candidates if stale or if a particle (moved at most
     /// sqrt(max_displacement_sq_m2) since the last build) and a mesh may have closed the skin.
@@ -65,7 +65,9 @@ public:
 
     const std::vector<MeshContactSlot> &slots() const { return slots_; }
     const std::vector<RigidBodyState> &bodyReference() const { return body_reference_; }
-    /// Installs a saved state (slots, candidate reference positions and body states).
+    /// Installs a saved state (slots, candidate reference positions and body states): the
+    /// candidates are recreated at that reference before the next pass, so that their rebuild
+    /// schedule continues as in the run that saved it.
     void restore(std::vector<MeshContactSlot> slots, std::vector<Vec3> reference,
                  std::vector<RigidBodyState> body_reference);
     void clearRollingHistories();
@@ -73,7 +75,9 @@ public:
 
 private:
     void moveBody(std::size_t k, double time_s); ///< unless it is held
-    void rebuild(const ParticleStore &p, double skin_m, int threads);
+    /// Candidates of the particles at `positions` and the triangles at `vertices` (per body).
+    void build(const ParticleStore &p, const std::vector<Vec3> &positions,
+               const std::vector<const std::vector<Vec3> *> &vertices, double skin_m, int threads);
 
     std::vector<MeshBody> bodies_;
     std::vector<BodyMotion> motions_;
@@ -86,6 +90,7 @@ private:
     std::vector<Vec3> reference_position_;
     std::vector<RigidBodyState> body_reference_;
     bool stale_ = true;
+    bool restored_ = false; ///< reference and slots restored, candidates not yet recreated
     CellGrid grid_;
     std::vector<std::vector<Vec3>> thread_force_, thread_torque_;       ///< [thread][body]
     std::vector<std::vector<std::vector<Vec3>>> thread_triangle_force_; ///< [thread][body][tri]

@@ -22,6 +22,8 @@ public:
     std::size_t size() const { return planes_.size(); }
     /// Reaction force of the particles on plane k during the last step [N].
     const Vec3 &force(int k) const { return force_[std::size_t(k)]; }
+    const std::vector<Vec3> &forces() const { return force_; }
+    void setForces(std::vector<Vec3> forces) { force_ = std::move(forces); }
 
     /// Properties under `law` and per-thread sums; histories laid out for `particles` (a changed
     /// plane count changes the layout, and those histories start afresh).

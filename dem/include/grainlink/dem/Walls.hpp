@@ -32,6 +32,15 @@ struct PlaneWall {
     Material material; ///< wall elasticity; defaults to the particles' material
 };
 
+/// A mesh body's wrench of the last step and its accumulated impulse (MeshBody's members).
+struct BodyLoads {
+    Vec3 force_N = Vec3::Zero();
+    Vec3 torque_N_m = Vec3::Zero(); ///< about the body origin
+    Vec3 impulse_N_s = Vec3::Zero();
+    Vec3 angular_impulse_N_m_s = Vec3::Zero();
+    double accumulated_time_s = 0.0;
+};
+
 /// Rigid body carrying a triangle mesh (wheel, plate, mole hull). Its state is imposed; the
 /// particles' reaction is accumulated as a wrench about the body origin.
 class MeshBody {
@@ -43,6 +52,8 @@ public:
     const RigidBodyState &state() const { return state_; }
     /// Imposes pose and velocity (DemSystem does it every step from the body's motion).
     void setState(const RigidBodyState &state);
+    /// Sets a state that state() returned, bit for bit (setState would normalize it again).
+    void restoreState(const RigidBodyState &saved);
 
     std::optional<double> friction_coefficient; ///< unset: particle law's Coulomb angles
     Material material;                          ///< defaults to the particles' material
@@ -57,12 +68,20 @@ public:
     Vec3 angular_impulse_N_m_s = Vec3::Zero();
     double accumulated_time_s = 0.0;
     void resetAccumulatedImpulse();
+    /// The members above as one value, and back (checkpoints, in-memory snapshots).
+    BodyLoads loads() const {
+        return {force_N, torque_N_m, impulse_N_s, angular_impulse_N_m_s, accumulated_time_s};
+    }
+    void setLoads(const BodyLoads &loads);
 
     /// World-frame vertices at the current pose.
     const std::vector<Vec3> &worldVertices() const { return world_vertices_; }
+    /// The same at another (normalized) state, e.g. one state() returned earlier.
+    void worldVerticesAt(const RigidBodyState &state, std::vector<Vec3> &out) const;
     double boundingRadius() const { return bounding_radius_; }
 
 private:
+    void placeVertices(); ///< world vertices at state_
     std::string name_;
     TriangleMesh mesh_;
     RigidBodyState state_;
