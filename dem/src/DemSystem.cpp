@@ -584,4 +584,35 @@ void DemSystem::restoreInternals(const Internals &s) {
     initialized_ = false;
 }
 
+DemSystem::State DemSystem::saveState() const {
+    return {planes_.size(),  particles_,         pairs_.state(),
+            planes_.state(), meshes_.state(),    step_,
+            step_offset_,    time_offset_s_,     settings_.time_step_s,
+            skin_m_,         max_overlap_ratio_, initialized_,
+            forces_valid_,   prepared_particles_};
+}
+
+void DemSystem::restoreState(const State &s) {
+    if (s.plane_count != planes_.size() ||
+        s.meshes.body_state.size() != std::size_t(meshes_.size()))
+        throw std::invalid_argument(
+            "restoreState: the state was saved with " + std::to_string(s.plane_count) +
+            " planes and " + std::to_string(s.meshes.body_state.size()) +
+            " mesh bodies, the system has " + std::to_string(planes_.size()) + " and " +
+            std::to_string(meshes_.size()) + ": restore a state of this system, as it was set up");
+    planes_.restore(s.planes);
+    meshes_.restore(s.meshes);
+    particles_ = s.particles;
+    pairs_.restore(s.pairs);
+    step_ = s.step;
+    step_offset_ = s.step_offset;
+    time_offset_s_ = s.time_offset_s;
+    settings_.time_step_s = s.time_step_s;
+    skin_m_ = s.skin_m;
+    max_overlap_ratio_ = s.max_overlap_ratio;
+    initialized_ = s.initialized;
+    forces_valid_ = s.forces_valid;
+    prepared_particles_ = s.prepared_particles;
+}
+
 } // namespace grainlink::dem

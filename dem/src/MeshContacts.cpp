@@ -206,6 +206,33 @@ void MeshContacts::restore(std::vector<MeshContactSlot> slots, std::vector<Vec3>
     restored_ = true;
 }
 
+MeshContacts::State MeshContacts::state() const {
+    State s{slots_, particles_, first_, candidates_, reference_position_, body_reference_, {},
+            {},     {},         stale_, restored_};
+    for (const MeshBody &b : bodies_) {
+        s.body_state.push_back(b.state());
+        s.body_loads.push_back(b.loads());
+        s.triangle_force.push_back(b.triangle_force_N);
+    }
+    return s;
+}
+
+void MeshContacts::restore(const State &s) {
+    slots_ = s.slots;
+    particles_ = s.particles;
+    first_ = s.first;
+    candidates_ = s.candidates;
+    reference_position_ = s.reference_position;
+    body_reference_ = s.body_reference;
+    stale_ = s.stale;
+    restored_ = s.restored;
+    for (std::size_t b = 0; b < bodies_.size(); ++b) {
+        bodies_[b].restoreState(s.body_state[b]);
+        bodies_[b].setLoads(s.body_loads[b]);
+        bodies_[b].triangle_force_N = s.triangle_force[b];
+    }
+}
+
 void MeshContacts::clearRollingHistories() {
     for (MeshContactSlot &slot : slots_)
         slot.history.rolling_N_m.setZero();

@@ -85,6 +85,13 @@ void PlaneContacts::sumForces(int threads) {
     }
 }
 
+void PlaneContacts::restore(const State &s) {
+    history_ = s.history;
+    history_planes_ = s.history_planes;
+    candidates_ = s.candidates;
+    force_ = s.force;
+}
+
 void PlaneContacts::setHistories(std::vector<ContactHistory> histories) {
     history_ = std::move(histories);
     history_planes_ = planes_.size();

@@ -126,6 +126,20 @@ public:
     Internals saveInternals() const;
     void restoreInternals(const Internals &state);
 
+    /// The complete state in memory, for implicit coupling (repeat a window) or a retry:
+    ///     const DemSystem::State start = sys.saveState();
+    ///     sys.run(n);                      // one try
+    ///     sys.restoreState(start);         // back, bit for bit
+    ///     sys.setBodyMotion(0, corrected); // the motions are inputs: set them again
+    ///     sys.run(n);                      // as if the first try never happened
+    /// Particles, every contact history (rolling and grain-shape state included), the
+    /// neighbour list and the mesh and plane candidates as they are, the bodies' states and
+    /// accumulated loads, the clock. The setup (laws, materials, planes, bodies, settings other
+    /// than the time step) must be the same as when it was saved.
+    struct State;
+    State saveState() const;
+    void restoreState(const State &state);
+
 private:
     void initialize();
     void validateTimeStep() const;
@@ -198,6 +212,19 @@ struct DemSystem::Internals {
     double skin_m = 0.0;
     std::vector<BodyLoads> body_loads; ///< per body; empty before version 3
     std::vector<Vec3> plane_force;     ///< of the last step, per plane; empty before version 3
+};
+
+struct DemSystem::State {
+    std::size_t plane_count = 0;
+    ParticleStore particles;
+    PairContacts::State pairs;
+    PlaneContacts::State planes;
+    MeshContacts::State meshes;
+    std::uint64_t step = 0, step_offset = 0;
+    double time_offset_s = 0.0, time_step_s = 0.0;
+    double skin_m = 0.0, max_overlap_ratio = 0.0;
+    bool initialized = false, forces_valid = false;
+    std::size_t prepared_particles = 0;
 };
 
 } // namespace grainlink::dem

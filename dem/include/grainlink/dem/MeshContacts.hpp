@@ -63,6 +63,21 @@ public:
     /// and its impulse accumulated over `dt_s`.
     void sumLoads(double dt_s, int threads);
 
+    /// Everything that changes while the system runs (DemSystem::saveState); the motions are
+    /// inputs, set again by the driver.
+    struct State {
+        std::vector<MeshContactSlot> slots;
+        std::vector<std::size_t> particles, first;
+        std::vector<std::pair<int, int>> candidates;
+        std::vector<Vec3> reference_position;
+        std::vector<RigidBodyState> body_reference, body_state;
+        std::vector<BodyLoads> body_loads;
+        std::vector<std::vector<Vec3>> triangle_force; ///< per body, where recorded
+        bool stale = true, restored = false;
+    };
+    State state() const;
+    void restore(const State &s);
+
     const std::vector<MeshContactSlot> &slots() const { return slots_; }
     const std::vector<RigidBodyState> &bodyReference() const { return body_reference_; }
     /// Installs a saved state (slots, candidate reference positions and body states): the

@@ -67,6 +67,19 @@ public:
     /// particles, in thread order (deterministic). Contains a barrier.
     void addSideContributions(int t, int threads, ParticleStore &p) const;
 
+    /// Everything that changes while the system runs (DemSystem::saveState).
+    struct State {
+        NeighbourList::Saved list;
+        std::vector<Vec3> reference_position;
+        std::vector<std::size_t> split;
+    };
+    State state() const { return {list_.save(), reference_position_, split_}; }
+    void restore(const State &s) {
+        list_.restore(s.list);
+        reference_position_ = s.reference_position;
+        split_ = s.split;
+    }
+
     std::size_t contactCount(const ParticleStore &p) const;
     /// Adds the stored elastic energy of the contacts to `energy_J`.
     void addElasticEnergy(const ParticleStore &p, const ContactLaw &law, double &energy_J) const;

@@ -25,6 +25,12 @@ public:
     const std::vector<Vec3> &forces() const { return force_; }
     void setForces(std::vector<Vec3> forces) { force_ = std::move(forces); }
 
+private:
+    struct Candidate {
+        std::size_t particle, plane;
+    };
+
+public:
     /// Properties under `law` and per-thread sums; histories laid out for `particles` (a changed
     /// plane count changes the layout, and those histories start afresh).
     void prepare(const std::vector<Material> &materials, const ContactLaw &law,
@@ -50,6 +56,16 @@ public:
     /// After the pass: the threads' plane forces summed in thread order.
     void sumForces(int threads);
 
+    /// Everything that changes while the system runs (DemSystem::saveState).
+    struct State {
+        std::vector<ContactHistory> history;
+        std::size_t history_planes = 0;
+        std::vector<Candidate> candidates;
+        std::vector<Vec3> force;
+    };
+    State state() const { return {history_, history_planes_, candidates_, force_}; }
+    void restore(const State &s);
+
     const std::vector<ContactHistory> &histories() const { return history_; }
     void setHistories(std::vector<ContactHistory> histories);
     void clearRollingHistories();
@@ -58,9 +74,6 @@ public:
     void addElasticEnergy(const ParticleStore &p, const ContactLaw &law, double &energy_J) const;
 
 private:
-    struct Candidate {
-        std::size_t particle, plane;
-    };
     double distance(const Vec3 &x, std::size_t plane) const {
         return (x - planes_[plane].point_m).dot(planes_[plane].normal);
     }
