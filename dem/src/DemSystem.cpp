@@ -584,6 +584,33 @@ void DemSystem::restoreInternals(const Internals &s) {
     initialized_ = false;
 }
 
+namespace {
+template <class T> std::size_t bytesOf(const std::vector<T> &v) {
+    return v.size() * sizeof(T);
+}
+template <class T, class... Rest> std::size_t bytesOf(const T &first, const Rest &...rest) {
+    return bytesOf(first) + bytesOf(rest...);
+}
+} // namespace
+
+std::size_t DemSystem::State::bytes() const {
+    const ParticleStore &p = particles;
+    std::size_t n = sizeof(State) +
+                    bytesOf(p.id, p.position, p.velocity, p.angular_velocity, p.orientation,
+                            p.force, p.torque, p.radius, p.mass, p.inv_mass, p.inertia,
+                            p.material);
+    const auto &l = pairs.list;
+    n += bytesOf(l.first, l.owner, l.neighbour, l.state, l.tangential_m, l.rolling_N_m,
+                 l.pending, pairs.reference_position, pairs.split);
+    n += bytesOf(planes.history, planes.candidates, planes.force);
+    n += bytesOf(meshes.slots, meshes.particles, meshes.first, meshes.candidates,
+                 meshes.reference_position, meshes.body_reference, meshes.body_state,
+                 meshes.body_loads, meshes.triangle_force);
+    for (const auto &forces : meshes.triangle_force)
+        n += bytesOf(forces);
+    return n;
+}
+
 DemSystem::State DemSystem::saveState() const {
     return {planes_.size(),  particles_,         pairs_.state(),
             planes_.state(), meshes_.state(),    step_,

@@ -225,6 +225,8 @@ struct DemSystem::State {
     double skin_m = 0.0, max_overlap_ratio = 0.0;
     bool initialized = false, forces_valid = false;
     std::size_t prepared_particles = 0;
+    /// Memory the snapshot holds: its arrays' elements and the struct itself [bytes].
+    std::size_t bytes() const;
 };
 
 } // namespace grainlink::dem
