@@ -27,7 +27,6 @@ int runFloorNode(const NodeOptions &options) {
                          [&](const coupling::BodyDescription &d) { return d.name == name; });
         floors.emplace_back(floor, meshOf(*description));
     }
-    std::vector<WindowMotion> motion(options.bodies.size());
 
     std::filesystem::create_directories(options.output_directory);
     std::ofstream series(options.output_directory + "/floor.csv");
@@ -47,18 +46,18 @@ int runFloorNode(const NodeOptions &options) {
             const double dt = in.duration_s / double(steps);
             coupling::WindowOutputs out;
             for (std::size_t b = 0; b < floors.size(); ++b) {
-                motion[b] = {in.start_s, in.duration_s, in.start_states.at(b), in.end_states.at(b)};
+                const dem::WindowMotion motion = windowMotion(in, b);
                 // The impulse over the window, midpoint in time, divided by the window.
                 dem::Vec3 impulse = dem::Vec3::Zero(), angular = dem::Vec3::Zero(), force, torque;
                 double work = 0.0;
                 for (long long k = 0; k < steps; ++k) {
-                    const auto state = motion[b].at(in.start_s + (double(k) + 0.5) * dt);
+                    const auto state = motion.at(in.start_s + (double(k) + 0.5) * dt);
                     floors[b].step(state, dt, force, torque);
                     impulse += force * dt;
                     angular += torque * dt;
-                    work +=
-                        (force.dot(state.velocity_m_s) + torque.dot(state.angular_velocity_rad_s)) *
-                        dt;
+                    work += (force.dot(state.linear_velocity_m_s) +
+                             torque.dot(state.angular_velocity_rad_s)) *
+                            dt;
                 }
                 coupling::Wrench w;
                 w.body = options.bodies[b];

@@ -39,15 +39,15 @@ int runSoilNode(const NodeOptions &options) {
     const auto &run = participant.initialize();
     const auto mirror = MirrorSymmetry::parse(root);
 
-    // Every consumed body becomes a mesh body whose motion follows the current window.
-    std::vector<WindowMotion> motion(options.bodies.size());
+    // Every consumed body becomes a mesh body; its motion is set each window.
+    const std::size_t body_count = options.bodies.size();
     for (std::size_t b = 0; b < options.bodies.size(); ++b) {
         const auto description = std::find_if(
             run.bodies.begin(), run.bodies.end(),
             [&](const coupling::BodyDescription &d) { return d.name == options.bodies[b]; });
         dem::MeshBody body(options.bodies[b], meshOf(*description, mirror.has_value()),
                            dem::RigidBodyState{});
-        sys->addBody(std::move(body), [&motion, b](double t) { return motion[b].at(t); });
+        sys->addBody(std::move(body));
     }
     double dem_offset_s = sys->time() - run.start_tick * run.tick_s; // DEM time - coupling time
     // Particle and wheel snapshots for ParaView (soil.output.snapshot_interval_s), at the first
@@ -96,12 +96,8 @@ int runSoilNode(const NodeOptions &options) {
                                               "': the macro step " + std::to_string(in.duration_s) +
                                               " s is not a whole number of DEM time steps (" +
                                               std::to_string(dt) + " s)");
-            for (std::size_t b = 0; b < motion.size(); ++b) {
-                motion[b].start_dem_s = in.start_s + dem_offset_s;
-                motion[b].duration_s = in.duration_s;
-                motion[b].a = in.start_states.at(b);
-                motion[b].b = in.end_states.at(b);
-                sys->body(int(b)).setState(motion[b].at(motion[b].start_dem_s));
+            for (std::size_t b = 0; b < body_count; ++b) {
+                sys->setBodyMotion(int(b), windowMotion(in, b, dem_offset_s));
                 sys->body(int(b)).resetAccumulatedImpulse();
                 if (in.window == 0 && !run.restore) { // a body must not start buried in the bed
                     double lowest = 1e300;
@@ -115,19 +111,19 @@ int runSoilNode(const NodeOptions &options) {
                             std::to_string(surface) + " m): start it higher");
                 }
             }
-            std::vector<double> work(motion.size(), 0.0);
+            std::vector<double> work(body_count, 0.0);
             for (std::uint64_t k = 0; k < steps; ++k) {
                 sys->step();
-                for (std::size_t b = 0; b < motion.size(); ++b) {
+                for (std::size_t b = 0; b < body_count; ++b) {
                     const auto &body = sys->body(int(b));
-                    work[b] += (body.force_N.dot(body.state().velocity_m_s) +
+                    work[b] += (body.force_N.dot(body.state().linear_velocity_m_s) +
                                 body.torque_N_m.dot(body.state().angular_velocity_rad_s)) *
                                dt;
                 }
             }
             // The soil's load on the body: the impulse over the window divided by the window.
             coupling::WindowOutputs out;
-            for (std::size_t b = 0; b < motion.size(); ++b) {
+            for (std::size_t b = 0; b < body_count; ++b) {
                 const auto &body = sys->body(int(b));
                 coupling::Wrench w;
                 w.body = options.bodies[b];

@@ -1,7 +1,7 @@
 #pragma once
 // What the soil-side participants (the DEM soil, the rigid floor) share: the mesh of a coupled
-// body from its handshake description, and the body's motion through a window, interpolated so
-// that position and velocity agree with the received states at both ends.
+// body from its handshake description, and the body's motion through a window as the DEM's
+// dem::WindowMotion (position and velocity agree with the received states at both ends).
 #include "Nodes.hpp"
 #include "grainlink/coupling/Participant.hpp"
 #include "grainlink/coupling/Types.hpp"
@@ -59,30 +59,23 @@ inline dem::TriangleMesh meshOf(const coupling::BodyDescription &body, bool half
     throw coupling::CouplingError("body '" + body.name + "' has no geometry the soil can touch");
 }
 
-/// Motion of one body inside the current window: cubic Hermite position (and its derivative)
-/// through both end states, orientation by slerp, angular velocity linear.
-struct WindowMotion {
-    double start_dem_s = 0.0, duration_s = 1.0;
-    coupling::BodyState a, b;
+/// A coupled body's state as the DEM's rigid-body state.
+inline dem::RigidBodyState demState(const coupling::BodyState &s) {
+    dem::RigidBodyState r;
+    r.position_m = s.position_m;
+    r.orientation = s.orientation;
+    r.linear_velocity_m_s = s.linear_velocity_m_s;
+    r.angular_velocity_rad_s = s.angular_velocity_rad_s;
+    return r;
+}
 
-    dem::RigidBodyState at(double dem_time_s) const {
-        const double H = duration_s;
-        const double s = std::clamp((dem_time_s - start_dem_s) / H, 0.0, 1.0);
-        const double s2 = s * s, s3 = s2 * s;
-        dem::RigidBodyState r;
-        r.position_m = (2 * s3 - 3 * s2 + 1) * a.position_m +
-                       (s3 - 2 * s2 + s) * H * a.linear_velocity_m_s +
-                       (-2 * s3 + 3 * s2) * b.position_m + (s3 - s2) * H * b.linear_velocity_m_s;
-        r.velocity_m_s =
-            ((6 * s2 - 6 * s) * a.position_m + (3 * s2 - 4 * s + 1) * H * a.linear_velocity_m_s +
-             (-6 * s2 + 6 * s) * b.position_m + (3 * s2 - 2 * s) * H * b.linear_velocity_m_s) /
-            H;
-        r.orientation = a.orientation.slerp(s, b.orientation).normalized();
-        r.angular_velocity_rad_s =
-            (1 - s) * a.angular_velocity_rad_s + s * b.angular_velocity_rad_s;
-        return r;
-    }
-};
+/// Body b's motion through the window `in` (dem::WindowMotion, docs/physics.md §7.2), on a
+/// clock `offset_s` ahead of the coupling's.
+inline dem::WindowMotion windowMotion(const coupling::WindowInputs &in, std::size_t b,
+                                      double offset_s = 0.0) {
+    return {in.start_s + offset_s, in.duration_s, demState(in.start_states.at(b)),
+            demState(in.end_states.at(b))};
+}
 
 /// Mirror symmetry (DIGEST §5): the soil simulates only the half of the bin at y >= plane, with
 /// a frictionless wall on the plane, and each wheel's y >= 0 half; the other half is the mirror

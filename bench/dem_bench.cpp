@@ -3,6 +3,8 @@
 //   dem_bench prepare DIR            settle the 30,000-sphere bed (cached), write DIR/bed.data
 //                                    (LIGGGHTS read_data) and DIR/cylinder.stl
 //   dem_bench run DIR CASE THREADS [STEPS]   time CASE (settle | cylinder) on that bed
+//   dem_bench snapshot DIR CASE THREADS [CALLS]   time DemSystem::saveState / restoreState
+//                                    on CASE after the warm-up, and print the snapshot's size
 #include "grainlink/dem/Checkpoint.hpp"
 #include "grainlink/dem/Deposition.hpp"
 #include "grainlink/dem/Progress.hpp"
@@ -133,7 +135,8 @@ Vec3 placeCylinder(DemSystem &sys) {
     return centre;
 }
 
-int run(const fs::path &dir, const std::string &which, int threads, std::uint64_t steps) {
+/// CASE on the prepared bed, warmed up; null for an unknown case.
+std::unique_ptr<DemSystem> makeCase(const fs::path &dir, const std::string &which, int threads) {
     auto sys = makeBenchSystem(threads);
     {
         // Start from the exported bed at rest, as LIGGGHTS does (contact histories from zero).
@@ -152,16 +155,27 @@ int run(const fs::path &dir, const std::string &which, int threads, std::uint64_
     if (which == "cylinder") {
         RigidBodyState start;
         start.position_m = placeCylinder(*sys);
-        start.velocity_m_s = Vec3(kSpeed, 0, 0);
+        start.linear_velocity_m_s = Vec3(kSpeed, 0, 0);
         start.angular_velocity_rad_s = Vec3(0, kSpin, 0);
         sys->addBody(
             MeshBody("cylinder", makeCylinder(kCylinderRadius, kCylinderWidth, 360), start),
-            [start](double t) { return constantVelocityMotion(start, t); });
+            constantVelocity(start));
     } else if (which != "settle") {
         std::fprintf(stderr, "unknown case '%s' (settle | cylinder)\n", which.c_str());
-        return 2;
+        return nullptr;
     }
     sys->run(200); // warm-up, as in the LIGGGHTS inputs
+    return sys;
+}
+
+double secondsSince(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+int run(const fs::path &dir, const std::string &which, int threads, std::uint64_t steps) {
+    auto sys = makeCase(dir, which, threads);
+    if (!sys)
+        return 2;
     sys->timer().reset();
     const auto t0 = std::chrono::steady_clock::now();
     sys->run(steps);
@@ -193,6 +207,33 @@ int run(const fs::path &dir, const std::string &which, int threads, std::uint64_
     return 0;
 }
 
+/// The in-memory snapshot that implicit coupling takes at every window's start and restores at
+/// every further iteration: its cost per call beside a step's.
+int snapshot(const fs::path &dir, const std::string &which, int threads, int calls) {
+    auto sys = makeCase(dir, which, threads);
+    if (!sys)
+        return 2;
+    const std::uint64_t steps = 50;
+    auto t0 = std::chrono::steady_clock::now();
+    sys->run(steps);
+    const double step_s = secondsSince(t0) / double(steps);
+    DemSystem::State state = sys->saveState();
+    t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < calls; ++k)
+        state = sys->saveState(); // a fresh value each time, as a driver would take it
+    const double save_s = secondsSince(t0) / calls;
+    t0 = std::chrono::steady_clock::now();
+    for (int k = 0; k < calls; ++k)
+        sys->restoreState(state);
+    const double restore_s = secondsSince(t0) / calls;
+    sys->run(1); // the restored system steps on
+    std::printf("GRAINLINK snapshot case=%s threads=%d particles=%zu contacts=%zu bytes=%zu "
+                "save_ms=%.3f restore_ms=%.3f step_ms=%.3f\n",
+                which.c_str(), threads, sys->particles().size(), sys->contactCount(),
+                state.bytes(), 1e3 * save_s, 1e3 * restore_s, 1e3 * step_s);
+    return 0;
+}
+
 } // namespace
 
 int main(int argc, char **argv) {
@@ -203,8 +244,11 @@ int main(int argc, char **argv) {
         if (verb == "run" && (argc == 5 || argc == 6))
             return run(argv[2], argv[3], std::stoi(argv[4]),
                        argc == 6 ? std::stoull(argv[5]) : 2000);
-        std::fprintf(stderr,
-                     "usage: dem_bench prepare DIR | dem_bench run DIR CASE THREADS [STEPS]\n");
+        if (verb == "snapshot" && (argc == 5 || argc == 6))
+            return snapshot(argv[2], argv[3], std::stoi(argv[4]),
+                            argc == 6 ? std::max(1, std::stoi(argv[5])) : 20);
+        std::fprintf(stderr, "usage: dem_bench prepare DIR | dem_bench run DIR CASE THREADS "
+                             "[STEPS] | dem_bench snapshot DIR CASE THREADS [CALLS]\n");
         return 2;
     } catch (const std::exception &e) {
         std::fprintf(stderr, "dem_bench: error: %s\n", e.what());

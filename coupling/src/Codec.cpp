@@ -1,6 +1,11 @@
 #include "Codec.hpp"
 
+#include <google/protobuf/io/coded_stream.h>
+#include <google/protobuf/wire_format_lite.h>
+
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 namespace grainlink::coupling::codec {
 
@@ -58,13 +63,13 @@ BodyDescription fromWire(const pb::BodyDescription &body) {
                               body.mesh().triangle_indices().end());
         if (mesh.triangles.size() % 3 != 0)
             throw ProtocolError(pb::Error::CODE_MALFORMED,
-                                "body '" + body.name() + "': triangle index count " +
+                                "body '" + printable(body.name()) + "': triangle index count " +
                                     std::to_string(mesh.triangles.size()) +
                                     " is not a multiple of 3");
         for (auto i : mesh.triangles)
             if (i >= mesh.vertices_m.size())
                 throw ProtocolError(pb::Error::CODE_MALFORMED,
-                                    "body '" + body.name() + "': triangle index " +
+                                    "body '" + printable(body.name()) + "': triangle index " +
                                         std::to_string(i) + " beyond " +
                                         std::to_string(mesh.vertices_m.size()) + " vertices");
         out.geometry = std::move(mesh);
@@ -102,11 +107,11 @@ void toWire(const BodyState &state, pb::BodyState *out) {
 
 BodyState fromWire(const pb::BodyState &state) {
     if (state.frame() != pb::FRAME_WORLD)
-        throw ProtocolError(pb::Error::CODE_MALFORMED,
-                            "state of body '" + state.body() + "' is not in the world frame");
+        throw ProtocolError(pb::Error::CODE_MALFORMED, "state of body '" + printable(state.body()) +
+                                                           "' is not in the world frame");
     if (!state.has_orientation())
         throw ProtocolError(pb::Error::CODE_MALFORMED,
-                            "state of body '" + state.body() + "' has no orientation");
+                            "state of body '" + printable(state.body()) + "' has no orientation");
     BodyState out;
     out.body = state.body();
     out.position_m = fromWire(state.position_m());
@@ -115,7 +120,7 @@ BodyState fromWire(const pb::BodyState &state) {
     const double norm = out.orientation.norm();
     if (!(std::abs(norm - 1.0) < 1e-6))
         throw ProtocolError(pb::Error::CODE_MALFORMED,
-                            "orientation of body '" + state.body() +
+                            "orientation of body '" + printable(state.body()) +
                                 "' is not a unit quaternion (|q| = " + std::to_string(norm) + ")");
     out.linear_velocity_m_s = fromWire(state.linear_velocity_m_s());
     out.angular_velocity_rad_s = fromWire(state.angular_velocity_rad_s());
@@ -159,8 +164,9 @@ void toWire(const Wrench &wrench, pb::BodyWrench *out) {
 
 Wrench fromWire(const pb::BodyWrench &wrench) {
     if (wrench.frame() != pb::FRAME_WORLD)
-        throw ProtocolError(pb::Error::CODE_MALFORMED,
-                            "wrench on body '" + wrench.body() + "' is not in the world frame");
+        throw ProtocolError(pb::Error::CODE_MALFORMED, "wrench on body '" +
+                                                           printable(wrench.body()) +
+                                                           "' is not in the world frame");
     Wrench out;
     out.body = wrench.body();
     out.force_N = fromWire(wrench.force_n());
@@ -245,13 +251,66 @@ std::string encode(const pb::Envelope &envelope) {
     return bytes;
 }
 
-pb::Envelope decode(const void *data, std::size_t size, const std::string &from) {
+namespace {
+
+using google::protobuf::Descriptor;
+using google::protobuf::FieldDescriptor;
+using google::protobuf::io::CodedInputStream;
+using Wire = google::protobuf::internal::WireFormatLite;
+
+/// Walks the bytes as `type` without building it, counting the sub-messages and strings parsing
+/// would make; false once more than `budget` are left. Malformed bytes end the walk with true:
+/// the parser that follows names them. The schema has no recursive types, so neither has this.
+bool withinParts(const Descriptor *type, CodedInputStream &in, std::size_t &budget) {
+    for (std::uint32_t tag = in.ReadTag(); tag != 0; tag = in.ReadTag()) {
+        if (Wire::GetTagWireType(tag) != Wire::WIRETYPE_LENGTH_DELIMITED) {
+            if (!Wire::SkipField(&in, tag))
+                return true;
+            continue;
+        }
+        std::uint32_t length = 0;
+        if (!in.ReadVarint32(&length))
+            return true;
+        const FieldDescriptor *field = type->FindFieldByNumber(Wire::GetTagFieldNumber(tag));
+        const bool message = field && field->type() == FieldDescriptor::TYPE_MESSAGE;
+        const bool text = field && (field->type() == FieldDescriptor::TYPE_STRING ||
+                                    field->type() == FieldDescriptor::TYPE_BYTES);
+        if ((message || text) && budget-- == 0)
+            return false;
+        if (!message) {
+            if (!in.Skip(static_cast<int>(length)))
+                return true;
+            continue;
+        }
+        const auto limit = in.PushLimit(static_cast<int>(length));
+        if (!withinParts(field->message_type(), in, budget))
+            return false;
+        in.PopLimit(limit);
+    }
+    return true;
+}
+
+} // namespace
+
+pb::Envelope decode(const void *data, std::size_t size, const std::string &from,
+                    std::size_t max_parts) {
     pb::Envelope envelope;
-    decode(data, size, from, envelope);
+    decode(data, size, from, envelope, max_parts);
     return envelope;
 }
 
-void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &envelope) {
+void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &envelope,
+            std::size_t max_parts) {
+    if (max_parts != SIZE_MAX) {
+        CodedInputStream in(static_cast<const std::uint8_t *>(data), static_cast<int>(size));
+        std::size_t budget = max_parts;
+        if (!withinParts(pb::Envelope::descriptor(), in, budget))
+            throw ProtocolError(pb::Error::CODE_MALFORMED,
+                                "message from " + from + " (" + std::to_string(size) +
+                                    " bytes) would unpack into more than " +
+                                    std::to_string(max_parts) +
+                                    " sub-messages and strings (limits.max_message_bytes / 16)");
+    }
     if (!envelope.ParseFromArray(data, static_cast<int>(size)))
         throw ProtocolError(pb::Error::CODE_MALFORMED,
                             "malformed message from " + from + " (" + std::to_string(size) +
@@ -279,6 +338,43 @@ pb::Envelope &ScratchEnvelope::fresh() {
 std::string bodyName(const pb::Envelope &envelope) {
     const auto *field = pb::Envelope::descriptor()->FindFieldByNumber(envelope.body_case());
     return field ? field->name() : "nothing";
+}
+
+std::string describe(const pb::Envelope &envelope) {
+    return bodyName(envelope) + " for window " + std::to_string(envelope.window());
+}
+
+std::string printable(std::string_view text, std::size_t max_bytes) {
+    const std::size_t shown = std::min(text.size(), max_bytes);
+    std::string out;
+    out.reserve(shown);
+    for (std::size_t i = 0; i < shown; ++i) {
+        const auto c = static_cast<unsigned char>(text[i]);
+        if (c >= 0x20 && c < 0x7f && c != '\\') {
+            out += static_cast<char>(c);
+        } else {
+            char escaped[5];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+            out += escaped;
+        }
+    }
+    if (shown < text.size())
+        out += "... (" + std::to_string(text.size()) + " bytes)";
+    return out;
+}
+
+void checkHeader(const pb::Envelope &e, const std::string &name, std::uint64_t last_sequence) {
+    if (e.sender() != name)
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "sent a message signed '" + printable(e.sender()) + "'");
+    if (e.sequence() <= last_sequence)
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "sent message " + std::to_string(e.sequence()) + " again (duplicate; " +
+                                "last was " + std::to_string(last_sequence) + ")");
+    if (e.sequence() != last_sequence + 1)
+        throw ProtocolError(pb::Error::CODE_MALFORMED,
+                            "sent message " + std::to_string(e.sequence()) + " after " +
+                                std::to_string(last_sequence) + " (out of order)");
 }
 
 } // namespace grainlink::coupling::codec

@@ -6,8 +6,10 @@
 
 #include <google/protobuf/arena.h>
 
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace grainlink::coupling::codec {
@@ -59,11 +61,15 @@ SchemeKind fromWire(pb::Scheme scheme);
 std::string encode(const pb::Envelope &envelope);
 
 /// Parses and checks an envelope: well-formed bytes, our major version, a body set.
-/// `from` names the peer in error messages.
-pb::Envelope decode(const void *data, std::size_t size, const std::string &from);
+/// `from` names the peer in error messages. With `max_parts`, bytes that would unpack into more
+/// sub-messages and strings than that are refused before any is made: a few bytes each on the
+/// wire, ~70 bytes each in memory, so the message size alone does not bound what parsing takes.
+pb::Envelope decode(const void *data, std::size_t size, const std::string &from,
+                    std::size_t max_parts = SIZE_MAX);
 
 /// The same into `out` (an empty envelope, e.g. ScratchEnvelope::fresh()).
-void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &out);
+void decode(const void *data, std::size_t size, const std::string &from, pb::Envelope &out,
+            std::size_t max_parts = SIZE_MAX);
 
 /// An envelope whose memory is kept from one message to the next: it lives on an arena with a
 /// fixed first block that is reset for each message, so building or parsing the messages of a
@@ -85,5 +91,17 @@ private:
 
 /// The name of the envelope's body ("hello", "advance_to", ...), for messages.
 std::string bodyName(const pb::Envelope &envelope);
+
+/// "window_done for window 5": what a message is, for "sent ... while ... waited for ...".
+std::string describe(const pb::Envelope &envelope);
+
+/// Text a peer sent, fit for one log line or error message: bytes outside printable ASCII as
+/// `\xNN` (a newline cannot forge a log line), and at most `max_bytes` of it, then how long it was.
+std::string printable(std::string_view text, std::size_t max_bytes = 64);
+
+/// Checks the envelope's header against the peer it came from: signed with its `name`, and
+/// numbered `last_sequence + 1` (a repeat is a duplicate, a gap out of order).
+void checkHeader(const pb::Envelope &envelope, const std::string &name,
+                 std::uint64_t last_sequence);
 
 } // namespace grainlink::coupling::codec

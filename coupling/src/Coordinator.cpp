@@ -1,8 +1,19 @@
+// The coordinator's transport and phases: it receives on its ROUTER socket, tells joined
+// participants from strangers, and drives the handshake, the windows and the checkpoints. What
+// can be decided without sockets lives beside it: RunState (lifecycle, failure lines), Admission
+// (the lobby: Hellos, heartbeats, strangers, floods), RunBodies (the bodies), WindowReplies
+// (WindowDone checks), CheckpointFiles, Authenticator (CURVE).
 #include "grainlink/coupling/Coordinator.hpp"
 
+#include "Admission.hpp"
+#include "Authenticator.hpp"
+#include "CheckpointFiles.hpp"
 #include "Codec.hpp"
 #include "CouplingSeries.hpp"
+#include "RunBodies.hpp"
+#include "RunState.hpp"
 #include "Sockets.hpp"
+#include "WindowReplies.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -10,42 +21,21 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <limits>
-#include <map>
 #include <mutex>
 #include <random>
 #include <set>
 #include <sstream>
-#include <thread>
 
 namespace grainlink::coupling {
 
 namespace pb = codec::pb;
 namespace fs = std::filesystem;
+using codec::printable;
 using sockets::Clock;
+using State = Coordinator::State;
 
 namespace {
-
-/// A participant as the coordinator knows it.
-struct Peer {
-    ParticipantSpec spec;
-    std::string who; ///< "participant '<name>'", for messages
-    bool joined = false;
-    std::string routing_id;
-    std::string heartbeat_id; ///< routing id of its heartbeat connection
-    std::vector<BodyDescription> provides;
-    std::vector<BodyState> initial_states;
-    std::vector<std::string> consumes;
-    Capabilities capabilities;
-    // Set once the bodies are known (collectBodies), so a window builds no name lists:
-    std::vector<std::size_t> inputs;  ///< the bodies (indices, body order) whose inputs it gets
-    std::vector<std::string> outputs; ///< the bodies it must answer for (what it provides or
-                                      ///< consumes, in that order)
-    std::uint64_t sent_sequence = 0;
-    std::uint64_t received_sequence = 0;
-    Clock::time_point last_seen;
-};
 
 /// Which participants the coordinator waits for; a plain flag per participant, so that waiting
 /// allocates nothing per window.
@@ -100,36 +90,30 @@ struct Coordinator::Impl {
     sockets::ContextFor own_context{config.endpoint};
     zmq::context_t &context = own_context.get();
     zmq::socket_t router;
+    std::unique_ptr<Authenticator> authenticator; ///< with CURVE; destroyed before `router` closes
     std::string bound_endpoint;
-    std::thread zap_thread;
-    std::atomic<bool> stop_zap{false};
-    std::atomic<int> refused_connections{0};
-    std::string last_refused_key;
     std::atomic<bool> stop_requested{false};
     std::mutex reported_mutex;
     std::optional<std::pair<std::string, std::string>> reported_failure;
 
     std::vector<Peer> peers;
-    std::vector<std::string> body_names;
-    std::vector<BodyDescription> bodies;
+    RunState run{config.tick_s};
+    RunBodies bodies;
     std::string run_id = makeRunId();
     std::unique_ptr<CouplingScheme> scheme;
+    Lobby lobby{peers, config.limits};
     // Reused every window (no allocation once warm):
     codec::ScratchEnvelope incoming; ///< the last message received from a joined participant
     codec::ScratchEnvelope outgoing; ///< a window's AdvanceTo
     std::vector<Task> tasks;
     PeerSet pending_peers{0};
-    std::vector<BodyState> received_states, got_states;
-    std::vector<Wrench> received_wrenches, got_wrenches;
+    std::optional<WindowReplies> replies;
 
-    std::uint64_t window = 0;
-    Ticks tick = 0, end_tick = 0, macro_step_ticks = 0;
+    Ticks end_tick = 0, macro_step_ticks = 0;
     Ticks nominal_step_ticks = 0, min_step_ticks = 0, max_step_ticks = 0;
-    bool handshake_done = false;
     double cumulative_mismatch_J = 0.0;
     Ticks hint_ticks = std::numeric_limits<Ticks>::max(); ///< smallest step hint this window
-    std::vector<BodyState> resumed_states;                ///< from the checkpoint, if resuming
-    std::vector<Wrench> resumed_wrenches;
+    std::optional<CoordinatorSnapshot> resumed;           ///< the checkpoint, if resuming
     std::unique_ptr<CouplingSeries> series;
     std::string completed_by; ///< the participant that declared the experiment complete
     const std::string heartbeat_bytes = [] {
@@ -142,27 +126,22 @@ struct Coordinator::Impl {
 
     // ---------------------------------------------------------------- failures
 
-    std::string where() const {
-        if (!handshake_done)
-            return "during the handshake";
-        return "in window " + std::to_string(window) +
-               " (t = " + formatSeconds(tick * config.tick_s) + " s)";
-    }
-
     /// Stops every participant, then throws the one line that names who failed and why.
     [[noreturn]] void fail(const std::string &who, const std::string &why) {
-        const std::string message = who + " failed " + where() + ": " + why;
+        const std::string message = run.failure(who, why);
         shutdownAll(true, message);
         if (series)
             series->flush();
         throw CouplingError(message);
     }
 
+    [[noreturn]] void fail(const PeerError &error) { fail(error.who, error.why); }
+
     void shutdownAll(bool failure, const std::string &reason) {
         for (std::size_t p = 0; p < peers.size(); ++p) {
             pb::Envelope e;
             if (peers[p].joined) {
-                e = envelopeFor(p);
+                address(p, e);
             } else { // not joined yet: its heartbeat connection (if any) hears the news
                 e.set_version(kProtocolMajor);
                 e.set_sender("coordinator");
@@ -182,18 +161,18 @@ struct Coordinator::Impl {
 
     // ---------------------------------------------------------------- sending
 
-    pb::Envelope envelopeFor(std::size_t p) {
-        pb::Envelope e;
-        address(p, e);
-        return e;
-    }
-
     /// Fills in the envelope's header for the next message to participant `p`.
     void address(std::size_t p, pb::Envelope &e) {
         e.set_version(kProtocolMajor);
         e.set_sender("coordinator");
         e.set_sequence(++peers[p].sent_sequence);
-        e.set_window(window);
+        e.set_window(run.window);
+    }
+
+    pb::Envelope envelopeFor(std::size_t p) {
+        pb::Envelope e;
+        address(p, e);
+        return e;
     }
 
     void sendRaw(const std::string &routing_id, const std::string &bytes, bool dontwait = false) {
@@ -207,7 +186,7 @@ struct Coordinator::Impl {
             router.send(zmq::buffer(peers[p].routing_id), zmq::send_flags::sndmore);
             router.send(sockets::encode(e), zmq::send_flags::none);
         } catch (const zmq::error_t &error) {
-            fail("participant '" + peers[p].spec.name + "'",
+            fail(peers[p].who,
                  std::string("cannot be reached (") + error.what() + "): it disconnected");
         }
     }
@@ -234,18 +213,12 @@ struct Coordinator::Impl {
         return std::nullopt;
     }
 
-    std::optional<std::size_t> peerByName(const std::string &name) const {
-        for (std::size_t p = 0; p < peers.size(); ++p)
-            if (peers[p].spec.name == name)
-                return p;
-        return std::nullopt;
-    }
-
-    std::string expectedNames() const {
-        std::string names;
-        for (const auto &p : peers)
-            names += (names.empty() ? "'" : ", '") + p.spec.name + "'";
-        return names;
+    /// The participant name the connection's CURVE key is bound to; nothing without CURVE.
+    std::optional<std::string> curveName(const zmq::message_t &message) const {
+        if (!authenticator)
+            return std::nullopt;
+        const char *name = zmq_msg_gets(message.handle(), "User-Id");
+        return std::string(name ? name : "");
     }
 
     /// Receives for up to 20 ms; answers heartbeats and strangers itself and returns
@@ -258,150 +231,67 @@ struct Coordinator::Impl {
             return std::nullopt;
         }
         (void)router.recv(payload, zmq::recv_flags::none);
-        while (payload.more()) { // a well-behaved DEALER sends one frame; drop the rest
+        // A DEALER of ours sends one frame. The parts of a message arrive together, so reading
+        // the rest never waits; each one's own `more` says whether another follows.
+        std::size_t frames = 1;
+        for (bool more = payload.more(); more; ++frames) {
             zmq::message_t extra;
-            (void)router.recv(extra, zmq::recv_flags::none);
+            more = router.recv(extra, zmq::recv_flags::none) && extra.more();
         }
-        auto result = handle(id.to_string(), payload);
+        auto result = handle(id.to_string(), payload, frames);
         checkHealth();
         return result;
     }
 
-    std::optional<Incoming> handle(const std::string &id, const zmq::message_t &payload) {
-        if (const auto p = peerByRoutingId(id)) {
-            Peer &peer = peers[*p];
-            const auto who = [&peer]() -> const std::string & { return peer.who; };
-            pb::Envelope &e = incoming.fresh();
-            try {
-                codec::decode(payload.data(), payload.size(), who(), e);
-            } catch (const codec::ProtocolError &error) {
-                fail(who(), std::string("sent a bad message: ") + error.what());
-            }
-            peer.last_seen = Clock::now();
-            if (e.sender() != peer.spec.name)
-                fail(who(), "sent a message signed '" + e.sender() + "'");
-            if (e.sequence() <= peer.received_sequence)
-                fail(who(), "sent message " + std::to_string(e.sequence()) + " again (duplicate; " +
-                                "last was " + std::to_string(peer.received_sequence) + ")");
-            if (e.sequence() != peer.received_sequence + 1)
-                fail(who(), "sent message " + std::to_string(e.sequence()) + " after " +
-                                std::to_string(peer.received_sequence) + " (out of order)");
-            peer.received_sequence = e.sequence();
-            if (e.has_heartbeat())
-                return std::nullopt;
-            if (e.has_error())
-                fail(who(), "reported: " + e.error().message());
-            return Incoming{*p, e};
-        }
-        return handleStranger(id, payload);
-    }
-
-    /// A connection that is not a joined participant's main one: a heartbeat connection, a
-    /// participant saying Hello, or something that should not be here.
-    std::optional<Incoming> handleStranger(const std::string &id, const zmq::message_t &payload) {
-        pb::Envelope e;
-        try {
-            e = codec::decode(payload.data(), payload.size(), "a new connection");
-        } catch (const codec::ProtocolError &error) {
-            const auto p = error.sender.empty() ? std::nullopt : peerByName(error.sender);
-            if (p && error.code == pb::Error::CODE_VERSION_MISMATCH) {
-                const std::string why =
-                    "speaks protocol major version " + std::to_string(error.version) +
-                    ", the coordinator speaks " + std::to_string(kProtocolMajor);
-                replyError(id, error.code, why);
-                fail("participant '" + peers[*p].spec.name + "'", why);
-            }
-            spdlog::warn("coordinator: ignored {} bytes from an unknown connection: {}",
-                         payload.size(), error.what());
-            replyError(id, error.code, error.what());
+    std::optional<Incoming> handle(const std::string &id, const zmq::message_t &payload,
+                                   std::size_t frames) {
+        const auto p = peerByRoutingId(id);
+        if (!p) {
+            handleStranger(id, payload, frames);
             return std::nullopt;
         }
-        const auto p = peerByName(e.sender());
-        if (e.has_heartbeat()) {
-            if (!p)
-                return std::nullopt;
-            // The first connection that beats for a name is its heartbeat connection; beats for
-            // that name from anywhere else do not keep it alive.
-            Peer &peer = peers[*p];
-            if (peer.heartbeat_id.empty())
-                peer.heartbeat_id = id;
-            if (peer.heartbeat_id != id) {
-                spdlog::warn("coordinator: ignored a heartbeat for '{}' from a second connection",
-                             peer.spec.name);
-                return std::nullopt;
-            }
-            if (peer.joined)
-                peer.last_seen = Clock::now();
-            try { // answered even before it joined, so it can tell when we are gone
+        Peer &peer = peers[*p];
+        if (frames > 1)
+            fail(peer.who, "sent a message of " + std::to_string(frames) +
+                               " frames (a participant sends one)");
+        pb::Envelope &e = incoming.fresh();
+        try {
+            codec::decode(payload.data(), payload.size(), peer.who, e, config.limits.maxParts());
+        } catch (const codec::ProtocolError &error) {
+            fail(peer.who, std::string("sent a bad message: ") + error.what());
+        }
+        peer.last_seen = Clock::now();
+        try {
+            codec::checkHeader(e, peer.spec.name, peer.received_sequence);
+        } catch (const codec::ProtocolError &error) {
+            fail(peer.who, error.what());
+        }
+        peer.received_sequence = e.sequence();
+        if (e.has_heartbeat())
+            return std::nullopt;
+        if (e.has_error())
+            fail(peer.who, "reported: " + printable(e.error().message(), 2000));
+        return Incoming{*p, e};
+    }
+
+    /// A message from a connection that is not a joined participant's main one: the lobby
+    /// decides, the coordinator answers.
+    void handleStranger(const std::string &id, const zmq::message_t &payload, std::size_t frames) {
+        const std::string_view bytes(static_cast<const char *>(payload.data()), payload.size());
+        const auto answer = lobby.receive(id, bytes, frames, curveName(payload),
+                                          run.state() == State::Handshake, Clock::now());
+        if (!answer.warning.empty())
+            spdlog::warn("coordinator: {}", answer.warning);
+        if (answer.joined)
+            spdlog::info("coordinator: {} joined as {}", peers[*answer.joined].who,
+                         roleName(peers[*answer.joined].declared.role));
+        if (answer.error)
+            replyError(id, *answer.error, answer.text);
+        if (answer.heartbeat)
+            try {
                 sendRaw(id, heartbeat_bytes, true);
             } catch (const zmq::error_t &) {
             }
-            return std::nullopt;
-        }
-        if (e.has_hello()) {
-            if (!p) {
-                replyError(id, pb::Error::CODE_UNKNOWN_PARTICIPANT,
-                           "this run expects participants " + expectedNames() + ", not '" +
-                               e.hello().participant() + "'");
-                spdlog::warn("coordinator: refused unknown participant '{}'",
-                             e.hello().participant());
-                return std::nullopt;
-            }
-            if (peers[*p].joined || handshake_done) {
-                const std::string text = "participant '" + e.sender() +
-                                         "' already joined this run; a participant cannot "
-                                         "rejoin mid-run (resume the run from its last "
-                                         "checkpoint instead)";
-                replyError(id, pb::Error::CODE_ALREADY_JOINED, text);
-                spdlog::warn("coordinator: {}", text);
-                return std::nullopt;
-            }
-            admit(*p, id, e);
-            return std::nullopt;
-        }
-        replyError(id, pb::Error::CODE_UNEXPECTED_MESSAGE,
-                   "send Hello first (got " + codec::bodyName(e) + ")");
-        spdlog::warn("coordinator: {} from a connection that has not joined; ignored",
-                     codec::bodyName(e));
-        return std::nullopt;
-    }
-
-    void admit(std::size_t p, const std::string &id, const pb::Envelope &e) {
-        Peer &peer = peers[p];
-        const std::string who = "participant '" + peer.spec.name + "'";
-        const auto &h = e.hello();
-        if (h.protocol_major() != kProtocolMajor) {
-            replyError(id, pb::Error::CODE_VERSION_MISMATCH, "protocol major version mismatch");
-            fail(who, "speaks protocol major version " + std::to_string(h.protocol_major()) +
-                          ", the coordinator speaks " + std::to_string(kProtocolMajor));
-        }
-        if (h.participant() != e.sender())
-            fail(who, "says Hello as '" + h.participant() + "' in an envelope from '" + e.sender() +
-                          "'");
-        if (e.sequence() != 1)
-            fail(who,
-                 "Hello must be its first message (sequence " + std::to_string(e.sequence()) + ")");
-        Role role;
-        try {
-            role = codec::fromWire(h.role(), who);
-            for (const auto &b : h.provides())
-                peer.provides.push_back(codec::fromWire(b));
-            peer.initial_states = codec::fromWire(h.initial_states());
-        } catch (const codec::ProtocolError &error) {
-            replyError(id, error.code, error.what());
-            fail(who, error.what());
-        }
-        if (role != peer.spec.role)
-            fail(who, std::string("joined as ") + roleName(role) +
-                          " but the run configures it as " + roleName(peer.spec.role));
-        peer.consumes.assign(h.consumes().begin(), h.consumes().end());
-        peer.capabilities = Capabilities{h.capabilities().rollback(), h.capabilities().checkpoint(),
-                                         h.capabilities().triangle_loads()};
-        peer.routing_id = id;
-        peer.joined = true;
-        peer.received_sequence = 1;
-        peer.last_seen = Clock::now();
-        spdlog::info("coordinator: {} joined as {}", who, roleName(role));
     }
 
     void checkHealth() {
@@ -410,17 +300,21 @@ struct Coordinator::Impl {
         {
             std::unique_lock<std::mutex> lock(reported_mutex);
             if (reported_failure) {
-                const auto [who, why] = *reported_failure;
+                const auto [name, why] = *reported_failure;
                 lock.unlock();
-                fail("participant '" + who + "'", why);
+                // A process that exits after its Hello was refused exits for that reason.
+                for (const auto &peer : peers)
+                    if (peer.spec.name == name && !peer.refusal.empty())
+                        fail(peer.who, peer.refusal + " (its Hello was refused, then " + why + ")");
+                fail("participant '" + name + "'", why);
             }
         }
-        if (!handshake_done)
+        if (run.state() != State::Running)
             return;
         for (auto &peer : peers) {
             const double silent = sockets::secondsSince(peer.last_seen);
             if (silent > config.peer_timeout_s)
-                fail("participant '" + peer.spec.name + "'",
+                fail(peer.who,
                      "silent for " + formatSeconds(silent) +
                          " s (no heartbeat: the process died, froze or lost its connection)");
         }
@@ -432,12 +326,8 @@ struct Coordinator::Impl {
         while (!pending.empty()) {
             if (auto in = pump()) {
                 if (!pending.contains(in->peer) || !accept(in->peer, in->envelope))
-                    fail(peers[in->peer].who, "sent " + codec::bodyName(in->envelope) +
-                                                  " for window " +
-                                                  std::to_string(in->envelope.window()) +
-                                                  " while the coordinator "
-                                                  "waited for " +
-                                                  what);
+                    fail(peers[in->peer].who, "sent " + codec::describe(in->envelope) +
+                                                  " while the coordinator waited for " + what);
                 pending.erase(in->peer);
             }
             if (!pending.empty() && sockets::secondsSince(start) > config.window_timeout_s)
@@ -450,93 +340,51 @@ struct Coordinator::Impl {
     // ---------------------------------------------------------------- phases
 
     void handshake() {
+        run.enter(State::Handshake);
         const auto start = Clock::now();
         while (std::any_of(peers.begin(), peers.end(), [](const Peer &p) { return !p.joined; })) {
             if (auto in = pump())
-                fail("participant '" + peers[in->peer].spec.name + "'",
+                fail(peers[in->peer].who,
                      "sent " + codec::bodyName(in->envelope) + " before the run started");
-            if (sockets::secondsSince(start) > config.handshake_timeout_s) {
-                std::string missing;
-                for (const auto &p : peers)
-                    if (!p.joined)
-                        missing += (missing.empty() ? "'" : ", '") + p.spec.name + "'";
-                std::string why = "did not join within handshake_timeout_s = " +
-                                  formatSeconds(config.handshake_timeout_s) + " s";
-                if (refused_connections > 0)
-                    why += " (" + std::to_string(refused_connections.load()) +
-                           " connection(s) refused by CURVE authentication, last with public "
-                           "key " +
-                           last_refused_key + ")";
-                fail("participant " + missing, why);
-            }
+            if (sockets::secondsSince(start) > config.handshake_timeout_s)
+                failHandshake();
         }
-        collectBodies();
-    }
-
-    void collectBodies() {
-        std::map<std::string, std::string> provider, consumer;
-        std::vector<BodyState> initial;
+        std::vector<Declaration> declared;
         for (const auto &peer : peers)
-            for (std::size_t b = 0; b < peer.provides.size(); ++b) {
-                const auto &body = peer.provides[b];
-                if (provider.count(body.name))
-                    fail("participant '" + peer.spec.name + "'",
-                         "provides body '" + body.name + "', which '" + provider[body.name] +
-                             "' provides already");
-                provider[body.name] = peer.spec.name;
-                bodies.push_back(body);
-                body_names.push_back(body.name);
-                if (b >= peer.initial_states.size() || peer.initial_states[b].body != body.name)
-                    fail("participant '" + peer.spec.name + "'",
-                         "gave no initial state for body '" + body.name + "'");
-                initial.push_back(peer.initial_states[b]);
-            }
-        for (const auto &peer : peers)
-            for (const auto &name : peer.consumes) {
-                if (!provider.count(name))
-                    fail("participant '" + peer.spec.name + "'",
-                         "consumes body '" + name + "', which no multibody participant provides");
-                if (consumer.count(name))
-                    fail("participant '" + peer.spec.name + "'", "consumes body '" + name +
-                                                                     "', which '" + consumer[name] +
-                                                                     "' consumes already");
-                consumer[name] = peer.spec.name;
-            }
-        for (const auto &[name, who] : provider)
-            if (!consumer.count(name))
-                fail("participant '" + who + "'",
-                     "provides body '" + name + "', which no soil participant consumes");
-        if (config.scheme.kind == SchemeKind::Implicit)
-            for (const auto &peer : peers)
-                if (!peer.capabilities.rollback)
-                    fail("participant '" + peer.spec.name + "'",
-                         "cannot roll back its state, which implicit coupling needs");
-        if (config.checkpoint_every_windows > 0)
-            for (const auto &peer : peers)
-                if (!peer.capabilities.checkpoint)
-                    fail("participant '" + peer.spec.name + "'",
-                         "cannot write checkpoints, but checkpoint_every_windows = " +
-                             std::to_string(config.checkpoint_every_windows));
-        for (auto &peer : peers) {
-            if (peer.spec.role == Role::Multibody)
-                for (const auto &b : peer.provides)
-                    peer.outputs.push_back(b.name);
-            else
-                peer.outputs = peer.consumes;
-            for (std::size_t b = 0; b < body_names.size(); ++b)
-                if (std::find(peer.outputs.begin(), peer.outputs.end(), body_names[b]) !=
-                    peer.outputs.end())
-                    peer.inputs.push_back(b);
+            declared.push_back(peer.declared);
+        try {
+            bodies = collectBodies(declared, {config.scheme.kind, config.checkpoint_every_windows});
+        } catch (const PeerError &error) {
+            fail(error);
         }
+        std::vector<WindowReplies::From> from;
+        for (std::size_t p = 0; p < peers.size(); ++p) {
+            peers[p].inputs = bodies.inputs[p];
+            from.push_back({peers[p].who, peers[p].spec.role, bodies.outputs[p]});
+        }
+        replies.emplace(std::move(from));
         pending_peers = PeerSet(peers.size());
-        scheme = std::make_unique<CouplingScheme>(config.scheme, std::move(initial));
+        scheme = std::make_unique<CouplingScheme>(config.scheme, bodies.initial_states);
     }
 
-    std::string checkpointDirectory(std::uint64_t w) const {
-        char name[32];
-        std::snprintf(name, sizeof name, "window_%09llu", static_cast<unsigned long long>(w));
-        // Absolute, so a participant started from another folder writes to the same place.
-        return fs::absolute(fs::path(config.output_directory) / "checkpoints" / name).string();
+    /// Names every participant that did not join, with what the coordinator saw of it.
+    [[noreturn]] void failHandshake() {
+        std::string missing, seen;
+        const auto note = [&seen](const std::string &text) {
+            seen += (seen.empty() ? " (" : "; ") + text;
+        };
+        if (authenticator)
+            if (const std::string refused = authenticator->refusals(); !refused.empty())
+                note(refused);
+        for (const auto &p : peers)
+            if (!p.joined) {
+                missing += (missing.empty() ? "'" : ", '") + p.spec.name + "'";
+                if (!p.refusal.empty())
+                    note("a Hello as '" + p.spec.name + "' was refused: " + p.refusal);
+            }
+        fail("participant " + missing, "did not join within handshake_timeout_s = " +
+                                           formatSeconds(config.handshake_timeout_s) + " s" + seen +
+                                           (seen.empty() ? "" : ")"));
     }
 
     void welcome(const std::optional<std::string> &restore_directory) {
@@ -545,11 +393,11 @@ struct Coordinator::Impl {
             auto *w = e.mutable_welcome();
             w->set_run_id(run_id);
             w->set_tick_s(config.tick_s);
-            w->set_start_tick(tick);
+            w->set_start_tick(run.tick);
             w->set_end_tick(end_tick);
             w->set_macro_step_ticks(macro_step_ticks);
             w->set_scheme(codec::toWire(config.scheme.kind));
-            for (const auto &b : bodies)
+            for (const auto &b : bodies.bodies)
                 codec::toWire(b, w->add_bodies());
             w->set_heartbeat_interval_ms(
                 static_cast<std::uint32_t>(std::lround(config.heartbeat_interval_s * 1000)));
@@ -557,15 +405,15 @@ struct Coordinator::Impl {
                 static_cast<std::uint32_t>(std::lround(config.peer_timeout_s * 1000)));
             if (restore_directory) {
                 auto *r = w->mutable_restore();
-                r->set_window(window);
-                r->set_tick(tick);
+                r->set_window(run.window);
+                r->set_tick(run.tick);
                 r->set_checkpoint_directory(
                     (fs::path(*restore_directory) / peers[p].spec.name).string());
             }
             send(p, e);
             peers[p].last_seen = Clock::now();
         }
-        handshake_done = true;
+        run.enter(State::Running);
     }
 
     /// One window: the scheme's tasks until it accepts. Returns the work each side reported.
@@ -599,44 +447,20 @@ struct Coordinator::Impl {
                     send(p, e);
                     pending.insert(p);
                 }
-            received_states.clear();
-            received_wrenches.clear();
+            replies->begin(run.window, end, tasks.front().iteration);
             double mb_work = 0.0, soil_work = 0.0;
-            const unsigned iteration = tasks.front().iteration;
             awaitFrom(pending, "WindowDone", [&](std::size_t p, const pb::Envelope &e) {
-                if (!e.has_window_done() || e.window() != window)
-                    return false;
-                const auto &done = e.window_done();
-                const std::string &who = peers[p].who;
-                if (done.end_tick() != end)
-                    fail(who, "reports end tick " + std::to_string(done.end_tick()) +
-                                  " for a window that ends at tick " + std::to_string(end));
-                if (done.iteration() != iteration)
-                    fail(who, "reports iteration " + std::to_string(done.iteration()) +
-                                  ", expected " + std::to_string(iteration));
+                WindowReplies::Reply reply;
                 try {
-                    if (peers[p].spec.role == Role::Multibody) {
-                        codec::fromWire(done.states(), got_states);
-                        checkNames(peers[p], "states", got_states);
-                        received_states.insert(received_states.end(), got_states.begin(),
-                                               got_states.end());
-                    } else {
-                        codec::fromWire(done.wrenches(), got_wrenches);
-                        checkNames(peers[p], "wrenches", got_wrenches);
-                        received_wrenches.insert(received_wrenches.end(), got_wrenches.begin(),
-                                                 got_wrenches.end());
-                    }
-                } catch (const codec::ProtocolError &error) {
-                    fail(who, error.what());
+                    reply = replies->read(p, e);
+                } catch (const PeerError &error) {
+                    fail(error);
                 }
-                double work = 0.0;
-                for (const auto &w : done.work())
-                    work += w.work_j();
-                (peers[p].spec.role == Role::Multibody ? mb_work : soil_work) += work;
-                if (done.run_complete() && completed_by.empty())
+                (peers[p].spec.role == Role::Multibody ? mb_work : soil_work) += reply.work_J;
+                if (reply.run_complete && completed_by.empty())
                     completed_by = peers[p].spec.name;
-                if (done.suggested_macro_step_ticks() > 0)
-                    hint_ticks = std::min(hint_ticks, Ticks(done.suggested_macro_step_ticks()));
+                if (reply.suggested_step_ticks > 0)
+                    hint_ticks = std::min(hint_ticks, reply.suggested_step_ticks);
                 return true;
             });
             try {
@@ -644,11 +468,11 @@ struct Coordinator::Impl {
                 for (const auto &task : tasks)
                     (task.role == Role::Multibody ? has_multibody : has_soil) = true;
                 if (has_multibody) {
-                    scheme->completeMultibody(received_states);
+                    scheme->completeMultibody(replies->states());
                     work_multibody = mb_work;
                 }
                 if (has_soil) {
-                    scheme->completeSoil(received_wrenches);
+                    scheme->completeSoil(replies->wrenches());
                     work_soil = soil_work;
                 }
             } catch (const CouplingError &error) {
@@ -656,39 +480,6 @@ struct Coordinator::Impl {
             }
         }
         return {work_multibody, work_soil};
-    }
-
-    /// Fails unless `got` is finite and names exactly the bodies `peer` answers for.
-    template <typename T>
-    void checkNames(const Peer &peer, const char *what, const std::vector<T> &got) {
-        const std::string &who = peer.who;
-        bool in_order = got.size() == peer.outputs.size();
-        for (std::size_t i = 0; i < got.size(); ++i) {
-            const auto &x = got[i];
-            if constexpr (std::is_same_v<T, BodyState>) {
-                if (!x.position_m.allFinite() || !x.linear_velocity_m_s.allFinite() ||
-                    !x.angular_velocity_rad_s.allFinite())
-                    fail(who, "sent a non-finite state of body '" + x.body + "'");
-            } else {
-                if (!x.force_N.allFinite() || !x.torque_N_m.allFinite())
-                    fail(who, "sent a non-finite wrench on body '" + x.body + "'");
-            }
-            in_order = in_order && x.body == peer.outputs[i];
-        }
-        if (in_order) // the usual case: the same names in the same order
-            return;
-        std::vector<std::string> names, expected = peer.outputs;
-        for (const auto &x : got)
-            names.push_back(x.body);
-        std::sort(names.begin(), names.end());
-        std::sort(expected.begin(), expected.end());
-        if (names != expected) {
-            std::string list;
-            for (const auto &n : expected)
-                list += " " + n;
-            fail(who,
-                 std::string("sent ") + what + " for other bodies than its own {" + list + " }");
-        }
     }
 
     /// The next window's length: the nominal step, or with adaptive stepping the smallest hint
@@ -704,118 +495,143 @@ struct Coordinator::Impl {
             step -= step % min_step_ticks;
         }
         hint_ticks = std::numeric_limits<Ticks>::max();
-        return std::min(step, end_tick - tick);
+        return std::min(step, end_tick - run.tick);
     }
 
     void writeCheckpoint() {
-        const std::string directory = checkpointDirectory(window);
+        const std::string directory = checkpointDirectory(config.output_directory, run.window);
         fs::create_directories(directory);
         PeerSet all(peers.size());
         for (std::size_t p = 0; p < peers.size(); ++p) {
             pb::Envelope e = envelopeFor(p);
             auto *c = e.mutable_checkpoint();
-            c->set_window(window);
-            c->set_tick(tick);
+            c->set_window(run.window);
+            c->set_tick(run.tick);
             c->set_checkpoint_directory((fs::path(directory) / peers[p].spec.name).string());
             send(p, e);
             all.insert(p);
         }
         awaitFrom(all, "CheckpointDone", [&](std::size_t, const pb::Envelope &e) {
-            return e.has_checkpoint_done() && e.checkpoint_done().window() == window;
+            return e.has_checkpoint_done() && e.checkpoint_done().window() == run.window;
         });
-        pb::CoordinatorCheckpoint state;
-        state.set_run_id(run_id);
-        state.set_window(window);
-        state.set_tick(tick);
-        state.set_macro_step_ticks(macro_step_ticks);
-        codec::toWire(scheme->states(), tick, state.mutable_states());
-        codec::toWire(scheme->wrenches(), tick, tick, state.mutable_wrenches());
-        state.set_cumulative_mismatch_j(cumulative_mismatch_J);
         series->flush();
-        writeAtomically((fs::path(directory) / "coordinator.pb").string(),
-                        state.SerializeAsString());
-        // Only now is the checkpoint complete: `latest` moves to it.
-        writeAtomically((fs::path(config.output_directory) / "checkpoints" / "latest").string(),
-                        fs::path(directory).filename().string() + "\n");
+        commitCheckpoint(config.output_directory, directory,
+                         {run_id, run.window, run.tick, macro_step_ticks, scheme->states(),
+                          scheme->wrenches(), cumulative_mismatch_J});
     }
 
-    static void writeAtomically(const std::string &path, const std::string &bytes) {
-        const std::string temporary = path + ".tmp";
-        {
-            std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-            out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-            if (!out.flush())
-                throw CouplingError("cannot write " + temporary);
-        }
-        fs::rename(temporary, path);
+    /// Continues where the last complete checkpoint left off; returns its directory.
+    std::string resume() {
+        std::string directory;
+        resumed = readLatestCheckpoint(config.output_directory, directory);
+        run_id = resumed->run_id;
+        run.window = resumed->window;
+        run.tick = resumed->tick;
+        macro_step_ticks = resumed->macro_step_ticks;
+        cumulative_mismatch_J = resumed->cumulative_mismatch_J;
+        return directory;
     }
 
-    /// Reads the last complete checkpoint; returns its directory.
-    std::string readCheckpoint() {
-        const fs::path latest = fs::path(config.output_directory) / "checkpoints" / "latest";
-        std::ifstream in(latest);
-        std::string name;
-        if (!(in >> name))
-            throw CouplingError("cannot resume: no complete checkpoint (" + latest.string() +
-                                " is missing)");
-        const fs::path directory = fs::absolute(latest.parent_path() / name);
-        std::ifstream state_file(directory / "coordinator.pb", std::ios::binary);
-        pb::CoordinatorCheckpoint state;
-        if (!state.ParseFromIstream(&state_file))
-            throw CouplingError("cannot resume: " + (directory / "coordinator.pb").string() +
-                                " is unreadable");
-        run_id = state.run_id();
-        window = state.window();
-        tick = state.tick();
-        macro_step_ticks = state.macro_step_ticks();
-        cumulative_mismatch_J = state.cumulative_mismatch_j();
-        resumed_states = codec::fromWire(state.states());
-        resumed_wrenches = codec::fromWire(state.wrenches());
-        return directory.string();
-    }
-    // ---------------------------------------------------------------- security
-
-    void startAuthenticator(const CurveServerKeys &keys) {
-        // ZeroMQ asks a handler bound here (ZAP, RFC 27) whether to admit each CURVE client.
-        zmq::socket_t handler(context, zmq::socket_type::rep);
-        handler.bind("inproc://zeromq.zap.01");
-        zap_thread = std::thread([this, allowed = keys.allowed_participants,
-                                  socket = std::move(handler)]() mutable {
-            while (!stop_zap) {
-                if (!sockets::poll(socket, 100))
-                    continue;
-                std::vector<zmq::message_t> frames;
-                do {
-                    frames.emplace_back();
-                    (void)socket.recv(frames.back(), zmq::recv_flags::none);
-                } while (frames.back().more());
-                std::string key_text = "?";
-                bool ok = false;
-                if (frames.size() >= 7 && frames[6].size() == 32) {
-                    char z85[41];
-                    zmq_z85_encode(z85, static_cast<const std::uint8_t *>(frames[6].data()), 32);
-                    key_text = z85;
-                    ok = std::find(allowed.begin(), allowed.end(), key_text) != allowed.end();
-                }
-                if (!ok) {
-                    ++refused_connections;
-                    last_refused_key = key_text;
-                    spdlog::warn("coordinator: refused a CURVE connection from {} with public key "
-                                 "{} (not among the participants' keys)",
-                                 frames.size() > 3 ? frames[3].to_string() : "?", key_text);
-                }
-                const std::string request_id = frames.size() > 1 ? frames[1].to_string() : "";
-                socket.send(zmq::str_buffer("1.0"), zmq::send_flags::sndmore);
-                socket.send(zmq::buffer(request_id), zmq::send_flags::sndmore);
-                socket.send(zmq::buffer(std::string(ok ? "200" : "400")), zmq::send_flags::sndmore);
-                socket.send(zmq::buffer(std::string(ok ? "OK" : "unknown key")),
-                            zmq::send_flags::sndmore);
-                socket.send(zmq::str_buffer(""), zmq::send_flags::sndmore);
-                socket.send(zmq::str_buffer(""), zmq::send_flags::none);
+    /// The whole run, from the first Hello to the last window.
+    CoordinatorSummary drive() {
+        const auto &c = config;
+        const auto started = Clock::now();
+        std::optional<std::string> restore_directory;
+        if (c.resume)
+            restore_directory = resume();
+        handshake();
+        if (resumed) {
+            try {
+                scheme->restore(resumed->states, resumed->wrenches);
+            } catch (const CouplingError &error) {
+                fail("the checkpoint", error.what());
             }
-        });
+        }
+        if (!c.output_directory.empty())
+            series = std::make_unique<CouplingSeries>(c.output_directory, bodies.names,
+                                                      c.resume ? std::optional(run.window)
+                                                               : std::nullopt);
+        welcome(restore_directory);
+        spdlog::info("coordinator: run {} with {} participants, {} coupling, {} windows of {} s",
+                     run_id, peers.size(), schemeName(c.scheme.kind),
+                     (end_tick - run.tick + macro_step_ticks - 1) / macro_step_ticks,
+                     formatSeconds(macro_step_ticks * c.tick_s));
+
+        CoordinatorSummary summary;
+        auto last_progress = Clock::now();
+        const Ticks first_tick = run.tick;
+        while (run.tick < end_tick) {
+            const auto window_started = Clock::now();
+            const Ticks step = std::min(macro_step_ticks, end_tick - run.tick);
+            const auto [work_multibody, work_soil] = runWindow(run.tick, run.tick + step);
+            const double mismatch = work_multibody - work_soil;
+            cumulative_mismatch_J += mismatch;
+            ++summary.windows;
+            summary.iterations += scheme->iterations();
+            if (series) {
+                CouplingSeries::Row row;
+                row.window = run.window;
+                row.start_s = run.tick * c.tick_s;
+                row.end_s = (run.tick + step) * c.tick_s;
+                row.iterations = scheme->iterations();
+                row.residual = scheme->residual();
+                row.work_multibody_J = work_multibody;
+                row.work_soil_J = work_soil;
+                row.cumulative_mismatch_J = cumulative_mismatch_J;
+                row.wall_s = sockets::secondsSince(window_started);
+                series->append(row, scheme->states(), scheme->wrenches()); // queued, cheap
+            }
+            run.tick += step;
+            ++run.window;
+            if (!completed_by.empty()) {
+                spdlog::info("coordinator: participant '{}' completed its experiment at t = {} s",
+                             completed_by, formatSeconds(run.tick * c.tick_s));
+                break;
+            }
+            macro_step_ticks = nextStep();
+            if (c.checkpoint_every_windows > 0 && run.window % c.checkpoint_every_windows == 0 &&
+                run.tick < end_tick)
+                writeCheckpoint();
+            if (c.progress_interval_s > 0.0 &&
+                sockets::secondsSince(last_progress) >= c.progress_interval_s) {
+                last_progress = Clock::now();
+                const double wall = sockets::secondsSince(started);
+                const double done = double(run.tick - first_tick) / double(end_tick - first_tick);
+                std::fprintf(stderr,
+                             "coupling: t = %.4f / %.4f s  window %llu  wall %.1f s  ETA %.0f s  "
+                             "%.2f passes/window  energy mismatch %.3g J\n",
+                             run.tick * c.tick_s, end_tick * c.tick_s,
+                             static_cast<unsigned long long>(run.window), wall,
+                             done > 0 ? wall * (1.0 - done) / done : 0.0,
+                             double(summary.iterations) / double(summary.windows),
+                             cumulative_mismatch_J);
+            }
+        }
+        shutdownAll(false, completed_by.empty()
+                               ? "the run reached its end time"
+                               : "participant '" + completed_by + "' completed its experiment");
+        if (series)
+            series->flush();
+        summary.end_time_s = run.tick * c.tick_s;
+        summary.wall_s = sockets::secondsSince(started);
+        summary.cumulative_mismatch_J = cumulative_mismatch_J;
+        summary.completed_by = completed_by;
+        summary.final_states = scheme->states();
+        summary.final_wrenches = scheme->wrenches();
+        return summary;
     }
 };
+
+namespace {
+
+void checkLimits(const CoordinatorLimits &l) {
+    if (l.max_message_bytes <= 0 || l.max_bodies == 0 || l.max_name_bytes == 0 ||
+        l.max_stranger_messages_per_s == 0)
+        throw CouplingError("every coupling.limits value must be positive (docs/protocol.md "
+                            "§Limits)");
+}
+
+} // namespace
 
 Coordinator::Coordinator(CoordinatorConfig config)
     : impl_(std::make_unique<Impl>(std::move(config))) {
@@ -831,6 +647,11 @@ Coordinator::Coordinator(CoordinatorConfig config)
         if (!names.insert(p.name).second)
             throw CouplingError("two participants are named '" + p.name + "'");
         (p.role == Role::Multibody ? has_multibody : has_soil) = true;
+        if (c.curve && !c.curve->allowed_participants.count(p.name))
+            throw CouplingError("participant '" + p.name +
+                                "' has no public key: the CURVE keys "
+                                "directory needs its " +
+                                p.name + ".pub (`grainlink keygen`)");
         Peer peer;
         peer.spec = p;
         peer.who = "participant '" + p.name + "'";
@@ -844,7 +665,7 @@ Coordinator::Coordinator(CoordinatorConfig config)
     const auto ticks = [&](double seconds) {
         return static_cast<Ticks>(std::llround(seconds / c.tick_s));
     };
-    s.tick = ticks(c.start_time_s);
+    s.run.tick = ticks(c.start_time_s);
     s.end_tick = ticks(c.end_time_s);
     s.nominal_step_ticks = s.macro_step_ticks = ticks(c.macro_step_s);
     if ((c.min_macro_step_s > 0.0) != (c.max_macro_step_s > 0.0) ||
@@ -854,6 +675,7 @@ Coordinator::Coordinator(CoordinatorConfig config)
     s.max_step_ticks = ticks(c.max_macro_step_s);
     if ((c.checkpoint_every_windows > 0 || c.resume) && c.output_directory.empty())
         throw CouplingError("checkpoints need an output directory");
+    checkLimits(c.limits);
 
     if (!isLocalEndpoint(c.endpoint) && !c.curve && !c.insecure)
         throw CouplingError("endpoint " + c.endpoint +
@@ -863,10 +685,12 @@ Coordinator::Coordinator(CoordinatorConfig config)
     s.router.set(zmq::sockopt::router_mandatory, 1);
     s.router.set(zmq::sockopt::linger, 1000);
     s.router.set(zmq::sockopt::rcvtimeo, 20); // liveness is checked between receives
+    // ZeroMQ drops a connection that announces a larger frame, before buffering any of it.
+    s.router.set(zmq::sockopt::maxmsgsize, c.limits.max_message_bytes);
     if (c.curve) {
         if (!curveAvailable())
             throw CouplingError("CURVE keys given, but this libzmq has no CURVE support");
-        s.startAuthenticator(*c.curve);
+        s.authenticator = std::make_unique<Authenticator>(s.context, s.router, *c.curve);
         s.router.set(zmq::sockopt::zap_domain, "grainlink");
         s.router.set(zmq::sockopt::curve_server, 1);
         s.router.set(zmq::sockopt::curve_secretkey, c.curve->coordinator.secret_key);
@@ -880,9 +704,7 @@ Coordinator::Coordinator(CoordinatorConfig config)
 }
 
 Coordinator::~Coordinator() {
-    impl_->stop_zap = true;
-    if (impl_->zap_thread.joinable())
-        impl_->zap_thread.join();
+    impl_->authenticator.reset();
     impl_->router.close();
 }
 
@@ -900,91 +722,23 @@ void Coordinator::reportFailure(const std::string &participant, const std::strin
         impl_->reported_failure.emplace(participant, why);
 }
 
+Coordinator::State Coordinator::state() const {
+    return impl_->run.state();
+}
+
 CoordinatorSummary Coordinator::run() {
     auto &s = *impl_;
-    const auto &c = s.config;
-    const auto started = Clock::now();
-    std::optional<std::string> restore_directory;
-    if (c.resume)
-        restore_directory = s.readCheckpoint();
-    s.handshake();
-    if (restore_directory) {
-        try {
-            s.scheme->restore(s.resumed_states, s.resumed_wrenches);
-        } catch (const CouplingError &error) {
-            s.fail("the checkpoint", error.what());
-        }
+    if (s.run.state() != State::Bound)
+        throw LifecycleError(std::string("coordinator: run() called in state '") +
+                             stateName(s.run.state()) + "'; " + s.run.whatToDo());
+    try {
+        CoordinatorSummary summary = s.drive();
+        s.run.enter(State::Finished);
+        return summary;
+    } catch (...) {
+        s.run.enter(State::Failed);
+        throw;
     }
-    if (!c.output_directory.empty())
-        s.series = std::make_unique<CouplingSeries>(
-            c.output_directory, s.body_names, c.resume ? std::optional(s.window) : std::nullopt);
-    s.welcome(restore_directory);
-    spdlog::info("coordinator: run {} with {} participants, {} coupling, {} windows of {} s",
-                 s.run_id, s.peers.size(), schemeName(c.scheme.kind),
-                 (s.end_tick - s.tick + s.macro_step_ticks - 1) / s.macro_step_ticks,
-                 formatSeconds(s.macro_step_ticks * c.tick_s));
-
-    CoordinatorSummary summary;
-    auto last_progress = Clock::now();
-    const Ticks first_tick = s.tick;
-    while (s.tick < s.end_tick) {
-        const auto window_started = Clock::now();
-        const Ticks step = std::min(s.macro_step_ticks, s.end_tick - s.tick);
-        const auto [work_multibody, work_soil] = s.runWindow(s.tick, s.tick + step);
-        const double mismatch = work_multibody - work_soil;
-        s.cumulative_mismatch_J += mismatch;
-        ++summary.windows;
-        summary.iterations += s.scheme->iterations();
-        if (s.series) {
-            CouplingSeries::Row row;
-            row.window = s.window;
-            row.start_s = s.tick * c.tick_s;
-            row.end_s = (s.tick + step) * c.tick_s;
-            row.iterations = s.scheme->iterations();
-            row.residual = s.scheme->residual();
-            row.work_multibody_J = work_multibody;
-            row.work_soil_J = work_soil;
-            row.cumulative_mismatch_J = s.cumulative_mismatch_J;
-            row.wall_s = sockets::secondsSince(window_started);
-            s.series->append(row, s.scheme->states(), s.scheme->wrenches()); // queued, cheap
-        }
-        s.tick += step;
-        ++s.window;
-        if (!s.completed_by.empty()) {
-            spdlog::info("coordinator: participant '{}' completed its experiment at t = {} s",
-                         s.completed_by, formatSeconds(s.tick * c.tick_s));
-            break;
-        }
-        s.macro_step_ticks = s.nextStep();
-        if (c.checkpoint_every_windows > 0 && s.window % c.checkpoint_every_windows == 0 &&
-            s.tick < s.end_tick)
-            s.writeCheckpoint();
-        if (c.progress_interval_s > 0.0 &&
-            sockets::secondsSince(last_progress) >= c.progress_interval_s) {
-            last_progress = Clock::now();
-            const double wall = sockets::secondsSince(started);
-            const double done = double(s.tick - first_tick) / double(s.end_tick - first_tick);
-            std::fprintf(
-                stderr,
-                "coupling: t = %.4f / %.4f s  window %llu  wall %.1f s  ETA %.0f s  "
-                "%.2f passes/window  energy mismatch %.3g J\n",
-                s.tick * c.tick_s, s.end_tick * c.tick_s, static_cast<unsigned long long>(s.window),
-                wall, done > 0 ? wall * (1.0 - done) / done : 0.0,
-                double(summary.iterations) / double(summary.windows), s.cumulative_mismatch_J);
-        }
-    }
-    s.shutdownAll(false, s.completed_by.empty()
-                             ? "the run reached its end time"
-                             : "participant '" + s.completed_by + "' completed its experiment");
-    if (s.series)
-        s.series->flush();
-    summary.end_time_s = s.tick * c.tick_s;
-    summary.wall_s = sockets::secondsSince(started);
-    summary.cumulative_mismatch_J = s.cumulative_mismatch_J;
-    summary.completed_by = s.completed_by;
-    summary.final_states = s.scheme->states();
-    summary.final_wrenches = s.scheme->wrenches();
-    return summary;
 }
 
 } // namespace grainlink::coupling

@@ -86,6 +86,27 @@ CoordinatorConfig coordinatorConfigFrom(const ConfigNode &root) {
         coupling["peer_timeout_s"].fail("must be at least three heartbeat intervals");
     if (coupling.has("checkpoint_every_windows"))
         c.checkpoint_every_windows = count(coupling["checkpoint_every_windows"], 0);
+    if (auto limits = coupling.optional("limits")) {
+        auto &l = c.limits;
+        if (limits->has("max_message_bytes"))
+            l.max_message_bytes = count((*limits)["max_message_bytes"], 1024);
+        if (limits->has("max_bodies"))
+            l.max_bodies = count((*limits)["max_bodies"], 1);
+        if (limits->has("max_name_bytes"))
+            l.max_name_bytes = count((*limits)["max_name_bytes"], 1);
+        if (limits->has("max_stranger_messages_per_s"))
+            l.max_stranger_messages_per_s = count((*limits)["max_stranger_messages_per_s"], 1);
+        limits->finish();
+    }
+    // A heartbeat connection beats once an interval: three times that rate is never a flood.
+    if (c.limits.max_stranger_messages_per_s < 3.0 / c.heartbeat_interval_s) {
+        const auto limits = coupling.optional("limits");
+        if (limits && limits->has("max_stranger_messages_per_s"))
+            (*limits)["max_stranger_messages_per_s"].fail(
+                "must be at least three heartbeats per heartbeat_interval_s");
+        coupling["heartbeat_interval_s"].fail(
+            "beats faster than limits.max_stranger_messages_per_s / 3 allows");
+    }
     coupling.finish();
 
     for (const auto &item : root["participants"].items()) {

@@ -1,6 +1,8 @@
 #include "grainlink/coupling/Participant.hpp"
 
 #include "Codec.hpp"
+#include "HandshakeWatch.hpp"
+#include "OutputCheck.hpp"
 #include "Sockets.hpp"
 
 #include <algorithm>
@@ -55,6 +57,7 @@ struct Participant::Impl {
     sockets::ContextFor own_context{config.endpoint};
     zmq::context_t &context = own_context.get();
     zmq::socket_t socket; ///< main connection, used by the calling thread only
+    std::optional<HandshakeWatch> handshake_watch; ///< on `socket` until the Welcome
     State state = State::Created;
     RunInfo run;
     WindowInputs inputs;
@@ -146,6 +149,10 @@ struct Participant::Impl {
                 received_sequence = e.sequence();
                 return e;
             }
+            // Keys the coordinator refuses, or CURVE on one side only: fail at once, saying so.
+            if (handshake_watch)
+                if (auto why = handshake_watch->failure())
+                    throw CouplingError(who() + ": " + *why);
             if (shutdown_heard) {
                 std::lock_guard<std::mutex> lock(shutdown_mutex);
                 throw CouplingError(who() +
@@ -243,7 +250,10 @@ Participant::~Participant() {
 const RunInfo &Participant::initialize() {
     auto &s = *impl_;
     s.expect(State::Created, "initialize()", "it can be called once");
-    s.socket = sockets::connectDealer(s.context, s.config.endpoint, s.config.curve, 2000);
+    // The handshake watch attaches before the connection, so that it misses no attempt.
+    s.socket = sockets::makeDealer(s.context, s.config.curve, 2000);
+    s.handshake_watch.emplace(s.context, s.socket, s.config.curve, s.config.endpoint);
+    s.socket.connect(s.config.endpoint);
     s.heartbeat_interval_s = s.config.heartbeat_interval_s;
     s.peer_timeout_s = s.config.peer_timeout_s;
     s.startHeartbeats();
@@ -266,6 +276,7 @@ const RunInfo &Participant::initialize() {
     sockets::send(s.socket, hello);
 
     const pb::Envelope &reply = s.receive(s.config.handshake_timeout_s, "Welcome");
+    s.handshake_watch.reset(); // the connection is up
     if (!reply.has_welcome())
         s.stopped(reply);
     const auto &w = reply.welcome();
@@ -362,62 +373,20 @@ void Participant::checkpointWritten() {
     s.state = State::Ready;
 }
 
-namespace {
-
-bool finite(const Vec3 &v) {
-    return v.allFinite();
-}
-
-/// The bodies of `items`, checked against `expected`: each exactly once.
-template <typename T>
-void checkBodies(const std::string &who, const char *what, const std::vector<T> &items,
-                 const std::vector<std::string> &expected) {
-    bool in_order = items.size() == expected.size();
-    for (std::size_t i = 0; in_order && i < items.size(); ++i)
-        in_order = items[i].body == expected[i];
-    if (in_order) // the usual case: the same names in the same order
-        return;
-    std::vector<std::string> names, sorted_expected = expected;
-    for (const auto &x : items)
-        names.push_back(x.body);
-    std::sort(names.begin(), names.end());
-    std::sort(sorted_expected.begin(), sorted_expected.end());
-    if (names == sorted_expected)
-        return;
-    std::ostringstream os;
-    os << who << ": writeOutputs() got " << what << " for {";
-    for (const auto &n : names)
-        os << ' ' << n;
-    os << " } but must give exactly one for each of {";
-    for (const auto &n : sorted_expected)
-        os << ' ' << n;
-    os << " }";
-    throw CouplingError(os.str());
-}
-
-} // namespace
-
 void Participant::writeOutputs(WindowOutputs outputs) {
     auto &s = *impl_;
     if (s.state != State::WindowOpen)
         throw LifecycleError(s.who() + ": writeOutputs() called in state '" + stateName(s.state) +
                              "'; " + s.whatToDoNow());
-    if (s.config.role == Role::Multibody) {
-        for (const auto &st : outputs.states) {
-            if (!finite(st.position_m) || !finite(st.linear_velocity_m_s) ||
-                !finite(st.angular_velocity_rad_s) || !std::isfinite(st.orientation.norm()))
-                throw CouplingError(s.who() + ": non-finite state of body '" + st.body +
-                                    "' in window " + std::to_string(s.inputs.window));
-        }
-        checkBodies(s.who(), "states", outputs.states, s.expected_bodies);
-    } else {
-        for (const auto &w : outputs.wrenches) {
-            if (!finite(w.force_N) || !finite(w.torque_N_m))
-                throw CouplingError(s.who() + ": non-finite wrench on body '" + w.body +
-                                    "' in window " + std::to_string(s.inputs.window));
-        }
-        checkBodies(s.who(), "wrenches", outputs.wrenches, s.expected_bodies);
-    }
+    // The same check the coordinator runs on arrival (OutputCheck), worded for this call.
+    const auto problem = s.config.role == Role::Multibody
+                             ? checkOutputs(outputs.states, s.expected_bodies)
+                             : checkOutputs(outputs.wrenches, s.expected_bodies);
+    if (problem)
+        throw CouplingError(s.who() + ": " +
+                            (problem->kind == OutputProblem::Kind::NonFinite
+                                 ? problem->text + " in window " + std::to_string(s.inputs.window)
+                                 : "writeOutputs() got " + problem->text));
     s.outputs = std::move(outputs);
     s.state = State::OutputsWritten;
 }

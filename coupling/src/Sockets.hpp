@@ -5,6 +5,7 @@
 
 #include <zmq.hpp>
 
+#include <atomic>
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
@@ -39,6 +40,13 @@ private:
     std::unique_ptr<zmq::context_t> own_;
 };
 
+/// A fresh inproc:// address for a socket monitor. Numbered, never an object's address: a
+/// closed socket gives its address back only later, so a reused one could still be taken.
+inline std::string monitorAddress(const char *what) {
+    static std::atomic<unsigned long> next{0};
+    return std::string("inproc://grainlink-") + what + "-" + std::to_string(++next);
+}
+
 inline double secondsSince(Clock::time_point t) {
     return std::chrono::duration<double>(Clock::now() - t).count();
 }
@@ -49,14 +57,22 @@ inline void makeCurveClient(zmq::socket_t &socket, const CurveClientKeys &keys) 
     socket.set(zmq::sockopt::curve_secretkey, keys.participant.secret_key);
 }
 
-/// A connected DEALER (participant side); linger bounds how long unsent messages keep a process.
-inline zmq::socket_t connectDealer(zmq::context_t &context, const std::string &endpoint,
-                                   const std::optional<CurveClientKeys> &curve, int linger_ms) {
+/// A DEALER (participant side), not yet connected; linger bounds how long unsent messages keep
+/// a process.
+inline zmq::socket_t makeDealer(zmq::context_t &context,
+                                const std::optional<CurveClientKeys> &curve, int linger_ms) {
     zmq::socket_t socket(context, zmq::socket_type::dealer);
     socket.set(zmq::sockopt::linger, linger_ms);
     socket.set(zmq::sockopt::rcvtimeo, 50);
     if (curve)
         makeCurveClient(socket, *curve);
+    return socket;
+}
+
+/// The same, connected.
+inline zmq::socket_t connectDealer(zmq::context_t &context, const std::string &endpoint,
+                                   const std::optional<CurveClientKeys> &curve, int linger_ms) {
+    zmq::socket_t socket = makeDealer(context, curve, linger_ms);
     socket.connect(endpoint);
     return socket;
 }

@@ -10,8 +10,10 @@ namespace grainlink::dem {
 
 namespace {
 
-// Version 2 adds the contact pass's thread split; version 1 files are still read.
-constexpr char kMagic[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '2'};
+// Version 2 adds the contact pass's thread split, version 3 the neighbour skin in use and the
+// bodies' and planes' loads; versions 1 and 2 are still read.
+constexpr char kMagic[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '3'};
+constexpr char kMagicVersion2[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '2'};
 constexpr char kMagicVersion1[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '1'};
 
 class Writer {
@@ -36,10 +38,10 @@ public:
     void item(const RigidBodyState &s) {
         item(s.position_m);
         item(s.orientation);
-        item(s.velocity_m_s);
+        item(s.linear_velocity_m_s);
         item(s.angular_velocity_rad_s);
     }
-    void item(const DemSystem::MeshContactSlot &s) {
+    void item(const MeshContactSlot &s) {
         pod<std::int32_t>(s.body);
         pod<std::int32_t>(s.triangle);
         item(s.normal);
@@ -49,6 +51,13 @@ public:
         pod<std::uint64_t>(c.i);
         pod<std::uint64_t>(c.j);
         item(c.history);
+    }
+    void item(const BodyLoads &l) {
+        item(l.force_N);
+        item(l.torque_N_m);
+        item(l.impulse_N_s);
+        item(l.angular_impulse_N_m_s);
+        pod(l.accumulated_time_s);
     }
     template <class T> std::enable_if_t<std::is_arithmetic_v<T>> item(const T &v) { pod(v); }
     void text(const std::string &s) {
@@ -90,10 +99,10 @@ public:
     void item(RigidBodyState &s) {
         item(s.position_m);
         item(s.orientation);
-        item(s.velocity_m_s);
+        item(s.linear_velocity_m_s);
         item(s.angular_velocity_rad_s);
     }
-    void item(DemSystem::MeshContactSlot &s) {
+    void item(MeshContactSlot &s) {
         s.body = pod<std::int32_t>();
         s.triangle = pod<std::int32_t>();
         item(s.normal);
@@ -103,6 +112,13 @@ public:
         c.i = pod<std::uint64_t>();
         c.j = pod<std::uint64_t>();
         item(c.history);
+    }
+    void item(BodyLoads &l) {
+        item(l.force_N);
+        item(l.torque_N_m);
+        item(l.impulse_N_s);
+        item(l.angular_impulse_N_m_s);
+        l.accumulated_time_s = pod<double>();
     }
     template <class T> std::enable_if_t<std::is_arithmetic_v<T>> item(T &v) { v = pod<T>(); }
     std::string text() {
@@ -158,6 +174,9 @@ void writeCheckpoint(const DemSystem &system, const std::string &path,
         w.pod(s.time_offset_s);
         w.pod(s.max_overlap_ratio);
         w.vec(s.contact_split);
+        w.pod(s.skin_m);
+        w.vec(s.body_loads);
+        w.vec(s.plane_force);
         w.pod<std::uint64_t>(extras.size());
         for (const auto &[key, value] : extras) {
             w.text(key);
@@ -179,10 +198,15 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
         throw std::runtime_error("cannot open checkpoint '" + path + "'");
     char magic[8];
     in.read(magic, sizeof magic);
-    const bool version1 = in && std::memcmp(magic, kMagicVersion1, sizeof magic) == 0;
-    if (!in || (!version1 && std::memcmp(magic, kMagic, sizeof magic) != 0))
+    int version = 0;
+    for (const auto &[known, number] :
+         {std::pair{kMagicVersion1, 1}, std::pair{kMagicVersion2, 2}, std::pair{kMagic, 3}})
+        if (in && std::memcmp(magic, known, sizeof magic) == 0)
+            version = number;
+    if (version == 0)
         throw std::runtime_error("'" + path +
-                                 "' is not a grainlink DEM checkpoint (version 1 or 2)");
+                                 "' is not a grainlink DEM checkpoint (version 1, 2 or 3)");
+    const std::string trailer(magic, sizeof magic);
     Reader r(in, path);
     p.setNextId(r.pod<std::uint64_t>());
     r.vec(p.id);
@@ -215,8 +239,13 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
     s.step_offset = r.pod<std::uint64_t>();
     s.time_offset_s = r.pod<double>();
     s.max_overlap_ratio = r.pod<double>();
-    if (!version1)
+    if (version >= 2)
         r.vec(s.contact_split);
+    if (version >= 3) {
+        s.skin_m = r.pod<double>();
+        r.vec(s.body_loads);
+        r.vec(s.plane_force);
+    }
     CheckpointExtras extras;
     const auto count = r.pod<std::uint64_t>();
     for (std::uint64_t k = 0; k < count; ++k) {
@@ -224,7 +253,7 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
         extras[key] = r.pod<double>();
     }
     in.read(magic, sizeof magic);
-    if (!in || std::memcmp(magic, version1 ? kMagicVersion1 : kMagic, sizeof magic) != 0)
+    if (!in || std::memcmp(magic, trailer.data(), sizeof magic) != 0)
         throw std::runtime_error("checkpoint '" + path + "' is truncated (no trailer)");
     for (const auto &c : s.contacts)
         if (c.i >= n || c.j >= n)

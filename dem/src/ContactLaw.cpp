@@ -158,6 +158,50 @@ std::string ContactLaw::describe() const {
     return out.str();
 }
 
+std::string modelName(const DampingModel &slot) {
+    return std::holds_alternative<DampingViscous>(slot) ? "viscous" : "restitution";
+}
+std::string modelName(const TangentialModel &slot) {
+    return std::holds_alternative<TangentialLinear>(slot) ? "linear" : "mindlin";
+}
+std::string modelName(const RollingModel &slot) {
+    return std::holds_alternative<RollingEpsd>(slot)         ? "epsd"
+           : std::holds_alternative<RollingGrainShape>(slot) ? "grain_shape"
+                                                             : "none";
+}
+std::string modelName(const CohesionModel &slot) {
+    return std::holds_alternative<CohesionLinear>(slot) ? "linear" : "none";
+}
+
+const ContactLaw &ContactLaws::of(ContactType type) const {
+    return type == ContactType::GrainGrain  ? grain_grain
+           : type == ContactType::GrainWall ? grain_wall
+                                            : grain_tool;
+}
+
+void ContactLaws::finalize() {
+    grain_grain.finalize();
+    for (ContactType type : {ContactType::GrainWall, ContactType::GrainTool}) {
+        ContactLaw &law = type == ContactType::GrainWall ? grain_wall : grain_tool;
+        const char *name = type == ContactType::GrainWall ? "grain-wall" : "grain-tool";
+        law.finalize();
+        // The contact loops are compiled once per combination of models: every type shares
+        // the grain-grain models and has its own parameters.
+        const auto same = [&](const std::string &slot, const std::string &own,
+                              const std::string &grains) {
+            if (own != grains)
+                throw std::invalid_argument(
+                    std::string("the ") + name + " contact law's " + slot + " model '" + own +
+                    "' differs from the grain-grain law's '" + grains +
+                    "': every contact type uses the grain-grain models with its own parameters");
+        };
+        same("damping", modelName(law.damping), modelName(grain_grain.damping));
+        same("tangential", modelName(law.tangential), modelName(grain_grain.tangential));
+        same("rolling", modelName(law.rolling), modelName(grain_grain.rolling));
+        same("cohesion", modelName(law.cohesion), modelName(grain_grain.cohesion));
+    }
+}
+
 PairProperties pairProperties(const Material &a, const Material &b, const ContactLaw &law) {
     PairProperties p;
     const double ca = (1.0 - a.poisson_ratio * a.poisson_ratio) / a.youngs_modulus_Pa;

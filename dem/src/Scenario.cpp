@@ -4,27 +4,6 @@
 
 namespace grainlink::dem {
 
-RigidBodyState segmentedMotion(const RigidBodyState &start,
-                               const std::vector<MotionSegment> &motion, double t_s) {
-    RigidBodyState s = start;
-    s.velocity_m_s.setZero();
-    s.angular_velocity_rad_s.setZero();
-    double remaining = std::max(t_s, 0.0);
-    for (const MotionSegment &seg : motion) {
-        const double span = std::min(remaining, seg.duration_s);
-        s.position_m += seg.velocity_m_s * span;
-        s.orientation = rotationFromVector(seg.angular_velocity_rad_s * span) * s.orientation;
-        remaining -= span;
-        if (remaining <= 0.0) {
-            s.velocity_m_s = seg.velocity_m_s;
-            s.angular_velocity_rad_s = seg.angular_velocity_rad_s;
-            break;
-        }
-    }
-    s.orientation.normalize();
-    return s;
-}
-
 namespace {
 
 Vec3 gravityOf(const ConfigNode &node) {
@@ -64,25 +43,97 @@ template <class Model> void validateAt(const ConfigNode &node, const Model &mode
     }
 }
 
-/// A `rolling:` section (contact.rolling, deposition.rolling), §2.6.
-RollingModel parseRolling(const ConfigNode &node) {
+/// A slot's parameter: required in `contact`; in `contact_wall` and `contact_tool` (`base` set:
+/// the grain-grain slot of the same model) it defaults to the grain-grain value.
+double parameter(const ConfigNode &node, const std::string &key, const double *base) {
+    return base ? node.number(key, *base) : node[key].number();
+}
+
+/// A slot's model: required in `contact`; in a contact type's section it may be left out and
+/// must otherwise be the grain-grain model (the types share models, docs/physics.md §2.10).
+template <class Slot>
+std::string modelOf(const ConfigNode &node, const std::vector<std::string> &choices,
+                    const Slot *base) {
+    if (!base)
+        return node["model"].choice(choices);
+    const std::string grains = modelName(*base);
+    if (const auto model = node.optional("model"))
+        if (model->choice(choices) != grains)
+            model->fail("'" + model->text() + "' differs from the grain-grain model '" + grains +
+                        "' in 'contact': every contact type uses the grain-grain models with its "
+                        "own parameters (a model the grains do not need goes in 'contact' with "
+                        "zero parameters)");
+    return grains;
+}
+
+template <class Model, class Slot> const Model *sameModel(const Slot *base) {
+    return base ? std::get_if<Model>(base) : nullptr;
+}
+
+DampingModel parseDamping(const ConfigNode &node, const DampingModel *base = nullptr) {
+    DampingModel damping;
+    if (modelOf(node, {"restitution", "viscous"}, base) == "restitution") {
+        const auto *b = sameModel<DampingRestitution>(base);
+        damping = DampingRestitution{parameter(node, "restitution", b ? &b->restitution : nullptr)};
+    } else {
+        const auto *b = sameModel<DampingViscous>(base);
+        damping = DampingViscous{
+            parameter(node, "coefficient_N_s_m", b ? &b->coefficient_N_s_m : nullptr)};
+    }
+    node.finish();
+    validateAt(node, damping);
+    return damping;
+}
+
+TangentialModel parseTangential(const ConfigNode &node, const TangentialModel *base = nullptr) {
+    TangentialModel tangential;
+    if (modelOf(node, {"mindlin", "linear"}, base) == "mindlin") {
+        const auto *b = sameModel<TangentialMindlin>(base);
+        tangential = TangentialMindlin{
+            parameter(node, "friction_coefficient", b ? &b->friction_coefficient : nullptr)};
+    } else {
+        const auto *b = sameModel<TangentialLinear>(base);
+        TangentialLinear t;
+        t.stiffness_N_m = parameter(node, "stiffness_N_m", b ? &b->stiffness_N_m : nullptr);
+        t.damping_N_s_m = node.number("damping_N_s_m", b ? b->damping_N_s_m : 0.0);
+        t.stick_angle_deg = parameter(node, "stick_angle_deg", b ? &b->stick_angle_deg : nullptr);
+        // Without its own slip angle a new stick angle is both (the seed's one-angle law).
+        const bool own_stick = !b || node.has("stick_angle_deg");
+        t.slip_angle_deg =
+            node.number("slip_angle_deg", own_stick ? t.stick_angle_deg : b->slip_angle_deg);
+        tangential = t;
+    }
+    node.finish();
+    validateAt(node, tangential);
+    return tangential;
+}
+
+/// A `rolling:` section (contact.rolling, deposition.rolling, a contact type's), §2.6.
+RollingModel parseRolling(const ConfigNode &node, const RollingModel *base = nullptr) {
     RollingModel rolling = RollingNone{};
-    const std::string model = node["model"].choice({"none", "epsd", "grain_shape"});
+    const std::string model = modelOf(node, {"none", "epsd", "grain_shape"}, base);
     if (model == "epsd") {
-        rolling = RollingEpsd{node["coefficient"].number()};
+        const auto *b = sameModel<RollingEpsd>(base);
+        rolling = RollingEpsd{parameter(node, "coefficient", b ? &b->coefficient : nullptr)};
     } else if (model == "grain_shape") {
         // gamma per local axis: one number for all three, or a list of three (§2.6.1).
-        RollingGrainShape shape;
-        const ConfigNode gamma = node["aspect_ratio_angle_deg"];
-        if (gamma.isSequence()) {
-            const std::vector<double> values = gamma.numbers();
-            if (values.size() != 3)
-                gamma.fail("needs one angle or three (one per local axis), got " +
-                           std::to_string(values.size()));
-            shape.aspect_ratio_angle_deg = Vec3(values[0], values[1], values[2]);
-        } else {
-            shape.aspect_ratio_angle_deg.setConstant(gamma.number());
+        const auto *b = sameModel<RollingGrainShape>(base);
+        RollingGrainShape shape = b ? *b : RollingGrainShape{};
+        if (const auto gamma = b ? node.optional("aspect_ratio_angle_deg")
+                                 : std::optional<ConfigNode>(node["aspect_ratio_angle_deg"])) {
+            if (gamma->isSequence()) {
+                const std::vector<double> values = gamma->numbers();
+                if (values.size() != 3)
+                    gamma->fail("needs one angle or three (one per local axis), got " +
+                                std::to_string(values.size()));
+                shape.aspect_ratio_angle_deg = Vec3(values[0], values[1], values[2]);
+            } else {
+                shape.aspect_ratio_angle_deg.setConstant(gamma->number());
+            }
         }
+        if (b && node.has("inertia"))
+            node["inertia"].fail("the grains' moments of inertia are the grain-grain law's "
+                                 "(contact.rolling.inertia), not a contact type's");
         if (const auto inertia = node.optional("inertia"))
             if (inertia->choice({"sphere", "seed_eq12"}) == "seed_eq12")
                 shape.inertia = RollingGrainShape::Inertia::SeedEq12;
@@ -93,38 +144,26 @@ RollingModel parseRolling(const ConfigNode &node) {
     return rolling;
 }
 
+CohesionModel parseCohesion(const ConfigNode &node, const CohesionModel *base = nullptr) {
+    CohesionModel cohesion = CohesionNone{};
+    if (modelOf(node, {"none", "linear"}, base) == "linear") {
+        const auto *b = sameModel<CohesionLinear>(base);
+        cohesion = CohesionLinear{
+            parameter(node, "energy_density_J_m3", b ? &b->energy_density_J_m3 : nullptr)};
+    }
+    node.finish();
+    validateAt(node, cohesion);
+    return cohesion;
+}
+
 ContactLaw parseContact(const ConfigNode &node) {
     ContactLaw law;
-    const ConfigNode damping = node["damping"];
-    if (damping["model"].choice({"restitution", "viscous"}) == "restitution")
-        law.damping = DampingRestitution{damping["restitution"].number()};
-    else
-        law.damping = DampingViscous{damping["coefficient_N_s_m"].number()};
-    damping.finish();
-    validateAt(damping, law.damping);
-
-    const ConfigNode tangential = node["tangential"];
-    if (tangential["model"].choice({"mindlin", "linear"}) == "mindlin") {
-        law.tangential = TangentialMindlin{tangential["friction_coefficient"].number()};
-    } else {
-        TangentialLinear t;
-        t.stiffness_N_m = tangential["stiffness_N_m"].number();
-        t.damping_N_s_m = tangential.number("damping_N_s_m", 0.0);
-        t.stick_angle_deg = tangential["stick_angle_deg"].number();
-        t.slip_angle_deg = tangential.number("slip_angle_deg", t.stick_angle_deg);
-        law.tangential = t;
-    }
-    tangential.finish();
-    validateAt(tangential, law.tangential);
-
+    law.damping = parseDamping(node["damping"]);
+    law.tangential = parseTangential(node["tangential"]);
     if (const auto rolling = node.optional("rolling"))
         law.rolling = parseRolling(*rolling);
-    if (const auto cohesion = node.optional("cohesion")) {
-        if ((*cohesion)["model"].choice({"none", "linear"}) == "linear")
-            law.cohesion = CohesionLinear{(*cohesion)["energy_density_J_m3"].number()};
-        cohesion->finish();
-        validateAt(*cohesion, law.cohesion);
-    }
+    if (const auto cohesion = node.optional("cohesion"))
+        law.cohesion = parseCohesion(*cohesion);
     law.background_damping_1_s = node.number("background_damping_1_s", 0.0);
     node.finish();
     try {
@@ -133,6 +172,26 @@ ContactLaw parseContact(const ConfigNode &node) {
         node.fail(e.what());
     }
     return law;
+}
+
+/// `contact_wall` or `contact_tool`: the slots that contact type sets for itself.
+ContactOverride parseContactOverride(const ConfigNode &node, const ContactLaw &grains) {
+    ContactOverride o;
+    if (const auto n = node.optional("damping"))
+        o.damping = parseDamping(*n, &grains.damping);
+    if (const auto n = node.optional("tangential"))
+        o.tangential = parseTangential(*n, &grains.tangential);
+    if (const auto n = node.optional("rolling"))
+        o.rolling = parseRolling(*n, &grains.rolling);
+    if (const auto n = node.optional("cohesion"))
+        o.cohesion = parseCohesion(*n, &grains.cohesion);
+    node.finish();
+    try {
+        o.appliedTo(grains).finalize();
+    } catch (const std::invalid_argument &e) {
+        node.fail(e.what());
+    }
+    return o;
 }
 
 void parseWall(const ConfigNode &node, const Material &material, std::vector<PlaneWall> &out) {
@@ -325,6 +384,10 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
 
     s.material = parseMaterial(root["material"]);
     s.law = parseContact(root["contact"]);
+    if (const auto wall = root.optional("contact_wall"))
+        s.contact_wall = parseContactOverride(*wall, s.law);
+    if (const auto tool = root.optional("contact_tool"))
+        s.contact_tool = parseContactOverride(*tool, s.law);
     if (const auto walls = root.optional("walls"))
         for (const ConfigNode &w : walls->items())
             parseWall(w, s.material, s.planes);
@@ -350,8 +413,28 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
     return s;
 }
 
+ContactLaw ContactOverride::appliedTo(ContactLaw law) const {
+    if (damping)
+        law.damping = *damping;
+    if (tangential)
+        law.tangential = *tangential;
+    if (rolling)
+        law.rolling = *rolling;
+    if (cohesion)
+        law.cohesion = *cohesion;
+    return law;
+}
+
+ContactLaws contactLaws(const DemScenario &s) {
+    ContactLaws laws(s.law);
+    laws.grain_wall = s.contact_wall.appliedTo(s.law);
+    laws.grain_tool = s.contact_tool.appliedTo(s.law);
+    return laws;
+}
+
 std::unique_ptr<DemSystem> makeSystem(const DemScenario &s) {
-    auto system = std::make_unique<DemSystem>(s.law, std::vector<Material>{s.material}, s.settings);
+    auto system =
+        std::make_unique<DemSystem>(contactLaws(s), std::vector<Material>{s.material}, s.settings);
     for (const PlaneWall &w : s.planes)
         system->addPlane(w);
     return system;
@@ -361,10 +444,11 @@ std::string packingKey(const DemScenario &s) {
     std::ostringstream key;
     key.precision(17);
     // The law the grains settle under: rolling laws tested on one packing share its key.
-    ContactLaw settling = s.law;
+    ContactLaw settling = s.law, settling_wall = s.contact_wall.appliedTo(s.law);
     if (s.deposition.rolling) {
-        settling.rolling = *s.deposition.rolling;
+        settling.rolling = settling_wall.rolling = *s.deposition.rolling;
         settling.finalize();
+        settling_wall.finalize();
     }
     key << "v2|" << settling.describe() << "|E=" << s.material.youngs_modulus_Pa
         << " nu=" << s.material.poisson_ratio << " rho=" << s.material.density_kg_m3
@@ -372,6 +456,8 @@ std::string packingKey(const DemScenario &s) {
         << s.settings.newmark_beta << ',' << s.settings.newmark_gamma
         << " g=" << s.settings.gravity_m_s2.transpose() << " threads=" << s.settings.threads << "|"
         << s.deposition.describe();
+    if (s.contact_wall.any()) // grain-wall contacts shape the packing, grain-tool ones do not
+        key << "|contact_wall " << settling_wall.describe();
     for (const PlaneWall &w : s.planes)
         key << "|wall " << w.name << ' ' << w.point_m.transpose() << ' ' << w.normal.transpose()
             << ' ' << w.friction_coefficient.value_or(-1.0);

@@ -75,7 +75,7 @@ std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progr
         sys->setRolling(*settling_rolling);
     const auto runLaw = [&] {
         if (settling_rolling)
-            sys->setRolling(scenario.law.rolling);
+            sys->setRolling(contactLaws(scenario));
         return std::move(sys);
     };
     const std::string key = packingKey(scenario);
@@ -165,7 +165,7 @@ std::string seriesRow(DemSystem &sys, double run_time_s, std::vector<BodyLoad> &
         const double span = body.accumulated_time_s > 0.0 ? body.accumulated_time_s : 1.0;
         const Vec3 f = body.impulse_N_s / span, t = body.angular_impulse_N_m_s / span;
         row << ',' << s.position_m.x() << ',' << s.position_m.y() << ',' << s.position_m.z() << ','
-            << s.velocity_m_s.x() << ',' << s.velocity_m_s.z() << ','
+            << s.linear_velocity_m_s.x() << ',' << s.linear_velocity_m_s.z() << ','
             << s.angular_velocity_rad_s.y() << ',' << f.x() << ',' << f.y() << ',' << f.z() << ','
             << t.x() << ',' << t.y() << ',' << t.z();
         loads.resize(std::size_t(sys.bodyCount()));
@@ -206,10 +206,7 @@ void addBody(DemSystem &sys, const BodySpec &spec, const RigidBodyState &start,
     MeshBody body(spec.name, spec.mesh, start);
     body.friction_coefficient = spec.friction_coefficient;
     body.record_triangle_loads = spec.record_triangle_loads;
-    const auto motion = spec.motion;
-    sys.addBody(std::move(body), [start, motion, run_start_s](double t) {
-        return segmentedMotion(start, motion, t - run_start_s);
-    });
+    sys.addBody(std::move(body), SegmentedMotion{start, run_start_s, spec.motion});
 }
 
 /// Start poses: a clearance above the bed puts the lowest mesh point that far above the surface.
@@ -248,7 +245,7 @@ void writeSummaryJson(const DemSystem &sys, const DemScenario &scenario, const R
         const RigidBodyState &s = sys.body(b).state();
         const BodyLoad load = std::size_t(b) < loads.size() ? loads[std::size_t(b)] : BodyLoad{};
         j["bodies"][sys.body(b).name()] = {{"position_m", vector(s.position_m)},
-                                           {"velocity_m_s", vector(s.velocity_m_s)},
+                                           {"velocity_m_s", vector(s.linear_velocity_m_s)},
                                            {"force_N", vector(load.force_N)},
                                            {"torque_N_m", vector(load.torque_N_m)}};
     }

@@ -13,23 +13,37 @@ MeshBody::MeshBody(std::string name, TriangleMesh mesh_body_frame, RigidBodyStat
 void MeshBody::setState(const RigidBodyState &state) {
     state_ = state;
     state_.orientation.normalize();
-    const Mat3 rotation = state_.orientation.toRotationMatrix();
-    world_vertices_.resize(mesh_.vertices_m.size());
-    for (std::size_t k = 0; k < world_vertices_.size(); ++k)
-        world_vertices_[k] = state_.position_m + rotation * mesh_.vertices_m[k];
+    placeVertices();
+}
+
+void MeshBody::restoreState(const RigidBodyState &saved) {
+    state_ = saved;
+    placeVertices();
+}
+
+void MeshBody::placeVertices() {
+    worldVerticesAt(state_, world_vertices_);
+}
+
+void MeshBody::worldVerticesAt(const RigidBodyState &state, std::vector<Vec3> &out) const {
+    const Mat3 rotation = state.orientation.toRotationMatrix();
+    out.resize(mesh_.vertices_m.size());
+    for (std::size_t k = 0; k < out.size(); ++k)
+        out[k] = state.position_m + rotation * mesh_.vertices_m[k];
+}
+
+void MeshBody::setLoads(const BodyLoads &loads) {
+    force_N = loads.force_N;
+    torque_N_m = loads.torque_N_m;
+    impulse_N_s = loads.impulse_N_s;
+    angular_impulse_N_m_s = loads.angular_impulse_N_m_s;
+    accumulated_time_s = loads.accumulated_time_s;
 }
 
 void MeshBody::resetAccumulatedImpulse() {
     impulse_N_s.setZero();
     angular_impulse_N_m_s.setZero();
     accumulated_time_s = 0.0;
-}
-
-RigidBodyState constantVelocityMotion(const RigidBodyState &initial, double t_s) {
-    RigidBodyState s = initial;
-    s.position_m = initial.position_m + initial.velocity_m_s * t_s;
-    s.orientation = rotationFromVector(initial.angular_velocity_rad_s * t_s) * initial.orientation;
-    return s;
 }
 
 } // namespace grainlink::dem

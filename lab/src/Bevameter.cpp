@@ -154,20 +154,15 @@ PlateRun BevameterExperiment::run(const LabBed &bed, double radius,
     const double highest = highestGrainUnder(sys.particles(), centre, radius, surface);
     dem::RigidBodyState initial;
     initial.position_m = Vec3(centre.x(), centre.y(), highest + t.start_clearance_m);
-    initial.velocity_m_s = Vec3(0.0, 0.0, -t.speed_m_s);
+    initial.linear_velocity_m_s = Vec3(0.0, 0.0, -t.speed_m_s);
     std::fprintf(stderr,
                  "[bevameter] R = %s: bed surface %.5f m, highest grain under the plate "
                  "%.5f m, plate starts at %.5f m\n",
                  mm(radius).c_str(), surface, highest, initial.position_m.z());
     dem::MeshBody plate("plate", plateMesh(radius, thickness, t.plate_segments), initial);
     plate.friction_coefficient = t.plate_friction_coefficient;
-    const double t0 = sys.time();
     const double z0 = initial.position_m.z(), v = t.speed_m_s;
-    sys.addBody(std::move(plate), [initial, t0, z0, v](double time_s) {
-        dem::RigidBodyState s = initial;
-        s.position_m.z() = z0 - v * (time_s - t0); // constant speed down
-        return s;
-    });
+    sys.addBody(std::move(plate), dem::constantVelocity(initial, sys.time())); // down
     sys.prepare();
 
     const auto total_steps = std::uint64_t(

@@ -69,11 +69,23 @@ struct BoxMotion {
     double shear_speed_m_s = 0.0;
     double shear_start_s = std::numeric_limits<double>::infinity();
     double plate_t_ref_s = 0.0, plate_z_ref_m = 0.0, plate_vz_m_s = 0.0;
+    dem::RigidBodyState upper_start, plate_start; ///< before the shear
     double shift(double t) const {
         return t > shear_start_s ? shear_speed_m_s * (t - shear_start_s) : 0.0;
     }
-    double shiftSpeed(double t) const { return t > shear_start_s ? shear_speed_m_s : 0.0; }
     double plateZ(double t) const { return plate_z_ref_m + plate_vz_m_s * (t - plate_t_ref_s); }
+    /// Hands the DEM both moving bodies' motions from time t on (after a change of speed).
+    void apply(dem::DemSystem &sys, int upper_id, int plate_id, double t) const {
+        const double shear_speed = t >= shear_start_s ? shear_speed_m_s : 0.0;
+        dem::RigidBodyState upper = upper_start, plate = plate_start;
+        upper.position_m.x() = shift(t);
+        upper.linear_velocity_m_s.x() = shear_speed;
+        plate.position_m.x() += shift(t);
+        plate.position_m.z() = plateZ(t);
+        plate.linear_velocity_m_s = Vec3(shear_speed, 0.0, plate_vz_m_s);
+        sys.setBodyMotion(upper_id, dem::constantVelocity(upper, t));
+        sys.setBodyMotion(plate_id, dem::constantVelocity(plate, t));
+    }
 };
 
 } // namespace
@@ -268,8 +280,8 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
     const double L = t.length_m, W = t.width_m, h = t.lower_height_m;
     const double lip = t.max_displacement_m + 0.01 * L;
 
-    auto motion = std::make_shared<BoxMotion>();
-    motion->shear_speed_m_s = t.shear_speed_m_s;
+    BoxMotion motion;
+    motion.shear_speed_m_s = t.shear_speed_m_s;
     double highest = 0.0;
     const auto &grains = sys.particles();
     for (std::size_t i = 0; i < grains.size(); ++i)
@@ -279,40 +291,28 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
             "direct shear: the settled bed reaches z = " + std::to_string(highest) +
             " m, above the upper frame's top " + std::to_string(h + t.upper_height_m) +
             " m; raise upper_height_m or deposit fewer grains");
-    motion->plate_t_ref_s = sys.time();
-    motion->plate_z_ref_m = highest + t.start_clearance_m;
+    motion.plate_t_ref_s = sys.time();
+    motion.plate_z_ref_m = highest + t.start_clearance_m;
 
     dem::RigidBodyState lower_state;
     dem::MeshBody lower("lower_frame", frameMesh(L, W, h, L, L + lip, h), lower_state);
     lower.friction_coefficient = t.wall_friction_coefficient;
     sys.addBody(std::move(lower));
 
-    dem::RigidBodyState upper_state;
-    upper_state.position_m = Vec3(0.0, 0.0, h);
+    motion.upper_start.position_m = Vec3(0.0, 0.0, h);
     dem::MeshBody upper("upper_frame", frameMesh(L, W, t.upper_height_m, -lip, 0.0, 0.0),
-                        upper_state);
+                        motion.upper_start);
     upper.friction_coefficient = t.wall_friction_coefficient;
-    const int upper_id = sys.addBody(std::move(upper), [upper_state, motion](double time_s) {
-        dem::RigidBodyState s = upper_state;
-        s.position_m.x() = motion->shift(time_s);
-        s.velocity_m_s.x() = motion->shiftSpeed(time_s);
-        return s;
-    });
+    const int upper_id = sys.addBody(std::move(upper));
 
-    dem::RigidBodyState plate_state;
-    plate_state.position_m = Vec3(0.5 * L, 0.5 * W, motion->plate_z_ref_m);
+    motion.plate_start.position_m = Vec3(0.5 * L, 0.5 * W, motion.plate_z_ref_m);
     dem::MeshBody plate(
         "top_plate",
         dem::makeRectangle(L - 2.0 * t.plate_clearance_m, W - 2.0 * t.plate_clearance_m, 1, 1),
-        plate_state);
+        motion.plate_start);
     plate.friction_coefficient = t.wall_friction_coefficient;
-    const int plate_id = sys.addBody(std::move(plate), [plate_state, motion](double time_s) {
-        dem::RigidBodyState s = plate_state;
-        s.position_m.x() += motion->shift(time_s);
-        s.position_m.z() = motion->plateZ(time_s);
-        s.velocity_m_s = Vec3(motion->shiftSpeed(time_s), 0.0, motion->plate_vz_m_s);
-        return s;
-    });
+    const int plate_id = sys.addBody(std::move(plate));
+    motion.apply(sys, upper_id, plate_id, sys.time());
     sys.prepare();
 
     LoadServo servo = t.servo.loadServo(run.target_force_N);
@@ -326,12 +326,13 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
         const auto loads = observeInterval(sys, control_steps, {plate_id, upper_id});
         Reaction r{loads[0].force_N, loads[1].force_N};
         // Servo on the top plate's vertical speed, physics.md §12.11.
-        motion->plate_z_ref_m = motion->plateZ(sys.time());
-        motion->plate_t_ref_s = sys.time();
+        motion.plate_z_ref_m = motion.plateZ(sys.time());
+        motion.plate_t_ref_s = sys.time();
         // Until the plate touches the bed it comes down at the servo's top speed; then the
         // proportional-integral law (integral gain 0: proportional alone).
-        motion->plate_vz_m_s =
+        motion.plate_vz_m_s =
             r.plate_N.z() > 0.0 ? -servo.update(r.plate_N.z(), control_dt) : -servo.max_speed_m_s;
+        motion.apply(sys, upper_id, plate_id, sys.time());
         return r;
     };
 
@@ -369,8 +370,9 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
             run.grains_above_weight_N += grains.mass[i] * g;
 
     // Shearing at constant speed.
-    motion->shear_start_s = sys.time();
-    const double plate_z0 = motion->plateZ(sys.time());
+    motion.shear_start_s = sys.time();
+    motion.apply(sys, upper_id, plate_id, sys.time());
+    const double plate_z0 = motion.plateZ(sys.time());
     const auto controls_per_sample =
         std::max<std::uint64_t>(1, std::llround(t.sample_interval_s / control_dt));
     const auto total_controls =
@@ -395,7 +397,7 @@ BoxShearRun shearOnce(const dem::DemSystem &base, const DirectShearSpec &t, doub
         s.area_m2 = W * (L - s.displacement_m);
         s.shear_stress_Pa = s.shear_force_N / s.area_m2;
         s.normal_stress_Pa = (s.normal_force_N + run.grains_above_weight_N) / s.area_m2;
-        s.plate_height_m = motion->plateZ(sys.time()) - plate_z0;
+        s.plate_height_m = motion.plateZ(sys.time()) - plate_z0;
         run.samples.push_back(s);
         progress.update(sys.time(), double(done) / double(total_controls),
                         (sys.stepCount() - steps0) * sys.particles().size(),

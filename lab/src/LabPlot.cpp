@@ -44,6 +44,9 @@ PlotOutcome plotLabRun(const std::string &directory, const std::string &test,
                            "and python3-matplotlib)"};
     if (!fs::exists(tool))
         return {false, "no plot: " + tool + " not found"};
+    const fs::path png = fs::path(directory) / (test + ".png");
+    std::error_code ignored;
+    fs::remove(png, ignored); // an earlier run's plot must not stand for this run
     const std::string command =
         shellQuoted(python) + " " + shellQuoted(tool) + " " + shellQuoted(directory) + " 2>&1";
     std::fflush(stdout); // the child shares the terminal
@@ -55,7 +58,6 @@ PlotOutcome plotLabRun(const std::string &directory, const std::string &test,
     while (std::fgets(buffer, sizeof buffer, pipe))
         output += buffer;
     const int status = pclose(pipe);
-    const fs::path png = fs::path(directory) / (test + ".png");
     if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 0 && fs::exists(png))
         return {true, "plot: " + png.string()};
     const std::string why = lastLine(output); // the tool's own reason, e.g. matplotlib missing

@@ -166,11 +166,8 @@ void measureHeap(const std::vector<Eigen::Vector3d> &positions, const std::vecto
 
 namespace {
 
-/// The fill: the grains settled in the standing tube (body 0), whose lift starts at
-/// *lift_start_s.
-struct ReposeFill : LabBed {
-    std::shared_ptr<double> lift_start_s;
-};
+/// The fill: the grains settled in the standing tube (body 0).
+struct ReposeFill : LabBed {};
 
 /// The repose test's steps of the lab skeleton (LabExperiment.hpp): the fill is the bed, the
 /// lift the one run, the heap's flank line the fit.
@@ -206,19 +203,8 @@ ReposeFill ReposeExperiment::prepareBed(double progress_interval_s) const {
 
     dem::RigidBodyState initial;
     initial.position_m = Vec3(centre.x(), centre.y(), d.region_lower_m.z());
-    auto lift_start = std::make_shared<double>(std::numeric_limits<double>::infinity());
-    fill.lift_start_s = lift_start;
-    const double v = t.lift_speed_m_s;
-    sys.addBody(
-        dem::MeshBody("tube", tubeMesh(t.tube_radius_m, t.tube_height_m, t.tube_segments), initial),
-        [initial, lift_start, v](double time_s) {
-            dem::RigidBodyState s = initial;
-            if (time_s > *lift_start) {
-                s.position_m.z() += v * (time_s - *lift_start);
-                s.velocity_m_s = Vec3(0.0, 0.0, v);
-            }
-            return s;
-        });
+    sys.addBody(dem::MeshBody("tube", tubeMesh(t.tube_radius_m, t.tube_height_m, t.tube_segments),
+                              initial));
 
     // Fill the tube and let the column settle (the tube stands still meanwhile), under the
     // deposition's rolling law if it has its own: one fill for several laws.
@@ -232,7 +218,7 @@ ReposeFill ReposeExperiment::prepareBed(double progress_interval_s) const {
     std::fprintf(stderr, "[repose] %zu grains settled in the tube (%.3f s simulated)\n",
                  report.inserted, report.settle_time_s);
     if (d.rolling)
-        sys.setRolling(scenario.soil.law.rolling);
+        sys.setRolling(dem::contactLaws(scenario.soil));
     fill.summary = measureBed(sys, scenario.soil,
                               {kPi * t.tube_radius_m * t.tube_radius_m, d.region_lower_m.z()});
     fill.summary.wall_s = secondsSince(start);
@@ -243,13 +229,15 @@ ReposeRun ReposeExperiment::run(const ReposeFill &fill, double lift_speed_m_s,
                                 double progress_interval_s) const {
     const auto start = std::chrono::steady_clock::now();
     const ReposeSpec &t = scenario.test;
-    dem::DemSystem sys = *fill.system; // the tube's motion reads *fill.lift_start_s
+    dem::DemSystem sys = *fill.system;
     const double dt = sys.settings().time_step_s;
     ReposeRun run;
     run.lift_speed_m_s = lift_speed_m_s;
 
     // Lift the tube by its own height: its bottom then clears any column it held.
-    *fill.lift_start_s = sys.time();
+    dem::RigidBodyState lifting = sys.body(0).state();
+    lifting.linear_velocity_m_s = Vec3(0.0, 0.0, lift_speed_m_s);
+    sys.setBodyMotion(0, dem::constantVelocity(lifting, sys.time()));
     const auto lift_steps = std::uint64_t(std::ceil(t.tube_height_m / (lift_speed_m_s * dt)));
     dem::Progress lift("repose lift", progress_interval_s);
     const std::uint64_t chunk = std::max<std::uint64_t>(1, std::llround(0.01 / dt));

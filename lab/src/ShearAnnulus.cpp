@@ -58,8 +58,8 @@ void appendBox(dem::TriangleMesh &mesh, const Vec3 &centre, const Vec3 &a, const
                  : std::array<int, 3>{first + t[0], first + t[1], first + t[2]});
 }
 
-/// Prescribed motion of the annulus: piecewise-constant vertical and angular speed, changed
-/// between sample intervals by retarget(); DemSystem asks it for the state at each step's end.
+/// Prescribed motion of the annulus (mesh body 0): piecewise-constant vertical and angular
+/// speed, changed between sample intervals by retarget(), which hands the DEM the new motion.
 struct AnnulusDrive {
     dem::RigidBodyState initial;
     double t_ref = 0.0, z_ref = 0.0, theta_ref = 0.0; ///< [s], [m], [rad] at the last change
@@ -70,16 +70,18 @@ struct AnnulusDrive {
         dem::RigidBodyState s = initial;
         s.position_m.z() = z(t);
         s.orientation = dem::Quat(Eigen::AngleAxisd(theta(t), Vec3::UnitZ()));
-        s.velocity_m_s = Vec3(0.0, 0.0, v_z);
+        s.linear_velocity_m_s = Vec3(0.0, 0.0, v_z);
         s.angular_velocity_rad_s = Vec3(0.0, 0.0, omega);
         return s;
     }
-    void retarget(double t, double new_v_z, double new_omega) {
+    dem::SegmentedMotion motion() const { return dem::constantVelocity(at(t_ref), t_ref); }
+    void retarget(dem::DemSystem &sys, double t, double new_v_z, double new_omega) {
         z_ref = z(t);
         theta_ref = theta(t);
         t_ref = t;
         v_z = new_v_z;
         omega = new_omega;
+        sys.setBodyMotion(0, motion());
     }
 };
 
@@ -418,7 +420,7 @@ ShearRun ShearAnnulusExperiment::run(const LabBed &bed, double pressure,
     drive->v_z = -t.approach_speed_m_s;
     dem::MeshBody annulus("annulus", makeShearAnnulus(g), drive->at(sys.time()));
     annulus.friction_coefficient = t.friction_coefficient;
-    sys.addBody(std::move(annulus), [drive](double time_s) { return drive->at(time_s); });
+    sys.addBody(std::move(annulus), drive->motion());
     sys.prepare();
 
     LoadServo servo = t.servo.loadServo(run.target_force_N);
@@ -450,7 +452,7 @@ ShearRun ShearAnnulusExperiment::run(const LabBed &bed, double pressure,
         progress.update(sys.time() - t0, 0.0, run.steps * sys.particles().size(),
                         "approach, F " + std::to_string(s.force_N) + " N");
         if (s.force_N >= run.target_force_N) {
-            drive->retarget(sys.time(), -servo.update(s.force_N, interval_s), 0.0);
+            drive->retarget(sys, sys.time(), -servo.update(s.force_N, interval_s), 0.0);
             break;
         }
         if (sys.time() - t0 > t.servo.max_load_time_s) {
@@ -468,18 +470,19 @@ ShearRun ShearAnnulusExperiment::run(const LabBed &bed, double pressure,
     const double hold_end = sys.time() + t.servo.hold_s;
     while (sys.time() < hold_end - 0.5 * dt) {
         const Interval s = interval();
-        drive->retarget(sys.time(), -servo.update(s.force_N, interval_s), 0.0);
+        drive->retarget(sys, sys.time(), -servo.update(s.force_N, interval_s), 0.0);
     }
     run.load_time_s = sys.time() - t0;
     run.sinkage_at_load_m = surface - (drive->z(sys.time()) - g.grouser_height_m);
 
     // Shear: constant angular speed, the servo holding the load.
     const double t_shear = sys.time();
-    drive->retarget(t_shear, drive->v_z, t.angular_speed_rad_s);
+    drive->retarget(sys, t_shear, drive->v_z, t.angular_speed_rad_s);
     double err2 = 0.0;
     for (;;) {
         const Interval s = interval();
-        drive->retarget(sys.time(), -servo.update(s.force_N, interval_s), t.angular_speed_rad_s);
+        drive->retarget(sys, sys.time(), -servo.update(s.force_N, interval_s),
+                        t.angular_speed_rad_s);
         ShearSample x;
         x.time_s = s.t_mid_s - t_shear;
         x.rotation_rad = t.angular_speed_rad_s * x.time_s;

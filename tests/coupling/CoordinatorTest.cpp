@@ -199,3 +199,25 @@ TEST_CASE("A participant that declares its experiment complete ends the run norm
     CHECK_NOTHROW(mbs.get());
     CHECK_NOTHROW(soil.get());
 }
+
+TEST_CASE("A coordinator runs once; a second run() says what to do instead",
+          "[coupling][coordinator]") {
+    Coordinator coordinator(twoMassRun(SchemeKind::ExplicitSerial, "inproc://once", 0.01, 0.05));
+    CHECK(coordinator.state() == Coordinator::State::Bound);
+    auto mbs = startSide(Role::Multibody, coordinator.boundEndpoint());
+    auto soil = startSide(Role::Soil, coordinator.boundEndpoint());
+    CHECK(coordinator.run().windows == 5);
+    mbs.get();
+    soil.get();
+    CHECK(coordinator.state() == Coordinator::State::Finished);
+    CHECK_THROWS_WITH(coordinator.run(),
+                      "coordinator: run() called in state 'finished'; the run is over and a "
+                      "coordinator runs once: construct a new Coordinator for another run");
+
+    auto config = twoMassRun(SchemeKind::ExplicitSerial, "inproc://once-failed", 0.01, 0.05);
+    config.handshake_timeout_s = 0.1;
+    Coordinator failed(config);
+    CHECK_THROWS_AS(failed.run(), CouplingError); // no one joins
+    CHECK(failed.state() == Coordinator::State::Failed);
+    CHECK_THROWS_AS(failed.run(), LifecycleError);
+}

@@ -9,6 +9,7 @@
 #include <chrono>
 #include <optional>
 #include <string>
+#include <vector>
 
 namespace grainlink::testing {
 
@@ -49,6 +50,12 @@ public:
     void sendBytes(const std::string &bytes) {
         socket_.send(zmq::buffer(bytes), zmq::send_flags::none);
     }
+    /// One message of several frames (our participants always send one).
+    void sendFrames(const std::vector<std::string> &frames) {
+        for (std::size_t i = 0; i < frames.size(); ++i)
+            socket_.send(zmq::buffer(frames[i]),
+                         i + 1 < frames.size() ? zmq::send_flags::sndmore : zmq::send_flags::none);
+    }
 
     /// The next message, or nothing within `timeout_ms`.
     std::optional<pb::Envelope> receive(long timeout_ms = 5000) {
@@ -76,6 +83,14 @@ public:
         w->mutable_torque_n_m();
         w->set_frame(pb::FRAME_WORLD);
         send(e);
+    }
+
+    /// How many messages arrive until none came for `quiet_ms`.
+    int countUntilQuiet(long quiet_ms = 500) {
+        int n = 0;
+        while (receive(quiet_ms))
+            ++n;
+        return n;
     }
 
     /// Drops messages other than `wanted` (for example the heartbeat echoes).

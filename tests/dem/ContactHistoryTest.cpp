@@ -55,12 +55,9 @@ std::unique_ptr<DemSystem> carried(const DemSettings& settings, bool keep_histor
     const DemSystem& packing = settledPacking();
     auto sys = std::make_unique<DemSystem>(law(), std::vector<Material>{kMaterial}, settings);
     const double t0 = packing.time();
-    sys->addBody(MeshBody("box", box(), {}), [t0](double t) {
-        RigidBodyState s;
-        s.position_m = kBoxVelocity * (t - t0);
-        s.velocity_m_s = kBoxVelocity;
-        return s;
-    });
+    RigidBodyState start;
+    start.linear_velocity_m_s = kBoxVelocity;
+    sys->addBody(MeshBody("box", box(), {}), constantVelocity(start, t0));
     copyState(packing, *sys);
     if (!keep_history) {
         DemSystem::Internals bare = packing.saveInternals();
@@ -69,7 +66,7 @@ std::unique_ptr<DemSystem> carried(const DemSettings& settings, bool keep_histor
         for (auto& h : bare.plane_history)
             h = ContactHistory{};
         for (auto& slot : bare.mesh_slots)
-            slot = DemSystem::MeshContactSlot{};
+            slot = MeshContactSlot{};
         sys->restoreInternals(bare);
     }
     for (Vec3& v : sys->particles().velocity)

@@ -27,10 +27,10 @@ ParticleStore pour(int threads) {
     addLattice(sys, lower, upper, 0.008, 0.0025, 0.0035, kMaterial.density_kg_m3, 0.3, 300);
     RigidBodyState start;
     start.position_m = Vec3(0, 0, 0.11);
-    start.velocity_m_s = Vec3(0, 0, -0.5);
+    start.linear_velocity_m_s = Vec3(0, 0, -0.5);
     start.angular_velocity_rad_s = Vec3(0, 5, 0);
     MeshBody wheel("wheel", makeCylinder(0.01, 0.03, 24), start);
-    sys.addBody(wheel, [start](double t) { return constantVelocityMotion(start, t); });
+    sys.addBody(wheel, constantVelocity(start));
     sys.run(2000);
     REQUIRE(sys.neighbourBuilds() > 20);
     REQUIRE(sys.body(0).force_N.norm() > 0.0); // the wheel is in the bed

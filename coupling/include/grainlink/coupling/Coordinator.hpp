@@ -8,6 +8,7 @@
 #include "grainlink/coupling/Types.hpp"
 
 #include <atomic>
+#include <cstdint>
 #include <memory>
 #include <optional>
 #include <string>
@@ -20,6 +21,24 @@ struct ParticipantSpec {
     Role role = Role::Multibody;
     std::vector<std::string> command; ///< `grainlink run` starts it with this command line
     bool external = false;            ///< `grainlink run` waits for it to connect instead
+};
+
+/// What the coordinator accepts from its peers, so that no peer (a participant gone wrong, or any
+/// process that can reach the endpoint) can exhaust its memory or its log. docs/protocol.md
+/// §Limits; keys `coupling.limits.*`.
+struct CoordinatorLimits {
+    /// The largest message (frame) the coordinator receives: ZeroMQ's ZMQ_MAXMSGSIZE on its
+    /// socket, which disconnects a sender before it buffers a larger one.
+    std::int64_t max_message_bytes = 16 * 1024 * 1024;
+    /// The most sub-messages and strings one message may unpack into, counted before parsing
+    /// makes any: parsing makes ~70 bytes of each (a few on the wire), so this bounds a message's
+    /// memory to ~5 times max_message_bytes.
+    std::size_t maxParts() const { return static_cast<std::size_t>(max_message_bytes / 16); }
+    std::size_t max_bodies = 1000;    ///< bodies one Hello may provide or consume
+    std::size_t max_name_bytes = 128; ///< a body's name (participant names come from the file)
+    /// A connection that is not a joined participant's main one (a heartbeat connection, or a
+    /// stranger) and sends more in one second is dropped: ignored from then on, logged once.
+    unsigned max_stranger_messages_per_s = 100;
 };
 
 struct CoordinatorConfig {
@@ -46,6 +65,7 @@ struct CoordinatorConfig {
     std::string output_directory;          ///< coupling.csv and checkpoints/; empty: no files
     bool resume = false;                   ///< continue from output_directory/checkpoints/latest
     double progress_interval_s = 0.0;      ///< [s] wall time between progress lines; 0: none
+    CoordinatorLimits limits;
 };
 
 struct CoordinatorSummary {
@@ -61,6 +81,15 @@ struct CoordinatorSummary {
 
 class Coordinator {
 public:
+    /// The run's lifecycle; run() enforces it, and a call out of turn says what to do instead.
+    enum class State {
+        Bound,     ///< the socket is bound: call run()
+        Handshake, ///< run() waits for every participant's Hello
+        Running,   ///< run() drives the windows
+        Finished,  ///< run() returned: the run is over
+        Failed,    ///< run() threw: the run stopped everywhere
+    };
+
     /// Validates the configuration and binds the socket (so boundEndpoint() is known at once).
     explicit Coordinator(CoordinatorConfig config);
     ~Coordinator();
@@ -77,11 +106,15 @@ public:
     /// Reports, from another thread, that a participant failed outside the protocol (its
     /// process exited); run() stops everything and throws naming it.
     void reportFailure(const std::string &participant, const std::string &why);
+    /// Where the run is (safe to call from another thread).
+    State state() const;
 
 private:
     struct Impl;
     std::unique_ptr<Impl> impl_;
 };
+
+const char *stateName(Coordinator::State state);
 
 /// Reads a YAML file with `coupling:` and `participants:` and nothing else (docs/protocol.md).
 CoordinatorConfig loadCoordinatorConfig(const std::string &path);

@@ -24,6 +24,49 @@ struct ContactGeometry {
     const Quat *orientation_j; ///< particle frame of j; nullptr for walls
 };
 
+/// Geometry of the pair i-j (§2): n from j to i, contact arms a = r - delta/2.
+[[gnu::always_inline]] inline ContactGeometry
+pairGeometry(const Vec3 &x_i, const Vec3 &x_j, double r_i, double r_j, double inv_mass_i,
+             double inv_mass_j, const Vec3 &v_i, const Vec3 &v_j, const Vec3 &w_i, const Vec3 &w_j,
+             const Quat *orientation_i, const Quat *orientation_j) {
+    const Vec3 d = x_i - x_j;
+    const double dist = std::sqrt(d.squaredNorm());
+    const double r_sum = r_i + r_j;
+    ContactGeometry g;
+    g.normal = d * (1.0 / dist);
+    g.overlap_m = r_sum - dist;
+    g.radius_eff_m = r_i * r_j / r_sum;
+    g.mass_eff_kg = 1.0 / (inv_mass_i + inv_mass_j);
+    g.arm_i_m = r_i - 0.5 * g.overlap_m;
+    g.arm_j_m = r_j - 0.5 * g.overlap_m;
+    g.contact_velocity_m_s = v_i - v_j - (g.arm_i_m * w_i + g.arm_j_m * w_j).cross(g.normal);
+    g.relative_spin_rad_s = w_i - w_j;
+    g.orientation_i = orientation_i;
+    g.orientation_j = orientation_j;
+    return g;
+}
+
+/// Geometry of sphere i on a wall (plane or triangle) whose surface point nearest the centre
+/// lies `dist` below it along the wall's outward normal n (§2, §2.9): R* = r_i, m* = m_i, the
+/// arm is dist; the wall's surface moves at `wall_velocity` there and spins at `wall_spin`.
+[[gnu::always_inline]] inline ContactGeometry
+wallGeometry(const Vec3 &n, double dist, double r_i, double mass_i, const Vec3 &v_i,
+             const Vec3 &w_i, const Vec3 &wall_velocity, const Vec3 &wall_spin,
+             const Quat *orientation_i) {
+    ContactGeometry g;
+    g.normal = n;
+    g.overlap_m = r_i - dist;
+    g.radius_eff_m = r_i;
+    g.mass_eff_kg = mass_i;
+    g.arm_i_m = dist;
+    g.arm_j_m = 0.0;
+    g.contact_velocity_m_s = v_i - dist * w_i.cross(n) - wall_velocity;
+    g.relative_spin_rad_s = w_i - wall_spin;
+    g.orientation_i = orientation_i;
+    g.orientation_j = nullptr;
+    return g;
+}
+
 struct ContactResult {
     Vec3 force_on_i_N;
     Vec3 torque_on_i_N_m;
@@ -210,12 +253,59 @@ evaluateContact(const Damping &damping, const Tangential &tangential, const Roll
     }
 }
 
-/// Calls `body` with the concrete slot types of `law` (one std::visit per batch of contacts).
+/// A contact law with its slot types known to the compiler: what the contact loops are
+/// instantiated for, so that evaluate() inlines the whole law.
+template <class Damping, class Tangential, class Rolling, class Cohesion> struct ConcreteLaw {
+    Damping damping;
+    Tangential tangential;
+    Rolling rolling;
+    Cohesion cohesion;
+    /// The grain-shape law reads the grains' orientations.
+    static constexpr bool kGrainShape = std::is_same_v<Rolling, RollingGrainShape>;
+    /// The rolling slot keeps a per-contact history.
+    static constexpr bool kRollingHistory = kGrainShape || std::is_same_v<Rolling, RollingEpsd>;
+
+    /// The same models with the parameters of `law` (ContactLaws::finalize checked that a
+    /// contact type's law has the grain-grain models).
+    static ConcreteLaw of(const ContactLaw &law) {
+        return {std::get<Damping>(law.damping), std::get<Tangential>(law.tangential),
+                std::get<Rolling>(law.rolling), std::get<Cohesion>(law.cohesion)};
+    }
+
+    [[gnu::always_inline]] void evaluate(const PairProperties &pair, const ContactGeometry &g,
+                                         double dt_s, ContactHistory &history,
+                                         ContactResult &out) const {
+        evaluateContact<NormalHertz>(damping, tangential, rolling, cohesion, pair, g, dt_s, history,
+                                     out);
+    }
+};
+
+/// Calls `body` with `law` as a ConcreteLaw (one std::visit per pass over the contacts).
 template <class Body> inline void withConcreteLaw(const ContactLaw &law, Body &&body) {
-    std::visit([&](const auto &normal, const auto &damping, const auto &tangential,
-                   const auto &rolling,
-                   const auto &cohesion) { body(normal, damping, tangential, rolling, cohesion); },
-               law.normal, law.damping, law.tangential, law.rolling, law.cohesion);
+    std::visit(
+        [&](const NormalHertz &, const auto &damping, const auto &tangential, const auto &rolling,
+            const auto &cohesion) {
+            using Law =
+                ConcreteLaw<std::decay_t<decltype(damping)>, std::decay_t<decltype(tangential)>,
+                            std::decay_t<decltype(rolling)>, std::decay_t<decltype(cohesion)>>;
+            body(Law{damping, tangential, rolling, cohesion});
+        },
+        law.normal, law.damping, law.tangential, law.rolling, law.cohesion);
+}
+
+/// Stored elastic energy of one contact [J]: Hertz 8/15 E* sqrt(R*) delta^(5/2) plus the
+/// tangential spring's 1/2 k_t |delta_t|^2 (docs/physics.md §2.1, §2.4, §2.5).
+inline double contactElasticEnergy(const ContactLaw &law, const PairProperties &pair,
+                                   double radius_eff_m, double overlap_m,
+                                   const ContactHistory &history) {
+    double k_t = 0.0;
+    if (const auto *lin = std::get_if<TangentialLinear>(&law.tangential))
+        k_t = lin->stiffness_N_m;
+    else
+        k_t = 8.0 * pair.effective_shear_modulus_Pa * std::sqrt(radius_eff_m * overlap_m);
+    return 8.0 / 15.0 * pair.effective_modulus_Pa * std::sqrt(radius_eff_m) *
+               std::pow(overlap_m, 2.5) +
+           0.5 * k_t * history.tangential_m.squaredNorm();
 }
 
 } // namespace grainlink::dem

@@ -128,6 +128,36 @@ struct ContactLaw {
     std::string describe() const;
 };
 
+/// Which two things a contact joins.
+enum class ContactType {
+    GrainGrain,
+    GrainWall, ///< planes and boxes
+    GrainTool, ///< mesh bodies: wheels, plates, hulls, STL meshes
+};
+
+/// The law of each contact type: one set of slot models, each type its own parameters, as
+/// LIGGGHTS and EDEM give parameters per material pair (docs/physics.md §2.10). A wall's or a
+/// body's own friction_coefficient still applies on top of its type's law.
+struct ContactLaws {
+    ContactLaw grain_grain; ///< its background damping acts on every grain (§2.8)
+    ContactLaw grain_wall;  ///< its background damping is not used
+    ContactLaw grain_tool;  ///< its background damping is not used
+
+    ContactLaws() = default;
+    /// Every contact type under `law` (implicit: a single law is the common case).
+    ContactLaws(const ContactLaw &law) : grain_grain(law), grain_wall(law), grain_tool(law) {}
+    const ContactLaw &of(ContactType type) const;
+    /// Finalizes each law; a wall or tool law whose models differ from the grain-grain law's
+    /// is an error naming the contact type, the slot and both models.
+    void finalize();
+};
+
+/// Name of a slot's model as the scenario writes it (`restitution`, `epsd`, ...).
+std::string modelName(const DampingModel &slot);
+std::string modelName(const TangentialModel &slot);
+std::string modelName(const RollingModel &slot);
+std::string modelName(const CohesionModel &slot);
+
 /// Pair quantities of two materials with Coulomb angles from the tangential slot.
 PairProperties pairProperties(const Material &a, const Material &b, const ContactLaw &law);
 /// Same, with a wall's own friction coefficient replacing both Coulomb angles.

@@ -94,6 +94,33 @@ public:
     /// Installs histories (i < j) to be merged into the next build.
     void setPendingContacts(std::vector<StoredContact> contacts) { pending_ = std::move(contacts); }
 
+    /// The list with its histories, without the buffers kept for the next build: an in-memory
+    /// snapshot (DemSystem::saveState). restore() puts it back, reusing this list's memory.
+    struct Saved {
+        std::vector<std::size_t> first;
+        std::vector<int> owner, neighbour;
+        std::vector<std::uint8_t> state;
+        std::vector<Vec3> tangential_m, rolling_N_m;
+        std::vector<StoredContact> pending;
+        std::uint64_t builds = 0;
+        bool keep_rolling = false;
+    };
+    Saved save() const {
+        return {first,       owner,    neighbour, state,        tangential_m,
+                rolling_N_m, pending_, builds_,   keep_rolling_};
+    }
+    void restore(const Saved &saved) {
+        first = saved.first;
+        owner = saved.owner;
+        neighbour = saved.neighbour;
+        state = saved.state;
+        tangential_m = saved.tangential_m;
+        rolling_N_m = saved.rolling_N_m;
+        pending_ = saved.pending;
+        builds_ = saved.builds;
+        keep_rolling_ = saved.keep_rolling;
+    }
+
 private:
     CellGrid grid_;
     std::vector<StoredContact> pending_;

@@ -15,25 +15,13 @@ namespace grainlink::dem {
 using config::ConfigError;
 using config::ConfigNode;
 
-/// A stretch of constant linear and angular velocity of a prescribed body.
-struct MotionSegment {
-    double duration_s = 0.0;
-    Vec3 velocity_m_s = Vec3::Zero();
-    Vec3 angular_velocity_rad_s = Vec3::Zero();
-};
-
-/// Pose at time t (from the start of the run phase) of piecewise-constant velocity motion;
-/// the body rests after the last segment.
-RigidBodyState segmentedMotion(const RigidBodyState &start,
-                               const std::vector<MotionSegment> &motion, double t_s);
-
 struct BodySpec {
     std::string name;
     TriangleMesh mesh;
     RigidBodyState start;
     /// If set, the body's lowest point starts this far above the settled bed's surface.
     std::optional<double> clearance_above_bed_m;
-    std::vector<MotionSegment> motion;
+    std::vector<MotionSegment> motion; ///< from the start of the run phase (BodyMotion.hpp)
     std::optional<double> friction_coefficient;
     bool record_triangle_loads = false;
 };
@@ -44,11 +32,26 @@ struct OutputSpec {
     double checkpoint_interval_s = 0.0; ///< 0: no periodic checkpoints
 };
 
+/// The slots a contact type sets for itself in `contact_wall` or `contact_tool`; the others are
+/// the grain-grain law's (`contact`). A slot given there is the grain-grain slot with the keys
+/// given replaced.
+struct ContactOverride {
+    std::optional<DampingModel> damping;
+    std::optional<TangentialModel> tangential;
+    std::optional<RollingModel> rolling;
+    std::optional<CohesionModel> cohesion;
+    bool any() const { return damping || tangential || rolling || cohesion; }
+    /// `law` with these slots in place of its own.
+    ContactLaw appliedTo(ContactLaw law) const;
+};
+
 struct DemScenario {
     std::string file;
     std::string name;
     DemSettings settings;
-    ContactLaw law;
+    ContactLaw law;               ///< `contact`: grain-grain contacts
+    ContactOverride contact_wall; ///< grain-wall contacts (planes, boxes)
+    ContactOverride contact_tool; ///< grain-tool contacts (mesh bodies)
     Material material;
     std::vector<PlaneWall> planes;
     DepositionSpec deposition;
@@ -63,6 +66,8 @@ DemScenario loadScenario(const std::string &path);
 /// `coupled`: the soil section of a coupled run (no `run:`; bodies come from the coupling).
 DemScenario parseScenario(const ConfigNode &root, bool coupled = false);
 
+/// The law of each contact type: `contact` with the overrides of `contact_wall`, `contact_tool`.
+ContactLaws contactLaws(const DemScenario &scenario);
 /// The system without mesh bodies (deposition runs without them).
 std::unique_ptr<DemSystem> makeSystem(const DemScenario &scenario);
 /// Key of the settled packing: everything that shapes it, nothing that does not.

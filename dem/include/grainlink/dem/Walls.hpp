@@ -1,6 +1,7 @@
 #pragma once
 // Boundaries the particles touch: infinite planes (with an optional friction track) and rigid
-// bodies carrying triangle meshes whose motion is set from outside every step.
+// bodies carrying triangle meshes, moved by their BodyMotion (BodyMotion.hpp).
+#include "grainlink/dem/BodyMotion.hpp"
 #include "grainlink/dem/ContactLaw.hpp"
 #include "grainlink/dem/TriangleMesh.hpp"
 
@@ -31,16 +32,13 @@ struct PlaneWall {
     Material material; ///< wall elasticity; defaults to the particles' material
 };
 
-/// Pose and velocity of a rigid body, world frame, about the body's origin.
-struct RigidBodyState {
-    Vec3 position_m = Vec3::Zero();
-    Quat orientation = Quat::Identity(); ///< body frame -> world frame
-    Vec3 velocity_m_s = Vec3::Zero();
-    Vec3 angular_velocity_rad_s = Vec3::Zero();
-    /// Velocity of the body-fixed point now at world position p.
-    Vec3 pointVelocity(const Vec3 &p) const {
-        return velocity_m_s + angular_velocity_rad_s.cross(p - position_m);
-    }
+/// A mesh body's wrench of the last step and its accumulated impulse (MeshBody's members).
+struct BodyLoads {
+    Vec3 force_N = Vec3::Zero();
+    Vec3 torque_N_m = Vec3::Zero(); ///< about the body origin
+    Vec3 impulse_N_s = Vec3::Zero();
+    Vec3 angular_impulse_N_m_s = Vec3::Zero();
+    double accumulated_time_s = 0.0;
 };
 
 /// Rigid body carrying a triangle mesh (wheel, plate, mole hull). Its state is imposed; the
@@ -52,8 +50,10 @@ public:
     const std::string &name() const { return name_; }
     const TriangleMesh &mesh() const { return mesh_; }
     const RigidBodyState &state() const { return state_; }
-    /// Imposes pose and velocity (prescribed motion now, the coupling later).
+    /// Imposes pose and velocity (DemSystem does it every step from the body's motion).
     void setState(const RigidBodyState &state);
+    /// Sets a state that state() returned, bit for bit (setState would normalize it again).
+    void restoreState(const RigidBodyState &saved);
 
     std::optional<double> friction_coefficient; ///< unset: particle law's Coulomb angles
     Material material;                          ///< defaults to the particles' material
@@ -68,20 +68,25 @@ public:
     Vec3 angular_impulse_N_m_s = Vec3::Zero();
     double accumulated_time_s = 0.0;
     void resetAccumulatedImpulse();
+    /// The members above as one value, and back (checkpoints, in-memory snapshots).
+    BodyLoads loads() const {
+        return {force_N, torque_N_m, impulse_N_s, angular_impulse_N_m_s, accumulated_time_s};
+    }
+    void setLoads(const BodyLoads &loads);
 
     /// World-frame vertices at the current pose.
     const std::vector<Vec3> &worldVertices() const { return world_vertices_; }
+    /// The same at another (normalized) state, e.g. one state() returned earlier.
+    void worldVerticesAt(const RigidBodyState &state, std::vector<Vec3> &out) const;
     double boundingRadius() const { return bounding_radius_; }
 
 private:
+    void placeVertices(); ///< world vertices at state_
     std::string name_;
     TriangleMesh mesh_;
     RigidBodyState state_;
     std::vector<Vec3> world_vertices_;
     double bounding_radius_ = 0.0;
 };
-
-/// Body state at time t for constant linear and angular velocity from an initial pose.
-RigidBodyState constantVelocityMotion(const RigidBodyState &initial, double t_s);
 
 } // namespace grainlink::dem
