@@ -182,7 +182,6 @@ void applyDomainSize(YAML::Node scenario, double f) {
             scalePoint(w["upper_m"]);
             scalePoint(w["point_m"]);
         }
-    // Tests that build their own box (direct shear) keep it: the domain is the bed's.
     soil["deposition"]["count"] = std::llround(soil["deposition"]["count"].as<double>() * f * f);
 }
 
@@ -332,6 +331,11 @@ EffectCatalogue loadEffects(const std::string &path) {
                     en.fail("give exactly one of set, scale, text, node, remove");
                 if (en.has("when"))
                     ed.when = en["when"].text();
+                if (en.has("if")) {
+                    ed.only_if = en["if"].text();
+                    if (ed.only_if->find('=') == std::string::npos)
+                        en["if"].fail("a condition reads key=value|value");
+                }
                 if (en.has("fallback"))
                     ed.fallback = en["fallback"].number();
                 if (const auto types = en.optional("types"))
@@ -364,19 +368,27 @@ EffectCatalogue loadEffects(const std::string &path) {
     return cat;
 }
 
+namespace {
+
+/// Why `scenario` does not hold the condition "key=value|value" (empty: it does).
+std::string unmet(const std::string &condition, const YAML::Node &scenario) {
+    const auto eq = condition.find('=');
+    const std::string key = condition.substr(0, eq);
+    const std::string have = textAt(scenario, key);
+    std::istringstream options(condition.substr(eq + 1));
+    std::string o;
+    while (std::getline(options, o, '|'))
+        if (o == have)
+            return "";
+    return "needs " + key + " in {" + condition.substr(eq + 1) + "}, the base has '" + have + "'";
+}
+
+} // namespace
+
 std::string inapplicable(const Effect &effect, const YAML::Node &scenario) {
-    for (const std::string &r : effect.requires_text) {
-        const auto eq = r.find('=');
-        const std::string key = r.substr(0, eq);
-        const std::string have = textAt(scenario, key);
-        std::istringstream options(r.substr(eq + 1));
-        std::string o;
-        bool ok = false;
-        while (std::getline(options, o, '|'))
-            ok = ok || o == have;
-        if (!ok)
-            return "needs " + key + " in {" + r.substr(eq + 1) + "}, the base has '" + have + "'";
-    }
+    for (const std::string &r : effect.requires_text)
+        if (const std::string why = unmet(r, scenario); !why.empty())
+            return why;
     return "";
 }
 
@@ -414,13 +426,18 @@ YAML::Node applyEffect(const Effect &effect, double s, const YAML::Node &scenari
         return out;
     }
     if (effect.builtin == "domain_size") {
-        applyDomainSize(out, s);
+        // A direct shear box is the test's own geometry (its size is a measured condition),
+        // not a container around the bed.
+        if (type != ExperimentType::DirectShear)
+            applyDomainSize(out, s);
         return out;
     }
     const std::string type_name = typeName(type);
     for (const EffectEdit &ed : effect.edits) {
         if (!ed.types.empty() &&
             std::find(ed.types.begin(), ed.types.end(), type_name) == ed.types.end())
+            continue;
+        if (ed.only_if && !unmet(*ed.only_if, out).empty())
             continue;
         if (ed.op == EffectEdit::Op::Remove) {
             removeKey(out, ed.key);

@@ -77,6 +77,9 @@ TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off"
     const YAML::Node coh = applyEffect(c.find("cohesion"), 5e4, base, ExperimentType::PlateSinkage);
     CHECK(coh["soil"]["contact"]["cohesion"]["model"].as<std::string>() == "linear");
     CHECK(coh["soil"]["contact"]["cohesion"]["energy_density_J_m3"].as<double>() == Approx(5e4));
+    // Grain-grain only: walls and tools get no cohesion (docs/scenario.md, contact_wall).
+    CHECK(coh["soil"]["contact_wall"]["cohesion"]["energy_density_J_m3"].as<double>() == 0.0);
+    CHECK(coh["soil"]["contact_tool"]["cohesion"]["energy_density_J_m3"].as<double>() == 0.0);
 
     const YAML::Node none = applyEffect(c.find("rolling_resistance"), 0.0, base, ExperimentType::PlateSinkage);
     CHECK(none["soil"]["contact"]["rolling"]["model"].as<std::string>() == "none");
@@ -84,12 +87,24 @@ TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off"
 
     const YAML::Node wall = applyEffect(c.find("wall_friction"), 0.25, base, ExperimentType::PlateSinkage);
     CHECK(wall["soil"]["walls"][0]["friction_coefficient"].as<double>() == Approx(0.25));
+    // The grain-wall law in its tangential model's terms: linear -> the stick angle atan(mu).
+    CHECK(wall["soil"]["contact_wall"]["tangential"]["stick_angle_deg"].as<double>() ==
+          Approx(14.036243).epsilon(1e-6));
+    CHECK_FALSE(wall["soil"]["contact_tool"]);
     // A wildcard path edits the walls there are; a test without walls gets none.
     YAML::Node wall_less = YAML::Clone(base);
     wall_less["soil"].remove("walls");
     CHECK_FALSE(applyEffect(c.find("wall_friction"), 0.25, wall_less, ExperimentType::DirectShear)["soil"]["walls"]);
     const YAML::Node tool = applyEffect(c.find("tool_friction"), 0.5, base, ExperimentType::DirectShear);
     CHECK_FALSE(tool["bevameter"]["plate_friction_coefficient"]); // only for plate tests
+    CHECK(tool["soil"]["contact_tool"]["tangential"]["stick_angle_deg"].as<double>() ==
+          Approx(26.565051).epsilon(1e-6));
+    YAML::Node mindlin = YAML::Clone(base);
+    mindlin["soil"]["contact"]["tangential"] = YAML::Load("{model: mindlin, friction_coefficient: 0.6}");
+    const YAML::Node tool_m = applyEffect(c.find("tool_friction"), 0.5, mindlin, ExperimentType::DirectShear);
+    CHECK(tool_m["soil"]["contact_tool"]["tangential"]["friction_coefficient"].as<double>() == 0.5);
+    CHECK_FALSE(tool_m["soil"]["contact_tool"]["tangential"]["stick_angle_deg"]);
+    CHECK_FALSE(tool["soil"]["contact_wall"]);
 }
 
 TEST_CASE("polydispersity keeps the mean radius and the solid volume; domain size the depth",

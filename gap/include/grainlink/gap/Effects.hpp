@@ -36,6 +36,7 @@ struct EffectEdit {
     std::string text;                  ///< Text
     YAML::Node node;                   ///< Node
     std::optional<std::string> when;   ///< expression; the edit applies where it is non-zero
+    std::optional<std::string> only_if; ///< `if: key=value|value`: the scenario must hold it
     std::optional<double> fallback;    ///< `base` where the key is absent (else absent = error)
     std::vector<std::string> types;    ///< experiment types it applies to (empty: all)
 };
