@@ -167,8 +167,11 @@ int GapCommand::run() const {
 
 int GapCommand::diagnose() const {
     const auto t0 = std::chrono::steady_clock::now();
-    const gap::ExperimentSet set = gap::loadExperiments(measurements_);
     const gap::BaseModel base = gap::loadBaseModel(model_);
+    std::vector<std::string> left_out;
+    const gap::ExperimentSet set = gap::simulable(gap::loadExperiments(measurements_), base, left_out);
+    for (const std::string &why : left_out)
+        std::fprintf(stderr, "[gap] left out: %s\n", why.c_str());
     const gap::EffectCatalogue catalogue = catalogueWith(effects_file_);
     std::vector<const gap::Effect *> effects;
     for (const gap::Effect *e : catalogue.diagnosable())

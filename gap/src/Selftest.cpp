@@ -176,7 +176,11 @@ SelftestResult runSelftest(const SelftestOptions &o) {
             truth.seed_offset = 1000 + 37 * int(key.seed % 1000);
             const Eigen::MatrixXd rows = sim.simulate(set, d.design, {truth})[0];
             const ColumnStats s = columnStats(rows);
+            // The same standardisation as the diagnosis' own gap test: the normal deviate of
+            // Student's t with u_val's degrees of freedom.
             Eigen::VectorXd z = (s.mean - d.validation.simulated).array() / d.validation.u_val.array();
+            for (Eigen::Index k = 0; k < z.size(); ++k)
+                z[k] = normalEquivalent(z[k], d.validation.dof[k]);
             t.weak = !testGap(d.design.keys, z).gap;
         }
         const Effect *hidden = key.effect.empty() ? nullptr : &o.catalogue.find(key.effect);

@@ -89,6 +89,22 @@ bool close(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::
 
 } // namespace
 
+ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
+                        std::vector<std::string> &left_out) {
+    ExperimentSet out = set;
+    out.experiments.clear();
+    for (const Experiment &e : set.experiments)
+        if (base.tests.count(typeName(e.type)))
+            out.experiments.push_back(e);
+        else
+            left_out.push_back(e.id + " (" + typeName(e.type) + ": " + base.path + " has no tests." +
+                               typeName(e.type) + ")");
+    if (out.experiments.empty())
+        throw std::invalid_argument(base.path + ": no test in `tests` simulates any experiment of " +
+                                    set.directory);
+    return out;
+}
+
 std::string labTestOf(ExperimentType type) {
     switch (type) {
     case ExperimentType::PlateSinkage:

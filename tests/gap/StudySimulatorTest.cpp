@@ -66,3 +66,23 @@ TEST_CASE("every effect and numerical check on the CI design is a scenario the l
     }
     fs::remove_all(scratch);
 }
+
+TEST_CASE("experiments of a type the base model does not simulate are left out, named",
+          "[gap][simulator]") {
+    const BaseModel base = loadBaseModel(kDir + "/base.yaml");
+    ExperimentSet set = loadDesign(kDir + "/design.yaml").set;
+    Experiment wheel = set.experiments.front();
+    wheel.id = "smooth_wheel";
+    wheel.type = ExperimentType::WheelSteadyState;
+    set.experiments.push_back(wheel);
+    std::vector<std::string> left_out;
+    const ExperimentSet kept = simulable(set, base, left_out);
+    CHECK(kept.experiments.size() == set.experiments.size() - 1);
+    REQUIRE(left_out.size() == 1);
+    CHECK(left_out[0].find("smooth_wheel (wheel_steady_state") == 0);
+
+    ExperimentSet only_wheels = set;
+    only_wheels.experiments = {wheel};
+    std::vector<std::string> all;
+    CHECK_THROWS_WITH(simulable(only_wheels, base, all), Catch::Contains("no test in `tests`"));
+}

@@ -32,6 +32,12 @@ struct BaseModel {
 /// checked by the lab's own readers on every scenario made from them.
 BaseModel loadBaseModel(const std::string &path);
 
+/// The experiments of `set` whose type the base model simulates (it has `tests.<type>`); the
+/// others' ids with why go to `left_out` (e.g. a folder of plates and wheels diagnosed with a
+/// plates-only base).
+ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
+                        std::vector<std::string> &left_out);
+
 /// The lab test that simulates an experiment type ("bevameter", "direct_shear", ...); throws
 /// naming the type when grainlink cannot simulate it from a base model yet.
 std::string labTestOf(ExperimentType type);
