@@ -25,12 +25,10 @@ coupling::ParticipantConfig participantConfig(const NodeOptions &options,
     config.name = options.name;
     config.role = coupling::Role::Multibody;
     config.endpoint = options.endpoint;
-    const auto bodies = model.coupledBodies();
+    config.provides = model.coupledBodies(); // the model's own descriptions, unchanged
     const auto states = model.bodyStates();
-    for (std::size_t b = 0; b < bodies.size(); ++b) {
-        config.provides.push_back(describe(bodies[b]));
-        config.initial_states.push_back(toCoupling(bodies[b].name, states[b]));
-    }
+    for (std::size_t b = 0; b < config.provides.size(); ++b)
+        config.initial_states.push_back(toCoupling(config.provides[b].name, states[b]));
     config.capabilities.rollback = true;
     config.capabilities.checkpoint = true;
     if (!options.keys_directory.empty())

@@ -133,11 +133,11 @@ RockerBogie::RockerBogie(const RockerBogieSettings &settings)
         std::vector<SimTK::MobilizerQIndex>{q0(), q0()});
 
     for (int i = 0; i < kWheels; ++i) {
-        CoupledBody wheel;
+        BodyDescription wheel;
         wheel.name = s.name_prefix + wheelSuffixes()[i];
-        wheel.mass_kg = s.wheel_mass_kg;
-        wheel.inertia_diagonal_kg_m2 = wheel_inertia;
-        wheel.wheel = s.wheel;
+        wheel.mass.mass_kg = s.wheel_mass_kg;
+        wheel.mass.inertia_diagonal_kg_m2 = wheel_inertia;
+        wheel.geometry = s.wheel;
         addCoupled(wheel, wheels_[i]);
     }
     finishBuilding();
