@@ -172,7 +172,10 @@ int main(int argc, char **argv) {
             return grainlink::apps::generateKeys(key_directory, key_names);
         }
     } catch (const std::exception &e) {
-        std::fprintf(stderr, "grainlink: error: %s\n", e.what());
+        // A participant node's line names the participant (its run has several processes).
+        const bool node_command = mbs_node->parsed() || dem_node->parsed() || floor_node->parsed();
+        std::fprintf(stderr, "%s: error: %s\n", node_command ? node.name.c_str() : "grainlink",
+                     e.what());
         return 1;
     }
     return 0;
