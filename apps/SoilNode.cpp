@@ -23,7 +23,7 @@ namespace {
 class SoilNode final : public coupling::ParticipantNode {
 public:
     SoilNode(const NodeOptions &options, const config::ConfigNode &root)
-        : options_(options), scenario_(dem::parseScenario(root[options.section], true)),
+        : options_(options), scenario_(parseSoilSection(root, options.section)),
           mirror_(MirrorSymmetry::parse(root)),
           // Its files: soil.csv and snapshots/ for the usual single bed, named after the
           // section when several soil nodes share a run.

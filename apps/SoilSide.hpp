@@ -5,6 +5,7 @@
 #include "Nodes.hpp"
 #include "grainlink/coupling/Participant.hpp"
 #include "grainlink/coupling/Types.hpp"
+#include "grainlink/dem/Scenario.hpp"
 #include "grainlink/dem/Walls.hpp"
 #include "grainlink/dem/WheelMesh.hpp"
 
@@ -30,6 +31,29 @@ inline coupling::ParticipantConfig soilParticipantConfig(const NodeOptions &opti
     if (!options.keys_directory.empty())
         config.curve = coupling::loadClientKeys(options.keys_directory, options.name);
     return config;
+}
+
+/// The bed of a soil node: a DEM scenario (section `section`) without what the coupling decides:
+/// its duration, its bodies, its rows and checkpoints. A key for those would change nothing.
+inline dem::DemScenario parseSoilSection(const config::ConfigNode &root,
+                                         const std::string &section) {
+    const config::ConfigNode soil = root[section];
+    if (soil.has("name"))
+        soil["name"].fail("a soil node's files are named after its section (--section), not "
+                          "`name`: remove the key");
+    if (soil.has("run"))
+        soil["run"].fail("a coupled soil runs as long as the coordinator says (coupling."
+                         "end_time_s): remove the key");
+    if (soil.has("bodies"))
+        soil["bodies"].fail("a coupled soil's bodies come from the multibody participant (the "
+                            "soil node's --bodies): remove the key");
+    if (const auto out = soil.optional("output"))
+        for (const char *key : {"series_interval_s", "checkpoint_interval_s"})
+            if (out->has(key))
+                (*out)[key].fail("the soil node writes a row every window and a checkpoint "
+                                 "when the coordinator asks (coupling.checkpoint_every_windows): "
+                                 "remove the key");
+    return dem::parseScenario(soil, true);
 }
 
 /// The description of the consumed body `name` among the run's bodies.

@@ -130,9 +130,9 @@ int main(int argc, char **argv) {
         command->add_option("--endpoint", node.endpoint, "the coordinator's endpoint")->required();
         command->add_option("--out", node.output_directory, "output directory")->required();
         command->add_option("--keys", node.keys_directory, "CURVE keys directory");
-        command->add_option("--progress-interval", node.progress_interval_s,
-                            "seconds between progress lines");
     }
+    dem_node->add_option("--progress-interval", node.progress_interval_s,
+                         "seconds between progress lines (settling and the run)");
     for (auto *command : {dem_node, floor_node})
         command->add_option("--bodies", node.bodies, "the coupled bodies it loads (comma separated)")
             ->delimiter(',')

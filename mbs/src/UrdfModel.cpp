@@ -318,6 +318,10 @@ UrdfModelSettings parseUrdfModel(const std::string &yaml_path) {
                     (*sp)[u.stiffness].fail("must be >= 0");
                 if (spring.damping < 0.0)
                     (*sp)[u.damping].fail("must be >= 0");
+                if (spring.stiffness == 0.0 && sp->has(u.rest))
+                    (*sp)[u.rest].fail(std::string("a spring without stiffness has no rest "
+                                                   "position: give ") +
+                                       u.stiffness + " or remove the key");
                 sp->finish();
                 j.spring = spring;
             }

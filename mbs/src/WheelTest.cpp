@@ -193,8 +193,16 @@ SingleWheelRigSettings parseSingleWheelRig(const config::ConfigNode &node) {
     s.start_position_m = node["start_position_m"].vec3();
     s.angular_velocity_rad_s = node.number("angular_velocity_rad_s", s.angular_velocity_rad_s);
     s.drawbar_force_N = node.number("drawbar_force_N", 0.0);
-    if (node.has("drive_torque_N_m"))
+    if (node.has("drive_torque_N_m")) {
         s.drive_torque_N_m = node["drive_torque_N_m"].number();
+        // A torque drive sets no speed, and slip control imposes one.
+        if (node.has("angular_velocity_rad_s"))
+            node["angular_velocity_rad_s"].fail("a torque drive (drive_torque_N_m) sets no speed: "
+                                                "remove one of the two keys");
+        if (node.has("slip"))
+            node["slip"].fail("slip control imposes the wheel speed; it cannot be combined with "
+                              "a torque drive (drive_torque_N_m)");
+    }
     if (node.has("slip"))
         s.slip = node["slip"].number();
     s.rotation_locked = true; // the procedure starts with the drop phase

@@ -298,6 +298,13 @@ TEST_CASE("URDF and YAML errors name the file, the key and the line", "[mbs][urd
             messageOf<ConfigError>([&] { parseUrdfModel(kData + "/wrong_unit.yaml"); });
         CHECK_THAT(msg, Catch::Contains("wrong_unit.yaml:5: unknown key 'joints[0].position_m'"));
     }
+    SECTION("a spring's rest position without a stiffness, which would change nothing") {
+        const std::string msg = messageOf<ConfigError>(
+            [&] { parseUrdfModel(kData + "/spring_rest_without_stiffness.yaml"); });
+        CHECK_THAT(msg, Catch::Contains("spring_rest_without_stiffness.yaml:6: key "
+                                        "'joints[0].spring.rest_position_m'") &&
+                            Catch::Contains("no rest position"));
+    }
     SECTION("a massless link at the end of a moving joint") {
         UrdfModelSettings s;
         s.urdf_path = kData + "/massless_terminal.urdf";
