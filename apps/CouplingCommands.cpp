@@ -40,10 +40,11 @@ struct StopSignals {
     }
 };
 
-/// What the scenario's own participant commands run: a Simbody node, and the bed sections
-/// its soil nodes read (`soil`, or what each `--section` names).
+/// What the scenario's own participant commands run: a Simbody node, a rigid floor, and the bed
+/// sections its soil nodes read (`soil`, or what each `--section` names).
 struct NodesInScenario {
     bool simbody = false;
+    bool floor = false;
     std::vector<std::string> soil_sections;
 };
 
@@ -57,6 +58,7 @@ NodesInScenario nodesIn(const config::ConfigNode &root) {
         std::string section = "soil";
         for (std::size_t w = 0; w < words.size(); ++w) {
             nodes.simbody = nodes.simbody || words[w].text() == "mbs-node";
+            nodes.floor = nodes.floor || words[w].text() == "floor-node";
             soil_node = soil_node || words[w].text() == "dem-node";
             if (words[w].text() == "--section" && w + 1 < words.size())
                 section = words[w + 1].text();
@@ -73,18 +75,7 @@ CoordinatorConfig checkedCoupledConfig(const config::ConfigNode &root) {
     // The coupling sections, and the participants' own sections checked up front, so a typo
     // stops the run before any process starts.
     CoordinatorConfig config = coupling::coordinatorConfigFrom(root);
-    const NodesInScenario nodes = nodesIn(root);
-    for (const auto &section : nodes.soil_sections)
-        dem::parseScenario(root[section], true);
-    MirrorSymmetry::parse(root);
-    if (const auto floor = root.optional("floor"))
-        dem::parseRigidFloor(*floor);
-    if (const auto rig = root.optional("rig"))
-        mbs::parseSingleWheelRig(*rig);
-    else if (nodes.simbody)
-        makeModel(root, root.file()); // builds it once: every model error shows now
-    if (const auto test = root.optional("wheel_test"))
-        mbs::parseWheelTest(*test);
+    checkParticipantSections(root, root.file());
     root.finish();
     return config;
 }
@@ -131,6 +122,47 @@ std::string substitute(std::string text, const std::string &key, const std::stri
 }
 
 } // namespace
+
+void checkParticipantSections(const config::ConfigNode &root, const std::string &path) {
+    const NodesInScenario nodes = nodesIn(root);
+    const auto unread = [&root](const char *section, const std::string &why) {
+        if (root.has(section))
+            root[section].fail(why + ": remove the section");
+    };
+    for (const auto &section : nodes.soil_sections)
+        parseSoilSection(root, section);
+    if (nodes.soil_sections.empty())
+        unread("mirror", "mirror symmetry is the DEM soil's (no participant runs `grainlink "
+                         "dem-node`)");
+    else
+        MirrorSymmetry::parse(root);
+    if (nodes.floor)
+        dem::parseRigidFloor(root["floor"]);
+    else
+        unread("floor", "no participant runs `grainlink floor-node`, which reads it");
+    const char *models[] = {"rig", "rover", "mole", "model"};
+    const char *model = nullptr;
+    for (const char *m : models)
+        if (root.has(m)) {
+            if (model)
+                root[m].fail(std::string("a second multibody model (`") + model +
+                             ":` is the first): the multibody node runs one");
+            model = m;
+        }
+    if (!nodes.simbody) {
+        for (const char *m : models)
+            unread(m, "no participant runs `grainlink mbs-node`, which reads it");
+    } else if (root.has("rig")) {
+        mbs::parseSingleWheelRig(root["rig"]);
+    } else {
+        makeModel(root, path); // builds it once: every model error shows now
+    }
+    if (!root.has("rig") || !nodes.simbody)
+        unread("wheel_test", "the wheel test is the single-wheel rig's procedure (`rig:` run by "
+                             "`grainlink mbs-node`)");
+    else if (const auto test = root.optional("wheel_test"))
+        mbs::parseWheelTest(*test);
+}
 
 int runCoordinator(const CoupledRunOptions &options) {
     const CoordinatorConfig config = configFor(options, "tcp://127.0.0.1:5555");

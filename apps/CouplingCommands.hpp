@@ -24,6 +24,10 @@ coupling::CoordinatorConfig checkedCoupledConfig(const config::ConfigNode &root)
 int runCoordinator(const CoupledRunOptions &options);
 /// `grainlink run`: the coordinator plus the participant processes the file names.
 int runCoupled(const CoupledRunOptions &options);
+/// Checks the participant sections of the coupled scenario `root` (file `path`) against the
+/// nodes its participant commands run, before any process starts: each section strictly, and a
+/// section no node reads, or a second multibody model, is an error naming the key and the line.
+void checkParticipantSections(const config::ConfigNode &root, const std::string &path);
 /// `grainlink keygen`: CURVE key pairs for the coordinator and each named participant.
 int generateKeys(const std::string &directory, const std::vector<std::string> &participants);
 

@@ -4,7 +4,7 @@
 // its observables and the soil's wrench on each of its coupled bodies.
 #include "MultibodySide.hpp"
 #include "Nodes.hpp"
-#include "grainlink/coupling/Participant.hpp"
+#include "grainlink/coupling/ParticipantNode.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
 
 #include <cstdio>
@@ -16,27 +16,6 @@
 namespace grainlink::apps {
 
 namespace {
-
-coupling::ParticipantConfig participantConfig(const NodeOptions &options,
-                                              const config::ConfigNode &root,
-                                              const mbs::MultibodyModel &model) {
-    coupling::ParticipantConfig config;
-    config.handshake_timeout_s = handshakeTimeout(root);
-    config.name = options.name;
-    config.role = coupling::Role::Multibody;
-    config.endpoint = options.endpoint;
-    const auto bodies = model.coupledBodies();
-    const auto states = model.bodyStates();
-    for (std::size_t b = 0; b < bodies.size(); ++b) {
-        config.provides.push_back(describe(bodies[b]));
-        config.initial_states.push_back(toCoupling(bodies[b].name, states[b]));
-    }
-    config.capabilities.rollback = true;
-    config.capabilities.checkpoint = true;
-    if (!options.keys_directory.empty())
-        config.curve = coupling::loadClientKeys(options.keys_directory, options.name);
-    return config;
-}
 
 /// What a run writes and decides beyond the common window loop: its time series, whether the
 /// experiment is complete after a window, and its closing report.
@@ -117,58 +96,69 @@ Report observablesReport(const mbs::MultibodyModel &model, const NodeOptions &op
     return r;
 }
 
-/// The window loop every model shares: apply the soil's wrenches, advance, report the states,
-/// the work and the model's hint for the next macro step (the mole asks for small ones around
-/// its impacts); roll back for implicit coupling; checkpoints.
-int runWindows(const config::ConfigNode &root, mbs::MultibodyModel &model, const Report &report,
-               const NodeOptions &options) {
-    coupling::Participant participant(participantConfig(options, root, model));
-    const auto &run = participant.initialize();
-    if (run.restore)
-        model.readCheckpoint(run.restore->checkpoint_directory + "/" + report.checkpoint_file);
-    std::filesystem::create_directories(options.output_directory);
-    std::ofstream series =
-        openSeries(options.output_directory + "/" + report.series_file, report.header,
-                   run.restore ? std::optional<double>(model.time()) : std::nullopt);
+/// Any model as the multibody participant: applies the soil's wrenches, advances, reports the
+/// states, the work and the model's hint for the next macro step (the mole asks for small ones
+/// around its impacts); rolls back for implicit coupling; checkpoints.
+class MultibodyNode final : public coupling::ParticipantNode {
+public:
+    MultibodyNode(mbs::MultibodyModel &model, Report report, const NodeOptions &options)
+        : model_(model), report_(std::move(report)), options_(options),
+          bodies_(model.coupledBodies()), soil_(bodies_.size()) {}
 
-    const auto bodies = model.coupledBodies();
-    std::vector<mbs::Wrench> soil(bodies.size());
-    for (;;) {
-        switch (participant.waitForCommand()) {
-        case coupling::Command::WriteCheckpoint:
-            model.writeCheckpoint(participant.checkpointDirectory() + "/" + report.checkpoint_file);
-            series.flush();
-            participant.checkpointWritten();
-            break;
-        case coupling::Command::Advance: {
-            const auto &in = participant.inputs();
-            if (in.restore_state)
-                model.restoreState();
-            if (in.save_state)
-                model.saveState();
-            for (std::size_t b = 0; b < bodies.size(); ++b)
-                soil[b] = {in.wrenches.at(b).force_N, in.wrenches.at(b).torque_N_m};
-            model.applyWrenches(soil);
-            const auto work = model.advanceTo(in.end_s);
-            coupling::WindowOutputs out;
-            out.run_complete = report.after_window(series, soil);
-            const auto states = model.bodyStates();
-            for (std::size_t b = 0; b < bodies.size(); ++b) {
-                out.states.push_back(toCoupling(bodies[b].name, states[b]));
-                out.work.push_back({bodies[b].name, work[b]});
-            }
-            out.suggested_macro_step_s = model.suggestedMacroStep_s();
-            participant.writeOutputs(std::move(out));
-            participant.advance();
-            break;
-        }
-        case coupling::Command::Finish:
-            participant.finalize();
-            series.flush();
-            report.finish();
-            return 0;
-        }
+    void start(const coupling::RunInfo &run) override {
+        std::filesystem::create_directories(options_.output_directory);
+        series_ = openSeries(options_.output_directory + "/" + report_.series_file, report_.header,
+                             run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
+                                         : std::nullopt);
     }
+
+    coupling::WindowOutputs advance(const coupling::WindowInputs &in) override {
+        for (std::size_t b = 0; b < bodies_.size(); ++b)
+            soil_[b] = {in.wrenches.at(b).force_N, in.wrenches.at(b).torque_N_m};
+        model_.applyWrenches(soil_);
+        const auto work = model_.advanceTo(in.end_s);
+        coupling::WindowOutputs out;
+        out.run_complete = report_.after_window(series_, soil_);
+        const auto states = model_.bodyStates();
+        for (std::size_t b = 0; b < bodies_.size(); ++b) {
+            out.states.push_back(toCoupling(bodies_[b].name, states[b]));
+            out.work.push_back({bodies_[b].name, work[b]});
+        }
+        out.suggested_macro_step_s = model_.suggestedMacroStep_s();
+        return out;
+    }
+
+    void saveState() override { model_.saveState(); }
+    void restoreState() override { model_.restoreState(); }
+
+    void writeCheckpoint(const std::string &directory) override {
+        model_.writeCheckpoint(directory + "/" + report_.checkpoint_file);
+        series_.flush();
+    }
+    void readCheckpoint(const std::string &directory) override {
+        model_.readCheckpoint(directory + "/" + report_.checkpoint_file);
+    }
+
+    void finish() override {
+        series_.flush();
+        report_.finish();
+    }
+
+private:
+    mbs::MultibodyModel &model_;
+    Report report_;
+    NodeOptions options_;
+    std::vector<mbs::BodyDescription> bodies_;
+    std::vector<mbs::Wrench> soil_; ///< the soil's wrenches of the current window
+    std::ofstream series_;
+};
+
+int runWindows(const config::ConfigNode &root, mbs::MultibodyModel &model, Report report,
+               const NodeOptions &options) {
+    MultibodyNode node(model, std::move(report), options);
+    coupling::Participant participant(multibodyParticipantConfig(options, root, model));
+    coupling::runParticipant(participant, node);
+    return 0;
 }
 
 } // namespace

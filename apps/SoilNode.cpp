@@ -3,12 +3,12 @@
 #include "Nodes.hpp"
 #include "Series.hpp"
 #include "SoilSide.hpp"
-#include "grainlink/coupling/Participant.hpp"
+#include "grainlink/coupling/ParticipantNode.hpp"
+#include "grainlink/coupling/WindowLoads.hpp"
 #include "grainlink/dem/Checkpoint.hpp"
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/dem/VtkWriter.hpp"
-#include "grainlink/dem/WheelMesh.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -18,149 +18,152 @@
 
 namespace grainlink::apps {
 
-int runSoilNode(const NodeOptions &options) {
-    const auto root = config::ConfigNode::loadFile(options.scenario_path);
-    const dem::DemScenario scenario = dem::parseScenario(root[options.section], true);
-    // Its files: soil.csv and snapshots/ for the usual single bed, named after the section when
-    // several soil nodes share a run.
-    const bool single = options.section == "soil";
-    const std::string series_name = options.section + ".csv";
-    const std::string snapshot_directory =
-        options.output_directory + (single ? "/snapshots" : "/snapshots_" + options.section);
-    auto sys = dem::prepareSoil(scenario, options.progress_interval_s);
-    const double surface = dem::bedSurface(sys->particles());
-    const double dt = scenario.settings.time_step_s;
-    std::fprintf(stderr, "[%s] %zu particles, bed surface at z = %.4f m\n", options.name.c_str(),
-                 sys->particles().size(), surface);
+namespace {
 
-    auto config = soilParticipantConfig(options, root);
-    config.capabilities.checkpoint = true;
-    coupling::Participant participant(config);
-    const auto &run = participant.initialize();
-    const auto mirror = MirrorSymmetry::parse(root);
-
-    // Every consumed body becomes a mesh body; its motion is set each window.
-    const std::size_t body_count = options.bodies.size();
-    for (std::size_t b = 0; b < options.bodies.size(); ++b) {
-        const auto description = std::find_if(
-            run.bodies.begin(), run.bodies.end(),
-            [&](const coupling::BodyDescription &d) { return d.name == options.bodies[b]; });
-        dem::MeshBody body(options.bodies[b], meshOf(*description, mirror.has_value()),
-                           dem::RigidBodyState{});
-        sys->addBody(std::move(body));
+class SoilNode final : public coupling::ParticipantNode {
+public:
+    SoilNode(const NodeOptions &options, const config::ConfigNode &root)
+        : options_(options), scenario_(parseSoilSection(root, options.section)),
+          mirror_(MirrorSymmetry::parse(root)),
+          // Its files: soil.csv and snapshots/ for the usual single bed, named after the
+          // section when several soil nodes share a run.
+          snapshot_directory_(options.output_directory + (options.section == "soil"
+                                                              ? "/snapshots"
+                                                              : "/snapshots_" + options.section)),
+          vtk_(snapshot_directory_), progress_(options.name, options.progress_interval_s) {
+        sys_ = dem::prepareSoil(scenario_, options.progress_interval_s);
+        surface_ = dem::bedSurface(sys_->particles());
+        std::fprintf(stderr, "[%s] %zu particles, bed surface at z = %.4f m\n",
+                     options.name.c_str(), sys_->particles().size(), surface_);
     }
-    double dem_offset_s = sys->time() - run.start_tick * run.tick_s; // DEM time - coupling time
-    // Particle and wheel snapshots for ParaView (soil.output.snapshot_interval_s), at the first
-    // window end past each multiple of the interval; their times are kept in the checkpoint.
-    const double snapshot_interval_s = scenario.output.snapshot_interval_s;
-    dem::VtkWriter vtk(snapshot_directory);
-    if (run.restore) {
-        const auto extras =
-            dem::readCheckpoint(*sys, run.restore->checkpoint_directory + "/soil.bin");
-        dem_offset_s = extras.at("dem_offset_s");
+
+    void start(const coupling::RunInfo &run) override {
+        // Every consumed body becomes a mesh body; its motion is set each window.
+        for (std::size_t b = 0; b < options_.bodies.size(); ++b) {
+            dem::MeshBody body(options_.bodies[b],
+                               meshOf(describedBody(run, options_.bodies[b]), mirror_.has_value()),
+                               dem::RigidBodyState{});
+            sys_->addBody(std::move(body));
+        }
+        dem_offset_s_ = sys_->time() - run.start_tick * run.tick_s; // DEM time - coupling time
+        resumed_ = run.restore.has_value();
+        end_s_ = run.end_tick * run.tick_s;
+        std::filesystem::create_directories(options_.output_directory);
+        series_ = openSeries(options_.output_directory + "/" + options_.section + ".csv",
+                             "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts",
+                             run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
+                                         : std::nullopt);
+        first_step_ = sys_->stepCount();
+    }
+
+    coupling::WindowOutputs advance(const coupling::WindowInputs &in) override {
+        const double dt = scenario_.settings.time_step_s;
+        const double steps_real = in.duration_s / dt;
+        const auto steps = static_cast<std::uint64_t>(std::llround(steps_real));
+        if (steps == 0 || std::abs(steps_real - double(steps)) > 1e-6)
+            throw coupling::CouplingError("the macro step " + std::to_string(in.duration_s) +
+                                          " s is not a whole number of DEM time steps (" +
+                                          std::to_string(dt) + " s)");
+        // The window's motion (dem::WindowMotion), handed to the DEM once: it takes the start
+        // state now and follows the motion at every step's end.
+        for (std::size_t b = 0; b < bodyCount(); ++b) {
+            sys_->setBodyMotion(int(b), windowMotion(in, b, dem_offset_s_));
+            if (in.window == 0 && !resumed_ && lowestPoint(b) < surface_)
+                throw coupling::CouplingError("body '" + options_.bodies[b] + "' starts " +
+                                              std::to_string(1000.0 * (surface_ - lowestPoint(b))) +
+                                              " mm inside the settled bed (surface at z = " +
+                                              std::to_string(surface_) + " m): start it higher");
+        }
+        coupling::WindowLoads loads(options_.bodies);
+        for (std::uint64_t k = 0; k < steps; ++k) {
+            sys_->step();
+            for (std::size_t b = 0; b < bodyCount(); ++b) {
+                const auto &body = sys_->body(int(b));
+                loads.add(b, body.force_N, body.torque_N_m, body.state().linear_velocity_m_s,
+                          body.state().angular_velocity_rad_s, dt);
+            }
+        }
+        coupling::WindowOutputs out = loads.outputs(in.duration_s);
+        for (std::size_t b = 0; b < bodyCount(); ++b) {
+            auto &w = out.wrenches[b];
+            if (mirror_) {
+                mirror_->check(in.end_states.at(b));
+                MirrorSymmetry::complete(w.force_N, w.torque_N_m);
+                out.work[b].work_J *= 2.0;
+            }
+            series_ << in.end_s << ',' << w.body << ',' << surface_ - lowestPoint(b) << ','
+                    << w.force_N.x() << ',' << w.force_N.y() << ',' << w.force_N.z() << ','
+                    << w.torque_N_m.x() << ',' << w.torque_N_m.y() << ',' << w.torque_N_m.z() << ','
+                    << sys_->wallContactCount() << '\n';
+        }
+        // Particle and wheel snapshots for ParaView (soil.output.snapshot_interval_s), at the
+        // first window end past each multiple of the interval.
+        const double interval_s = scenario_.output.snapshot_interval_s;
+        if (interval_s > 0.0 && in.end_s >= interval_s * double(vtk_.count()) - 1e-12) {
+            std::filesystem::create_directories(snapshot_directory_);
+            vtk_.write(*sys_, in.end_s);
+        }
+        progress_.update(in.end_s, in.end_s / end_s_,
+                         (sys_->stepCount() - first_step_) * sys_->particles().size(), "");
+        return out;
+    }
+
+    // The snapshots' times travel in the checkpoint, so a resumed run keeps them in its .pvd.
+    void writeCheckpoint(const std::string &directory) override {
+        dem::CheckpointExtras extras{{"dem_offset_s", dem_offset_s_},
+                                     {"snapshots", double(vtk_.count())}};
+        for (int k = 0; k < vtk_.count(); ++k)
+            extras["snapshot" + std::to_string(k) + "_s"] = vtk_.times()[std::size_t(k)];
+        dem::writeCheckpoint(*sys_, directory + "/soil.bin", extras);
+        series_.flush();
+    }
+
+    void readCheckpoint(const std::string &directory) override {
+        const auto extras = dem::readCheckpoint(*sys_, directory + "/soil.bin");
+        dem_offset_s_ = extras.at("dem_offset_s");
         std::vector<double> times;
         for (int k = 0; k < int(extras.at("snapshots")); ++k)
             times.push_back(extras.at("snapshot" + std::to_string(k) + "_s"));
-        vtk.resumeAt(int(times.size()), times);
+        vtk_.resumeAt(int(times.size()), times);
+        first_step_ = sys_->stepCount();
     }
 
-    std::filesystem::create_directories(options.output_directory);
-    std::ofstream series =
-        openSeries(options.output_directory + "/" + series_name,
-                   "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts",
-                   run.restore ? std::optional<double>(double(run.restore->tick) * run.tick_s)
-                               : std::nullopt);
-    dem::Progress progress(options.name, options.progress_interval_s);
-    const std::uint64_t first_step = sys->stepCount();
-    const double end_s = run.end_tick * run.tick_s;
+    void finish() override { series_.flush(); }
 
-    for (;;) {
-        switch (participant.waitForCommand()) {
-        case coupling::Command::WriteCheckpoint:
-        {
-            dem::CheckpointExtras extras{{"dem_offset_s", dem_offset_s},
-                                         {"snapshots", double(vtk.count())}};
-            for (int k = 0; k < vtk.count(); ++k)
-                extras["snapshot" + std::to_string(k) + "_s"] = vtk.times()[std::size_t(k)];
-            dem::writeCheckpoint(*sys, participant.checkpointDirectory() + "/soil.bin", extras);
-            series.flush();
-            participant.checkpointWritten();
-            break;
-        }
-        case coupling::Command::Advance: {
-            const auto &in = participant.inputs();
-            const double steps_real = in.duration_s / dt;
-            const auto steps = static_cast<std::uint64_t>(std::llround(steps_real));
-            if (steps == 0 || std::abs(steps_real - double(steps)) > 1e-6)
-                throw coupling::CouplingError("participant '" + options.name +
-                                              "': the macro step " + std::to_string(in.duration_s) +
-                                              " s is not a whole number of DEM time steps (" +
-                                              std::to_string(dt) + " s)");
-            for (std::size_t b = 0; b < body_count; ++b) {
-                sys->setBodyMotion(int(b), windowMotion(in, b, dem_offset_s));
-                sys->body(int(b)).resetAccumulatedImpulse();
-                if (in.window == 0 && !run.restore) { // a body must not start buried in the bed
-                    double lowest = 1e300;
-                    for (const auto &v : sys->body(int(b)).worldVertices())
-                        lowest = std::min(lowest, v.z());
-                    if (lowest < surface)
-                        throw coupling::CouplingError(
-                            "participant '" + options.name + "': body '" + options.bodies[b] +
-                            "' starts " + std::to_string(1000.0 * (surface - lowest)) +
-                            " mm inside the settled bed (surface at z = " +
-                            std::to_string(surface) + " m): start it higher");
-                }
-            }
-            std::vector<double> work(body_count, 0.0);
-            for (std::uint64_t k = 0; k < steps; ++k) {
-                sys->step();
-                for (std::size_t b = 0; b < body_count; ++b) {
-                    const auto &body = sys->body(int(b));
-                    work[b] += (body.force_N.dot(body.state().linear_velocity_m_s) +
-                                body.torque_N_m.dot(body.state().angular_velocity_rad_s)) *
-                               dt;
-                }
-            }
-            // The soil's load on the body: the impulse over the window divided by the window.
-            coupling::WindowOutputs out;
-            for (std::size_t b = 0; b < body_count; ++b) {
-                const auto &body = sys->body(int(b));
-                coupling::Wrench w;
-                w.body = options.bodies[b];
-                w.force_N = body.impulse_N_s / in.duration_s;
-                w.torque_N_m = body.angular_impulse_N_m_s / in.duration_s;
-                if (mirror) {
-                    mirror->check(in.end_states.at(b));
-                    MirrorSymmetry::complete(w.force_N, w.torque_N_m);
-                    work[b] *= 2.0;
-                }
-                out.wrenches.push_back(w);
-                out.work.push_back({w.body, work[b]});
-                double lowest = 1e300;
-                for (const auto &v : body.worldVertices())
-                    lowest = std::min(lowest, v.z());
-                series << in.end_s << ',' << w.body << ',' << surface - lowest << ','
-                       << w.force_N.x() << ',' << w.force_N.y() << ',' << w.force_N.z() << ','
-                       << w.torque_N_m.x() << ',' << w.torque_N_m.y() << ',' << w.torque_N_m.z()
-                       << ',' << sys->wallContactCount() << '\n';
-            }
-            if (snapshot_interval_s > 0.0 &&
-                in.end_s >= snapshot_interval_s * double(vtk.count()) - 1e-12) {
-                std::filesystem::create_directories(snapshot_directory);
-                vtk.write(*sys, in.end_s);
-            }
-            participant.writeOutputs(std::move(out));
-            participant.advance();
-            progress.update(in.end_s, in.end_s / end_s,
-                            (sys->stepCount() - first_step) * sys->particles().size(), "");
-            break;
-        }
-        case coupling::Command::Finish:
-            participant.finalize();
-            series.flush();
-            return 0;
-        }
+private:
+    std::size_t bodyCount() const { return options_.bodies.size(); }
+    double lowestPoint(std::size_t b) const {
+        double lowest = 1e300;
+        for (const auto &v : sys_->body(int(b)).worldVertices())
+            lowest = std::min(lowest, v.z());
+        return lowest;
     }
+
+    NodeOptions options_;
+    dem::DemScenario scenario_;
+    std::optional<MirrorSymmetry> mirror_;
+    std::string snapshot_directory_;
+    std::unique_ptr<dem::DemSystem> sys_;
+    double surface_ = 0.0;      ///< [m] the settled bed's top
+    double dem_offset_s_ = 0.0; ///< [s] DEM time - coupling time
+    bool resumed_ = false;
+    double end_s_ = 0.0; ///< [s] the run's end, for the progress line
+    dem::VtkWriter vtk_;
+    std::ofstream series_;
+    dem::Progress progress_;
+    std::uint64_t first_step_ = 0;
+};
+
+} // namespace
+
+int runSoilNode(const NodeOptions &options) {
+    const auto root = config::ConfigNode::loadFile(options.scenario_path);
+    SoilNode node(options, root);
+    auto config = soilParticipantConfig(options, root);
+    config.capabilities.checkpoint = true;
+    coupling::Participant participant(config);
+    coupling::runParticipant(participant, node);
+    return 0;
 }
 
 } // namespace grainlink::apps

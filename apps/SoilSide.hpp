@@ -5,6 +5,7 @@
 #include "Nodes.hpp"
 #include "grainlink/coupling/Participant.hpp"
 #include "grainlink/coupling/Types.hpp"
+#include "grainlink/dem/Scenario.hpp"
 #include "grainlink/dem/Walls.hpp"
 #include "grainlink/dem/WheelMesh.hpp"
 
@@ -13,6 +14,8 @@
 #include <algorithm>
 #include <cmath>
 #include <optional>
+#include <stdexcept>
+#include <string>
 
 namespace grainlink::apps {
 
@@ -30,30 +33,57 @@ inline coupling::ParticipantConfig soilParticipantConfig(const NodeOptions &opti
     return config;
 }
 
-/// The triangle mesh of a body as its provider described it (parametric wheel or mesh).
+/// The bed of a soil node: a DEM scenario (section `section`) without what the coupling decides:
+/// its duration, its bodies, its rows and checkpoints. A key for those would change nothing.
+inline dem::DemScenario parseSoilSection(const config::ConfigNode &root,
+                                         const std::string &section) {
+    const config::ConfigNode soil = root[section];
+    if (soil.has("name"))
+        soil["name"].fail("a soil node's files are named after its section (--section), not "
+                          "`name`: remove the key");
+    if (soil.has("run"))
+        soil["run"].fail("a coupled soil runs as long as the coordinator says (coupling."
+                         "end_time_s): remove the key");
+    if (soil.has("bodies"))
+        soil["bodies"].fail("a coupled soil's bodies come from the multibody participant (the "
+                            "soil node's --bodies): remove the key");
+    if (const auto out = soil.optional("output"))
+        for (const char *key : {"series_interval_s", "checkpoint_interval_s"})
+            if (out->has(key))
+                (*out)[key].fail("the soil node writes a row every window and a checkpoint "
+                                 "when the coordinator asks (coupling.checkpoint_every_windows): "
+                                 "remove the key");
+    return dem::parseScenario(soil, true);
+}
+
+/// The description of the consumed body `name` among the run's bodies.
+inline const coupling::BodyDescription &describedBody(const coupling::RunInfo &run,
+                                                      const std::string &name) {
+    for (const auto &body : run.bodies)
+        if (body.name == name)
+            return body;
+    throw coupling::CouplingError("the run has no body '" + name + "' (check --bodies)");
+}
+
+/// The triangle mesh the grains touch, built from the body's description exactly as its
+/// provider gave it (a parametric wheel, or a mesh).
 inline dem::TriangleMesh meshOf(const coupling::BodyDescription &body, bool half = false) {
-    if (const auto *w = std::get_if<coupling::WheelGeometry>(&body.geometry)) {
-        dem::WheelMeshSpec spec;
-        spec.diameter_m = w->diameter_m;
-        spec.width_m = w->width_m;
-        spec.grouser_count = w->grouser_count;
-        spec.grouser_height_m = w->grouser_height_m;
-        spec.grouser_thickness_m = w->grouser_thickness_m;
-        spec.chevron = w->grouser_shape == coupling::GrouserShape::Chevron;
-        spec.chevron_angle_deg = w->chevron_angle_deg;
-        spec.closed_sides = w->closed_sides;
-        spec.half = half;
-        return dem::makeWheel(spec);
+    if (const auto *wheel = std::get_if<coupling::WheelShape>(&body.geometry)) {
+        dem::WheelMeshOptions options;
+        options.half = half;
+        try {
+            return dem::makeWheel(*wheel, options);
+        } catch (const std::invalid_argument &e) {
+            throw coupling::CouplingError("body '" + body.name + "': " + e.what());
+        }
     }
     if (half)
         throw coupling::CouplingError("body '" + body.name + "': a mirror-symmetric half model "
                                       "needs parametric wheels, not a mesh");
-    if (const auto *m = std::get_if<coupling::MeshGeometry>(&body.geometry)) {
+    if (const auto *m = std::get_if<coupling::MeshShape>(&body.geometry)) {
         dem::TriangleMesh mesh;
         mesh.vertices_m = m->vertices_m;
-        for (std::size_t t = 0; t + 2 < m->triangles.size(); t += 3)
-            mesh.triangles.push_back(
-                {int(m->triangles[t]), int(m->triangles[t + 1]), int(m->triangles[t + 2])});
+        mesh.triangles = m->triangles;
         return mesh;
     }
     throw coupling::CouplingError("body '" + body.name + "' has no geometry the soil can touch");

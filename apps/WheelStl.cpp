@@ -17,23 +17,14 @@ int exportWheelStl(const std::string &scenario_path, const std::string &stl_path
             block = root[model]["wheel"];
     if (!block)
         root.fail("no `rig.wheel` or `rover.wheel` block to build a wheel from");
-    const mbs::WheelShape shape = mbs::parseWheelShape(*block);
-    dem::WheelMeshSpec spec;
-    spec.diameter_m = shape.diameter_m;
-    spec.width_m = shape.width_m;
-    spec.grouser_count = shape.grouser_count;
-    spec.grouser_height_m = shape.grouser_height_m;
-    spec.grouser_thickness_m = shape.grouser_thickness_m;
-    spec.chevron = shape.chevron;
-    spec.chevron_angle_deg = shape.chevron_angle_deg;
-    spec.closed_sides = shape.closed_sides;
-    const dem::TriangleMesh mesh = dem::makeWheel(spec);
+    const mbs::WheelShape wheel = mbs::parseWheelShape(*block);
+    const dem::TriangleMesh mesh = dem::makeWheel(wheel);
     if (binary)
         dem::writeStlBinary(mesh, stl_path);
     else
         dem::writeStlAscii(mesh, stl_path, "grainlink_wheel");
     std::printf("%s: %zu triangles, wheel %.4g m x %.4g m\n", stl_path.c_str(),
-                mesh.triangleCount(), spec.diameter_m, spec.width_m);
+                mesh.triangleCount(), wheel.diameter_m, wheel.width_m);
     return 0;
 }
 

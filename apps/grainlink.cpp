@@ -132,9 +132,9 @@ int main(int argc, char **argv) {
         command->add_option("--endpoint", node.endpoint, "the coordinator's endpoint")->required();
         command->add_option("--out", node.output_directory, "output directory")->required();
         command->add_option("--keys", node.keys_directory, "CURVE keys directory");
-        command->add_option("--progress-interval", node.progress_interval_s,
-                            "seconds between progress lines");
     }
+    dem_node->add_option("--progress-interval", node.progress_interval_s,
+                         "seconds between progress lines (settling and the run)");
     for (auto *command : {dem_node, floor_node})
         command->add_option("--bodies", node.bodies, "the coupled bodies it loads (comma separated)")
             ->delimiter(',')
@@ -181,7 +181,10 @@ int main(int argc, char **argv) {
             return grainlink::apps::generateKeys(key_directory, key_names);
         }
     } catch (const std::exception &e) {
-        std::fprintf(stderr, "grainlink: error: %s\n", e.what());
+        // A participant node's line names the participant (its run has several processes).
+        const bool node_command = mbs_node->parsed() || dem_node->parsed() || floor_node->parsed();
+        std::fprintf(stderr, "%s: error: %s\n", node_command ? node.name.c_str() : "grainlink",
+                     e.what());
         return 1;
     }
     return 0;

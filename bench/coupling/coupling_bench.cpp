@@ -94,10 +94,9 @@ coupling::ParticipantConfig participantConfig(coupling::Role role, const std::st
         body.name = bodyName(b);
         body.mass.mass_kg = 5.0;
         body.mass.inertia_diagonal_kg_m2 = coupling::Vec3(0.05, 0.08, 0.05);
-        coupling::WheelGeometry wheel;
+        coupling::WheelShape wheel;
         wheel.diameter_m = 0.3;
         wheel.width_m = 0.1;
-        wheel.rim_thickness_m = 0.005;
         wheel.grouser_count = 12;
         wheel.grouser_height_m = 0.01;
         wheel.grouser_thickness_m = 0.004;

@@ -26,13 +26,14 @@ void toWire(const BodyDescription &body, pb::BodyDescription *out) {
     toWire(body.mass.center_of_mass_m, mass->mutable_center_of_mass_m());
     toWire(body.mass.inertia_diagonal_kg_m2, mass->mutable_inertia_diagonal_kg_m2());
     toWire(body.mass.inertia_off_diagonal_kg_m2, mass->mutable_inertia_off_diagonal_kg_m2());
-    if (const auto *mesh = std::get_if<MeshGeometry>(&body.geometry)) {
+    if (const auto *mesh = std::get_if<MeshShape>(&body.geometry)) {
         auto *m = out->mutable_mesh();
         for (const auto &v : mesh->vertices_m)
             toWire(v, m->add_vertices_m());
-        for (auto i : mesh->triangles)
-            m->add_triangle_indices(i);
-    } else if (const auto *wheel = std::get_if<WheelGeometry>(&body.geometry)) {
+        for (const auto &t : mesh->triangles)
+            for (int i : t)
+                m->add_triangle_indices(std::uint32_t(i));
+    } else if (const auto *wheel = std::get_if<WheelShape>(&body.geometry)) {
         auto *w = out->mutable_wheel();
         w->set_diameter_m(wheel->diameter_m);
         w->set_width_m(wheel->width_m);
@@ -56,26 +57,26 @@ BodyDescription fromWire(const pb::BodyDescription &body) {
     out.mass.inertia_diagonal_kg_m2 = fromWire(body.mass().inertia_diagonal_kg_m2());
     out.mass.inertia_off_diagonal_kg_m2 = fromWire(body.mass().inertia_off_diagonal_kg_m2());
     if (body.has_mesh()) {
-        MeshGeometry mesh;
+        const auto &indices = body.mesh().triangle_indices();
+        MeshShape mesh;
         for (const auto &v : body.mesh().vertices_m())
             mesh.vertices_m.push_back(fromWire(v));
-        mesh.triangles.assign(body.mesh().triangle_indices().begin(),
-                              body.mesh().triangle_indices().end());
-        if (mesh.triangles.size() % 3 != 0)
+        if (indices.size() % 3 != 0)
             throw ProtocolError(pb::Error::CODE_MALFORMED,
                                 "body '" + printable(body.name()) + "': triangle index count " +
-                                    std::to_string(mesh.triangles.size()) +
-                                    " is not a multiple of 3");
-        for (auto i : mesh.triangles)
+                                    std::to_string(indices.size()) + " is not a multiple of 3");
+        for (auto i : indices)
             if (i >= mesh.vertices_m.size())
                 throw ProtocolError(pb::Error::CODE_MALFORMED,
                                     "body '" + printable(body.name()) + "': triangle index " +
                                         std::to_string(i) + " beyond " +
                                         std::to_string(mesh.vertices_m.size()) + " vertices");
+        for (int t = 0; t + 2 < indices.size(); t += 3)
+            mesh.triangles.push_back({int(indices[t]), int(indices[t + 1]), int(indices[t + 2])});
         out.geometry = std::move(mesh);
     } else if (body.has_wheel()) {
         const auto &w = body.wheel();
-        WheelGeometry wheel;
+        WheelShape wheel;
         wheel.diameter_m = w.diameter_m();
         wheel.width_m = w.width_m();
         wheel.rim_thickness_m = w.rim_thickness_m();

@@ -70,8 +70,12 @@ CoordinatorConfig coordinatorConfigFrom(const ConfigNode &root) {
                 accelerationFromName(name->choice({"constant", "aitken", "iqn-ils"}));
         if (implicit->has("initial_relaxation"))
             s.acceleration.initial_relaxation = (*implicit)["initial_relaxation"].positive();
-        if (implicit->has("reuse_windows"))
+        if (implicit->has("reuse_windows")) {
+            if (s.acceleration.kind != AccelerationKind::IqnIls) // the others keep no history
+                (*implicit)["reuse_windows"].fail("only acceleration: iqn-ils reuses past "
+                                                  "windows: remove the key");
             s.acceleration.reuse_windows = count((*implicit)["reuse_windows"], 0);
+        }
         implicit->finish();
     }
     if (coupling.has("heartbeat_interval_s"))

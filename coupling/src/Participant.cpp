@@ -67,6 +67,8 @@ struct Participant::Impl {
     std::uint64_t expected_window = 0;
     std::string checkpoint_directory;
     std::uint64_t checkpoint_window = 0;
+    bool run_stopped = false;      ///< the coordinator stopped the run, refused us or is gone
+    bool failure_reported = false; ///< fail() told the coordinator already
 
     // Heartbeats travel on their own connection from their own thread, so a participant busy
     // in a long window still proves it is alive, and notices when the coordinator is gone.
@@ -155,6 +157,7 @@ struct Participant::Impl {
                     throw CouplingError(who() + ": " + *why);
             if (shutdown_heard) {
                 std::lock_guard<std::mutex> lock(shutdown_mutex);
+                run_stopped = true;
                 throw CouplingError(who() +
                                     ": the coordinator stopped the run: " + shutdown_reason);
             }
@@ -165,18 +168,21 @@ struct Participant::Impl {
                 os << who() << ": the coordinator has been silent for " << coordinatorSilence()
                    << " s while waiting for " << waiting_for
                    << " (it stopped, or the connection is down)";
+                run_stopped = true;
                 throw CouplingError(os.str());
             }
             if (sockets::secondsSince(start) > timeout_s) {
                 std::ostringstream os;
                 os << who() << ": no " << waiting_for << " from the coordinator at "
                    << config.endpoint << " within " << timeout_s << " s";
+                run_stopped = true;
                 throw CouplingError(os.str());
             }
         }
     }
 
     [[noreturn]] void stopped(const pb::Envelope &e) {
+        run_stopped = true;
         if (e.has_shutdown())
             throw CouplingError(who() +
                                 ": the coordinator stopped the run: " + e.shutdown().reason());
@@ -429,17 +435,35 @@ void Participant::finalize() {
 
 void Participant::fail(const std::string &reason) noexcept {
     auto &s = *impl_;
+    // Nothing to tell a coordinator that is not there, that stopped the run itself (it knows
+    // why), or that heard it already; and a finished run cannot fail.
+    if (!s.socket || s.run_stopped || s.failure_reported || s.state == State::Finished ||
+        s.state == State::Finalized)
+        return;
+    s.failure_reported = true;
     try {
-        if (!s.socket)
-            return;
         pb::Envelope e = s.envelope(s.inputs.window);
         e.mutable_error()->set_code(pb::Error::CODE_PARTICIPANT_FAILED);
         e.mutable_error()->set_message(reason);
         const std::string bytes = codec::encode(e);
         (void)s.socket.send(zmq::buffer(bytes), zmq::send_flags::dontwait);
+        // Wait (briefly) until the coordinator stops the run: it has then read this report and
+        // prints it, rather than the exit status of a process that left before it read it.
+        const auto sent = Clock::now();
+        const double wait_s = std::min(2.0, s.peer_timeout_s);
+        while (!s.shutdown_heard && sockets::secondsSince(sent) < wait_s) {
+            zmq::message_t message;
+            if (!sockets::receive(s.socket, message)) // waits at most 50 ms
+                continue;
+            pb::Envelope reply;
+            if (reply.ParseFromArray(message.data(), int(message.size())) &&
+                (reply.has_shutdown() || reply.has_error()))
+                break;
+        }
     } catch (...) {
-        // Best effort: the coordinator also notices the missing heartbeats.
+        // Best effort: the coordinator also notices the process exit or the missing heartbeats.
     }
+    s.run_stopped = true;
 }
 
 Participant::State Participant::state() const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
 #include <stdexcept>
@@ -19,6 +20,16 @@ double RadiusDistribution::largest() const {
         return *std::max_element(radii_m.begin(), radii_m.end());
     }
     return 0.0;
+}
+
+double RadiusDistribution::smallest() const {
+    if (kind != Kind::Discrete)
+        return min_m;
+    double r = std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < radii_m.size(); ++k)
+        if (fractions[k] > 0.0)
+            r = std::min(r, radii_m[k]);
+    return r;
 }
 
 void RadiusDistribution::validate() const {
@@ -60,6 +71,32 @@ std::string DepositionSpec::describe() const {
     s << " material=" << material << " seed=" << seed << " layers=" << layers
       << " interval=" << layer_interval_s << " settle=" << settle_kinetic_energy_J << ','
       << max_settle_time_s;
+    // Only what is set: a bed that is only settled keeps the key it had before these existed.
+    if (strike_off_height_m)
+        s << " strike_off=" << *strike_off_height_m;
+    if (compaction)
+        s << " compaction=" << compaction->pressure_Pa << ',' << compaction->hold_time_s << ','
+          << compaction->speed_m_s;
+    if (crust)
+        s << " crust=" << crust->thickness_m << ',' << crust->youngs_modulus_factor << ','
+          << crust->material;
+    return s.str();
+}
+
+std::string DepositionReport::preparationSummary() const {
+    std::ostringstream s;
+    s.precision(4);
+    if (struck_off > 0)
+        s << "struck off " << struck_off << " grains; ";
+    if (compaction)
+        s << "compacted: plate " << compaction->hold_force_N << " N at hold (target "
+          << compaction->target_force_N << " N); ";
+    if (crust_grains > 0)
+        s << "crust of " << crust_grains << " grains; ";
+    if (s.tellp() == 0)
+        return "";
+    s << "packing fraction " << packing_fraction_settled << " settled, " << packing_fraction
+      << " prepared";
     return s.str();
 }
 
@@ -162,6 +199,32 @@ std::size_t insertRandom(DemSystem &system, const DepositionSpec &spec, Random &
     return placed;
 }
 
+namespace {
+
+/// Steps until the mean kinetic energy per grain is below the spec's threshold (checked every
+/// 0.01 s) or report.settle_time_s reaches until_s.
+void settle(DemSystem &system, const DepositionSpec &spec, DepositionReport &report,
+            const std::function<void(const DepositionReport &)> &progress, double until_s) {
+    const double dt = system.settings().time_step_s;
+    const std::uint64_t check_every = std::max<std::uint64_t>(1, std::uint64_t(0.01 / dt));
+    for (;;) {
+        for (std::uint64_t k = 0; k < check_every; ++k)
+            system.step();
+        report.settle_time_s += double(check_every) * dt;
+        const Energies e = system.energies();
+        report.final_kinetic_energy_per_particle_J =
+            (e.translational_J + e.rotational_J) /
+            double(std::max<std::size_t>(1, system.particles().size()));
+        report.settled = report.final_kinetic_energy_per_particle_J < spec.settle_kinetic_energy_J;
+        if (progress)
+            progress(report);
+        if (report.settled || report.settle_time_s >= until_s)
+            break;
+    }
+}
+
+} // namespace
+
 DepositionReport deposit(DemSystem &system, const DepositionSpec &spec,
                          const std::function<void(const DepositionReport &)> &progress) {
     spec.radius.validate();
@@ -171,14 +234,13 @@ DepositionReport deposit(DemSystem &system, const DepositionSpec &spec,
         throw std::invalid_argument("deposition: region is thinner than a grain");
     if (spec.layers < 1)
         throw std::invalid_argument("deposition: layers must be >= 1");
+    if (spec.compaction)
+        spec.compaction->validate();
+    if (spec.crust)
+        spec.crust->validate();
     Random random(spec.seed);
     DepositionReport report;
     const double dt = system.settings().time_step_s;
-    auto meanKinetic = [&] {
-        const Energies e = system.energies();
-        return (e.translational_J + e.rotational_J) /
-               double(std::max<std::size_t>(1, system.particles().size()));
-    };
     if (spec.method == DepositionSpec::Method::Random) {
         report.inserted = insertRandom(system, spec, random, spec.count, spec.region_lower_m,
                                        spec.region_upper_m);
@@ -207,19 +269,30 @@ DepositionReport deposit(DemSystem &system, const DepositionSpec &spec,
                "or lower count";
         throw std::runtime_error(msg.str());
     }
-    // Settle until the mean kinetic energy per particle falls below the threshold.
-    const std::uint64_t check_every = std::max<std::uint64_t>(1, std::uint64_t(0.01 / dt));
-    for (;;) {
-        for (std::uint64_t k = 0; k < check_every; ++k)
-            system.step();
-        report.settle_time_s += double(check_every) * dt;
-        report.final_kinetic_energy_per_particle_J = meanKinetic();
-        report.settled = report.final_kinetic_energy_per_particle_J < spec.settle_kinetic_energy_J;
-        if (progress)
-            progress(report);
-        if (report.settled || report.settle_time_s >= spec.max_settle_time_s)
-            break;
+    settle(system, spec, report, progress, spec.max_settle_time_s);
+    const Vec3 footprint = spec.region_upper_m - spec.region_lower_m;
+    const double area_m2 = footprint.x() * footprint.y();
+    report.packing_fraction_settled = packingFraction(system.particles(), area_m2);
+
+    // Preparation (docs/physics.md §6.1): each step then settles again, as long as it may.
+    const auto settleAgain = [&] {
+        settle(system, spec, report, progress, report.settle_time_s + spec.max_settle_time_s);
+    };
+    if (spec.strike_off_height_m) {
+        report.struck_off = strikeOff(system, *spec.strike_off_height_m);
+        if (report.struck_off > 0)
+            settleAgain();
     }
+    if (spec.compaction) {
+        report.compaction =
+            compact(system, *spec.compaction, spec.region_lower_m, spec.region_upper_m);
+        settleAgain();
+    }
+    if (spec.crust) {
+        report.crust_grains = applyCrust(system, *spec.crust);
+        settleAgain();
+    }
+    report.packing_fraction = packingFraction(system.particles(), area_m2);
     return report;
 }
 

@@ -71,6 +71,17 @@ void ParticleStore::reserve(std::size_t n) {
 void ParticleStore::permute(const std::vector<std::size_t> &order) {
     if (order.size() != size())
         throw std::logic_error("ParticleStore::permute: wrong order size");
+    select(order);
+}
+
+void ParticleStore::keep(const std::vector<std::size_t> &kept) {
+    for (std::size_t k = 0; k < kept.size(); ++k)
+        if (kept[k] >= size() || (k > 0 && kept[k] <= kept[k - 1]))
+            throw std::logic_error("ParticleStore::keep: indices must ascend within the store");
+    select(kept);
+}
+
+void ParticleStore::select(const std::vector<std::size_t> &order) {
     applyOrder(id, order);
     applyOrder(position, order);
     applyOrder(velocity, order);

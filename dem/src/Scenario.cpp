@@ -266,6 +266,61 @@ RadiusDistribution parseRadius(const ConfigNode &node) {
     return d;
 }
 
+/// Runs a preparation step's own check (a backstop: the keys are checked where they are read).
+template <class Spec> void validateSpecAt(const ConfigNode &node, const Spec &spec) {
+    try {
+        spec.validate();
+    } catch (const std::invalid_argument &e) {
+        node.fail(e.what());
+    }
+}
+
+/// deposition.strike_off_height_m, .compaction, .crust (docs/physics.md §6.1). Each is refused
+/// where it could change nothing.
+void parsePreparation(const ConfigNode &node, DepositionSpec &d) {
+    if (const auto h = node.optional("strike_off_height_m")) {
+        const double height = h->number();
+        const double floor = d.region_lower_m.z();
+        const double highest_centre = d.region_upper_m.z() - d.radius.smallest();
+        std::ostringstream limits;
+        limits.precision(6);
+        if (!(height > floor)) {
+            limits << "must lie above the bed's floor (region.lower_m z = " << floor << " m)";
+            h->fail(limits.str());
+        }
+        if (height >= highest_centre) {
+            limits << "removes nothing: no grain centre can lie above region.upper_m z minus the "
+                      "smallest radius = "
+                   << highest_centre << " m";
+            h->fail(limits.str());
+        }
+        d.strike_off_height_m = height;
+    }
+    if (const auto c = node.optional("compaction")) {
+        CompactionSpec compaction;
+        compaction.pressure_Pa = (*c)["pressure_Pa"].positive();
+        if (const auto hold = c->optional("hold_time_s"))
+            compaction.hold_time_s = hold->positive();
+        if (const auto speed = c->optional("speed_m_s"))
+            compaction.speed_m_s = speed->positive();
+        c->finish();
+        validateSpecAt(*c, compaction);
+        d.compaction = compaction;
+    }
+    if (const auto c = node.optional("crust")) {
+        CrustSpec crust;
+        crust.thickness_m = (*c)["thickness_m"].positive();
+        const ConfigNode factor = (*c)["youngs_modulus_factor"];
+        crust.youngs_modulus_factor = factor.positive();
+        if (crust.youngs_modulus_factor == 1.0)
+            factor.fail("1 changes nothing (the crust would be the soil itself): leave crust out");
+        c->finish();
+        validateSpecAt(*c, crust);
+        crust.material = 1; // makeSystem puts the crust after the soil
+        d.crust = crust;
+    }
+}
+
 DepositionSpec parseDeposition(const ConfigNode &node) {
     DepositionSpec d;
     d.method = node.text("method", "random") == "rain" ? DepositionSpec::Method::Rain
@@ -289,6 +344,7 @@ DepositionSpec parseDeposition(const ConfigNode &node) {
     d.max_settle_time_s = node.number("max_settle_time_s", 5.0);
     if (const auto rolling = node.optional("rolling"))
         d.rolling = parseRolling(*rolling);
+    parsePreparation(node, d);
     node.finish();
     return d;
 }
@@ -433,8 +489,13 @@ ContactLaws contactLaws(const DemScenario &s) {
 }
 
 std::unique_ptr<DemSystem> makeSystem(const DemScenario &s) {
-    auto system =
-        std::make_unique<DemSystem>(contactLaws(s), std::vector<Material>{s.material}, s.settings);
+    std::vector<Material> materials{s.material};
+    if (const auto &crust = s.deposition.crust) {
+        if (crust->material != int(materials.size()))
+            throw std::logic_error("makeSystem: the crust's material index must follow the soil's");
+        materials.push_back(crustMaterial(s.material, *crust));
+    }
+    auto system = std::make_unique<DemSystem>(contactLaws(s), std::move(materials), s.settings);
     for (const PlaneWall &w : s.planes)
         system->addPlane(w);
     return system;

@@ -54,17 +54,6 @@ private:
 
 } // namespace
 
-double bedSurface(const ParticleStore &p) {
-    if (p.empty())
-        return 0.0;
-    std::vector<double> tops(p.size());
-    for (std::size_t i = 0; i < p.size(); ++i)
-        tops[i] = p.position[i].z() + p.radius[i];
-    const std::size_t k = std::min(p.size() - 1, std::size_t(0.98 * double(p.size())));
-    std::nth_element(tops.begin(), tops.begin() + std::ptrdiff_t(k), tops.end());
-    return tops[k];
-}
-
 std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progress_interval_s,
                                        bool *from_cache) {
     auto sys = makeSystem(scenario);
@@ -114,6 +103,8 @@ std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progr
                  "[deposition] %zu particles, settled %s after %.3f s (KE/particle %.3g J)\n",
                  report.inserted, report.settled ? "" : "NOT (time limit)", report.settle_time_s,
                  report.final_kinetic_energy_per_particle_J);
+    if (const std::string prepared = report.preparationSummary(); !prepared.empty())
+        std::fprintf(stderr, "[deposition] %s\n", prepared.c_str());
     if (!cache.empty()) {
         writeCheckpoint(*sys, cache.string()); // through a temporary file and a rename
         // Go on from the packing as stored, as every later run of it does: the settled system

@@ -53,23 +53,60 @@ void appendGrouserPiece(TriangleMesh &mesh, double r, double inner, double heigh
               along * (0.5 * (run.norm() + extend0 + extend1)));
 }
 
+/// An open rim's inner surface at `inner_radius` (facing the axis) and its annular edge at each
+/// open end, joined to the outer rim's vertex rings (makeCylinder's first 2 x `segments`
+/// vertices, at y_from then y_to). A half wheel has no edge on its symmetry plane (y_from).
+void appendRimThickness(TriangleMesh &mesh, double inner_radius, double y_from, double y_to,
+                        int segments, bool edge_at_from) {
+    const int outer_from = 0, outer_to = segments;
+    const int inner_from = static_cast<int>(mesh.vertices_m.size()),
+              inner_to = inner_from + segments;
+    for (const double y : {y_from, y_to})
+        for (int k = 0; k < segments; ++k) {
+            const double a = 2.0 * M_PI * k / segments; // the outer rim's angles
+            mesh.vertices_m.emplace_back(inner_radius * std::cos(a), y, inner_radius * std::sin(a));
+        }
+    for (int k = 0; k < segments; ++k) {
+        const int k1 = (k + 1) % segments;
+        const int c0 = inner_from + k, c1 = inner_from + k1, d0 = inner_to + k, d1 = inner_to + k1;
+        // The outer rim's winding reversed: the inner surface faces the axis.
+        mesh.triangles.push_back({c0, d1, d0});
+        mesh.triangles.push_back({c0, c1, d1});
+        // The edges, wound as a closed wheel's caps (normal -y at y_from, +y at y_to).
+        const int b0 = outer_to + k, b1 = outer_to + k1;
+        mesh.triangles.push_back({d0, b1, b0});
+        mesh.triangles.push_back({d0, d1, b1});
+        if (edge_at_from) {
+            const int a0 = outer_from + k, a1 = outer_from + k1;
+            mesh.triangles.push_back({c0, a0, a1});
+            mesh.triangles.push_back({c0, a1, c1});
+        }
+    }
+}
+
 } // namespace
 
-TriangleMesh makeWheel(const WheelMeshSpec &spec) {
-    const double r = 0.5 * spec.diameter_m;
-    if (!(r > 0.0) || !(spec.width_m > 0.0))
+TriangleMesh makeWheel(const body::WheelShape &wheel, const WheelMeshOptions &options) {
+    const double r = 0.5 * wheel.diameter_m;
+    const bool chevron = wheel.grouser_shape == body::GrouserShape::Chevron;
+    if (!(r > 0.0) || !(wheel.width_m > 0.0))
         throw std::invalid_argument("wheel: diameter_m and width_m must be positive");
-    if (spec.chevron && !(std::abs(spec.chevron_angle_deg) < 80.0 && spec.chevron_segments > 0))
+    if (chevron && !(std::abs(wheel.chevron_angle_deg) < 80.0 && options.chevron_segments > 0))
         throw std::invalid_argument("wheel: chevron_angle_deg must lie in (-80, 80) degrees and "
                                     "chevron_segments be positive");
-    if (spec.grouser_count > 0 &&
-        (!(spec.grouser_height_m > 0.0) || !(spec.grouser_thickness_m > 0.0)))
+    if (wheel.grouser_count > 0 &&
+        (!(wheel.grouser_height_m > 0.0) || !(wheel.grouser_thickness_m > 0.0)))
         throw std::invalid_argument("wheel: grousers need a positive height and thickness");
-    const int segments = spec.rim_segments > 0
-                             ? spec.rim_segments
+    if (!(wheel.rim_thickness_m >= 0.0 && wheel.rim_thickness_m < r))
+        throw std::invalid_argument("wheel: rim_thickness_m must lie in [0, diameter_m / 2)");
+    if (wheel.closed_sides && wheel.rim_thickness_m != 0.0)
+        throw std::invalid_argument("wheel: rim_thickness_m shapes an open wheel's rim "
+                                    "(closed_sides false); a closed wheel is solid to the grains");
+    const int segments = options.rim_segments > 0
+                             ? options.rim_segments
                              : std::max(24, static_cast<int>(std::lround(360.0 / 5.0)));
     // The rim from y = -w/2 (or 0 for the half wheel) to w/2.
-    const double y_from = spec.half ? 0.0 : -0.5 * spec.width_m, y_to = 0.5 * spec.width_m;
+    const double y_from = options.half ? 0.0 : -0.5 * wheel.width_m, y_to = 0.5 * wheel.width_m;
     TriangleMesh mesh = makeCylinder(r, y_to - y_from, segments);
     for (auto &v : mesh.vertices_m)
         v.y() += 0.5 * (y_from + y_to);
@@ -78,40 +115,44 @@ TriangleMesh makeWheel(const WheelMeshSpec &spec) {
     const int centre_minus = 2 * segments, centre_plus = centre_minus + 1;
     std::vector<std::array<int, 3>> kept;
     for (const auto &t : mesh.triangles)
-        if (!(t[0] == centre_minus && (spec.half || !spec.closed_sides)) &&
-            !(t[0] == centre_plus && !spec.closed_sides))
+        if (!(t[0] == centre_minus && (options.half || !wheel.closed_sides)) &&
+            !(t[0] == centre_plus && !wheel.closed_sides))
             kept.push_back(t);
     mesh.triangles = kept;
+    if (wheel.rim_thickness_m > 0.0) // an open rim with a thickness; the half's edge at y = 0 is
+                                     // its image's, not an edge
+        appendRimThickness(mesh, r - wheel.rim_thickness_m, y_from, y_to, segments, !options.half);
     // Grousers stand on the rim: from just inside the facetted rim to r + height.
     const double inner = r * std::cos(M_PI / segments) - 1e-6;
-    for (unsigned g = 0; g < spec.grouser_count; ++g) {
-        const double angle = 2.0 * M_PI * g / spec.grouser_count;
-        if (!spec.chevron) {
-            appendGrouserPiece(mesh, r, inner, spec.grouser_height_m, spec.grouser_thickness_m,
+    for (unsigned g = 0; g < wheel.grouser_count; ++g) {
+        const double angle = 2.0 * M_PI * g / wheel.grouser_count;
+        if (!chevron) {
+            appendGrouserPiece(mesh, r, inner, wheel.grouser_height_m, wheel.grouser_thickness_m,
                                angle, angle, y_from, y_to);
             continue;
         }
         // Each arm runs from the apex (y = 0) to a side, its angle growing as |y| tan(sweep)/r:
         // a straight line on the unrolled rim.
-        const double sweep = std::tan(spec.chevron_angle_deg * M_PI / 180.0) / r;
-        const int n = spec.chevron_segments;
+        const double sweep = std::tan(wheel.chevron_angle_deg * M_PI / 180.0) / r;
+        const int n = options.chevron_segments;
         for (const double side : {-1.0, 1.0}) {
-            if (spec.half && side < 0.0)
+            if (options.half && side < 0.0)
                 continue;
             for (int k = 0; k < n; ++k) {
-                const double y0 = side * 0.5 * spec.width_m * k / n;
-                const double y1 = side * 0.5 * spec.width_m * (k + 1) / n;
-                const double overlap = 0.5 * spec.grouser_thickness_m; // closes the joints
+                const double y0 = side * 0.5 * wheel.width_m * k / n;
+                const double y1 = side * 0.5 * wheel.width_m * (k + 1) / n;
+                const double overlap = 0.5 * wheel.grouser_thickness_m; // closes the joints
                 // A half wheel's arm stops where its slanted end face touches the symmetry
                 // plane (its image continues it), leaving a notch smaller than the thickness.
                 const double start =
-                    k > 0 || !spec.half
+                    k > 0 || !options.half
                         ? overlap
-                        : -0.5 * spec.grouser_thickness_m *
-                              std::abs(std::tan(spec.chevron_angle_deg * M_PI / 180.0));
-                appendGrouserPiece(mesh, r, inner, spec.grouser_height_m, spec.grouser_thickness_m,
-                                   angle + std::abs(y0) * sweep, angle + std::abs(y1) * sweep, y0,
-                                   y1, start, k + 1 < n ? overlap : 0.0);
+                        : -0.5 * wheel.grouser_thickness_m *
+                              std::abs(std::tan(wheel.chevron_angle_deg * M_PI / 180.0));
+                appendGrouserPiece(mesh, r, inner, wheel.grouser_height_m,
+                                   wheel.grouser_thickness_m, angle + std::abs(y0) * sweep,
+                                   angle + std::abs(y1) * sweep, y0, y1, start,
+                                   k + 1 < n ? overlap : 0.0);
             }
         }
     }

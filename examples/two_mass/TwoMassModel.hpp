@@ -117,8 +117,9 @@ public:
     explicit MassTwoSide(const TwoMassParameters &p) : p_(p) {}
 
     struct Result {
-        double force_on_mass1_N = 0.0; ///< averaged over the window
-        double work_on_mass1_J = 0.0;
+        double force_on_mass1_N = 0.0;     ///< [N] averaged over the window
+        double impulse_on_mass1_N_s = 0.0; ///< [N s] over the window
+        double work_on_mass1_J = 0.0;      ///< [J]
     };
 
     Result advance(double window_s, double xa, double va, double xb, double vb) {
@@ -153,7 +154,7 @@ public:
         }
         x_ = y[0];
         v_ = y[1];
-        return Result{y[2] / window_s, y[3]};
+        return Result{y[2] / window_s, y[2], y[3]};
     }
     void save() { saved_x_ = x_, saved_v_ = v_; }
     void restore() { x_ = saved_x_, v_ = saved_v_; }

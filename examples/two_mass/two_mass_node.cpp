@@ -22,6 +22,8 @@ int main(int argc, char **argv) {
     faults->add_option("--die-at-window", misbehave.die_at_window, "SIGKILL itself here");
     faults->add_option("--hang-at-window", misbehave.hang_at_window, "never finish this window");
     faults->add_option("--freeze-at-window", misbehave.freeze_at_window, "SIGSTOP itself here");
+    faults->add_option("--throw-at-window", misbehave.throw_at_window,
+                       "the model throws here (its message reaches the coordinator)");
     CLI11_PARSE(app, argc, argv);
     if (name.empty())
         name = side;

@@ -269,12 +269,12 @@ Mole::Mole(const MoleSettings &settings)
                                                           SimTK::MobilizerQIndex(0));
     cam_constraint_.setDisabledByDefault(true);
 
-    CoupledBody hull;
+    BodyDescription hull;
     hull.name = s.hull_name;
-    hull.mass_kg = s.hull_mass_kg;
-    hull.center_of_mass_m = hull_com;
-    hull.inertia_diagonal_kg_m2 = hull_inertia;
-    hull.mesh = moleHullMesh(s);
+    hull.mass.mass_kg = s.hull_mass_kg;
+    hull.mass.center_of_mass_m = hull_com;
+    hull.mass.inertia_diagonal_kg_m2 = hull_inertia;
+    hull.geometry = moleHullMesh(s);
     addCoupled(hull, hull_);
     finishBuilding();
 

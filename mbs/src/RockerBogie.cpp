@@ -133,11 +133,11 @@ RockerBogie::RockerBogie(const RockerBogieSettings &settings)
         std::vector<SimTK::MobilizerQIndex>{q0(), q0()});
 
     for (int i = 0; i < kWheels; ++i) {
-        CoupledBody wheel;
+        BodyDescription wheel;
         wheel.name = s.name_prefix + wheelSuffixes()[i];
-        wheel.mass_kg = s.wheel_mass_kg;
-        wheel.inertia_diagonal_kg_m2 = wheel_inertia;
-        wheel.wheel = s.wheel;
+        wheel.mass.mass_kg = s.wheel_mass_kg;
+        wheel.mass.inertia_diagonal_kg_m2 = wheel_inertia;
+        wheel.geometry = s.wheel;
         addCoupled(wheel, wheels_[i]);
     }
     finishBuilding();
@@ -370,6 +370,17 @@ RockerBogieSettings parseRockerBogie(const config::ConfigNode &node) {
     if (auto n = node.optional("drive_torque_N_m"))
         s.drive_torques_N_m = perWheel(*n);
     s.rotation_locked = node.boolean("rotation_locked", false);
+    // One drive, and none for wheels that stay locked (nothing unlocks them in a coupled run).
+    for (const char *key : {"wheel_speed_rad_s", "drive_torque_N_m"}) {
+        if (!node.has(key))
+            continue;
+        if (s.rotation_locked)
+            node[key].fail("the wheels are locked (rotation_locked: true) and never driven: "
+                           "remove the key or the lock");
+        if (node.has("wheel_speed_rad_s") && node.has("drive_torque_N_m"))
+            node[key].fail("give one drive: wheel_speed_rad_s (speed) or drive_torque_N_m "
+                           "(torque)");
+    }
     s.gravity_m_s2 = vec3Or(node, "gravity_m_s2", s.gravity_m_s2);
     node.finish();
     return s;

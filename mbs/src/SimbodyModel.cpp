@@ -12,7 +12,7 @@ SimbodyModel::SimbodyModel(const Vec3 &gravity_m_s2, const IntegratorSettings &i
     SimTK::Force::UniformGravity(forces_, matter_, toSimTK(gravity_m_s2));
 }
 
-void SimbodyModel::addCoupled(const CoupledBody &body, const SimTK::MobilizedBody &mobod) {
+void SimbodyModel::addCoupled(const BodyDescription &body, const SimTK::MobilizedBody &mobod) {
     coupled_.push_back(body);
     coupled_bodies_.push_back(mobod);
     applied_.emplace_back();

@@ -63,11 +63,11 @@ SingleWheelRig::SingleWheelRig(const SingleWheelRigSettings &settings)
     carriage_speed_.setDisabledByDefault(!s.slip.has_value());
     wheel_speed_.setDisabledByDefault(s.drive_torque_N_m.has_value() && !s.rotation_locked);
 
-    CoupledBody wheel;
+    BodyDescription wheel;
     wheel.name = s.wheel_name;
-    wheel.mass_kg = s.wheel_mass_kg;
-    wheel.inertia_diagonal_kg_m2 = inertia;
-    wheel.wheel = s.wheel;
+    wheel.mass.mass_kg = s.wheel_mass_kg;
+    wheel.mass.inertia_diagonal_kg_m2 = inertia;
+    wheel.geometry = s.wheel;
     addCoupled(wheel, wheel_);
     finishBuilding();
 

@@ -264,12 +264,10 @@ UrdfModelSettings parseUrdfModel(const std::string &yaml_path) {
             const bool wheel = item.has("wheel"), mesh = item.has("mesh_file");
             if (wheel == mesh)
                 item.fail("give exactly one of 'wheel' (a parametric wheel) or 'mesh_file' (STL)");
-            if (wheel) {
-                c.wheel = parseWheelShape(item["wheel"]);
-            } else {
-                c.mesh = readMesh(item, folder);
-                c.mesh_file = (folder / item["mesh_file"].text()).lexically_normal().string();
-            }
+            if (wheel)
+                c.geometry = parseWheelShape(item["wheel"]);
+            else
+                c.geometry = readMesh(item, folder);
             item.finish();
             s.coupled.push_back(std::move(c));
         }
@@ -320,6 +318,10 @@ UrdfModelSettings parseUrdfModel(const std::string &yaml_path) {
                     (*sp)[u.stiffness].fail("must be >= 0");
                 if (spring.damping < 0.0)
                     (*sp)[u.damping].fail("must be >= 0");
+                if (spring.stiffness == 0.0 && sp->has(u.rest))
+                    (*sp)[u.rest].fail(std::string("a spring without stiffness has no rest "
+                                                   "position: give ") +
+                                       u.stiffness + " or remove the key");
                 sp->finish();
                 j.spring = spring;
             }
@@ -524,13 +526,14 @@ UrdfModel::UrdfModel(const UrdfModelSettings &settings)
 
     for (const auto &c : settings_.coupled) {
         const LinkMass m = massOf(*model->getLink(c.link), path);
-        CoupledBody body;
+        BodyDescription body;
         body.name = c.name;
-        body.mass_kg = m.mass_kg;
-        body.center_of_mass_m = m.com_m;
-        body.inertia_diagonal_kg_m2 = m.inertia_com.diagonal();
-        body.wheel = c.wheel;
-        body.mesh = c.mesh;
+        body.mass.mass_kg = m.mass_kg;
+        body.mass.center_of_mass_m = m.com_m;
+        body.mass.inertia_diagonal_kg_m2 = m.inertia_com.diagonal();
+        body.mass.inertia_off_diagonal_kg_m2 =
+            Vec3(m.inertia_com(0, 1), m.inertia_com(0, 2), m.inertia_com(1, 2));
+        body.geometry = c.geometry;
         addCoupled(body, bodies.at(c.link));
     }
 

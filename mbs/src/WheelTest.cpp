@@ -139,18 +139,46 @@ WheelTestSettings parseWheelTest(const config::ConfigNode &node) {
 }
 
 WheelShape parseWheelShape(const config::ConfigNode &w) {
+    // Every key changes the mesh the grains touch; one that would not (a grouser's height
+    // without grousers) is an error, not silently dropped.
     WheelShape shape;
     shape.diameter_m = w["diameter_m"].positive();
     shape.width_m = w["width_m"].positive();
-    shape.rim_thickness_m = w.number("rim_thickness_m", 0.005);
-    shape.grouser_count =
-        static_cast<unsigned>(w.has("grouser_count") ? w["grouser_count"].integer() : 0);
-    shape.grouser_height_m = w.number("grouser_height_m", 0.0);
-    shape.grouser_thickness_m = w.number("grouser_thickness_m", 0.0);
-    if (w.has("grouser_shape"))
-        shape.chevron = w["grouser_shape"].choice({"straight", "chevron"}) == "chevron";
-    shape.chevron_angle_deg = w.number("chevron_angle_deg", shape.chevron ? 30.0 : 0.0);
     shape.closed_sides = w.boolean("closed_sides", true);
+    if (const auto t = w.optional("rim_thickness_m")) {
+        if (shape.closed_sides)
+            t->fail("a closed wheel is solid to the grains, so its rim takes no thickness: give "
+                    "it to an open wheel (closed_sides: false) or remove the key");
+        shape.rim_thickness_m = t->positive();
+        if (!(shape.rim_thickness_m < 0.5 * shape.diameter_m))
+            t->fail("must be less than the rim radius, " + std::to_string(0.5 * shape.diameter_m) +
+                    " m");
+    }
+    const long long count = w.has("grouser_count") ? w["grouser_count"].integer() : 0;
+    if (count < 0)
+        w["grouser_count"].fail("must be >= 0");
+    shape.grouser_count = static_cast<unsigned>(count);
+    if (shape.grouser_count == 0) {
+        for (const char *key :
+             {"grouser_height_m", "grouser_thickness_m", "grouser_shape", "chevron_angle_deg"})
+            if (w.has(key))
+                w[key].fail("a wheel without grousers (grouser_count 0) has no grouser shape: "
+                            "set grouser_count or remove the key");
+        w.finish();
+        return shape;
+    }
+    shape.grouser_height_m = w["grouser_height_m"].positive();
+    shape.grouser_thickness_m = w["grouser_thickness_m"].positive();
+    if (w.has("grouser_shape") && w["grouser_shape"].choice({"straight", "chevron"}) == "chevron")
+        shape.grouser_shape = GrouserShape::Chevron;
+    if (const auto angle = w.optional("chevron_angle_deg")) {
+        if (shape.grouser_shape != GrouserShape::Chevron)
+            angle->fail("straight grousers have no sweep angle: set grouser_shape: chevron or "
+                        "remove the key");
+        shape.chevron_angle_deg = angle->number();
+        if (!(std::abs(shape.chevron_angle_deg) < 80.0))
+            angle->fail("must lie in (-80, 80) degrees");
+    }
     w.finish();
     return shape;
 }
@@ -165,8 +193,16 @@ SingleWheelRigSettings parseSingleWheelRig(const config::ConfigNode &node) {
     s.start_position_m = node["start_position_m"].vec3();
     s.angular_velocity_rad_s = node.number("angular_velocity_rad_s", s.angular_velocity_rad_s);
     s.drawbar_force_N = node.number("drawbar_force_N", 0.0);
-    if (node.has("drive_torque_N_m"))
+    if (node.has("drive_torque_N_m")) {
         s.drive_torque_N_m = node["drive_torque_N_m"].number();
+        // A torque drive sets no speed, and slip control imposes one.
+        if (node.has("angular_velocity_rad_s"))
+            node["angular_velocity_rad_s"].fail("a torque drive (drive_torque_N_m) sets no speed: "
+                                                "remove one of the two keys");
+        if (node.has("slip"))
+            node["slip"].fail("slip control imposes the wheel speed; it cannot be combined with "
+                              "a torque drive (drive_torque_N_m)");
+    }
     if (node.has("slip"))
         s.slip = node["slip"].number();
     s.rotation_locked = true; // the procedure starts with the drop phase

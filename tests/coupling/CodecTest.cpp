@@ -9,6 +9,7 @@
 
 #include <catch2/catch.hpp>
 
+#include <array>
 #include <cmath>
 
 using namespace grainlink::coupling;
@@ -175,7 +176,9 @@ TEST_CASE("Codec: a mesh's triangles index its vertices, three at a time", "[cou
     for (std::uint32_t i : {0u, 1u, 2u})
         mesh->add_triangle_indices(i);
     const auto ok = codec::fromWire(body);
-    CHECK(std::get<MeshGeometry>(ok.geometry).triangles.size() == 3);
+    const auto &triangles = std::get<MeshShape>(ok.geometry).triangles;
+    REQUIRE(triangles.size() == 1);
+    CHECK(triangles[0] == std::array<int, 3>{0, 1, 2});
     SECTION("an index beyond the vertices") {
         mesh->set_triangle_indices(2, 3);
         CHECK_THROWS_WITH(codec::fromWire(body),

@@ -149,3 +149,103 @@ TEST_CASE("Only loopback without keys, unless --insecure", "[coupling][security]
     CHECK(isLocalEndpoint("tcp://127.0.0.1:5555"));
     CHECK_FALSE(isLocalEndpoint("tcp://192.168.1.4:5555"));
 }
+
+namespace {
+
+/// Every field of a body description, compared exactly.
+void checkSameBody(const BodyDescription &got, const BodyDescription &sent) {
+    INFO("body " << sent.name);
+    CHECK(got.name == sent.name);
+    CHECK(got.mass.mass_kg == sent.mass.mass_kg);
+    CHECK(got.mass.center_of_mass_m == sent.mass.center_of_mass_m);
+    CHECK(got.mass.inertia_diagonal_kg_m2 == sent.mass.inertia_diagonal_kg_m2);
+    CHECK(got.mass.inertia_off_diagonal_kg_m2 == sent.mass.inertia_off_diagonal_kg_m2);
+    REQUIRE(got.geometry.index() == sent.geometry.index());
+    if (const auto *w = std::get_if<WheelShape>(&sent.geometry)) {
+        const auto &g = std::get<WheelShape>(got.geometry);
+        CHECK(g.diameter_m == w->diameter_m);
+        CHECK(g.width_m == w->width_m);
+        CHECK(g.rim_thickness_m == w->rim_thickness_m);
+        CHECK(g.grouser_count == w->grouser_count);
+        CHECK(g.grouser_height_m == w->grouser_height_m);
+        CHECK(g.grouser_thickness_m == w->grouser_thickness_m);
+        CHECK(g.grouser_shape == w->grouser_shape);
+        CHECK(g.chevron_angle_deg == w->chevron_angle_deg);
+        CHECK(g.closed_sides == w->closed_sides);
+    }
+    if (const auto *m = std::get_if<MeshShape>(&sent.geometry)) {
+        const auto &g = std::get<MeshShape>(got.geometry);
+        CHECK(g.vertices_m == m->vertices_m);
+        CHECK(g.triangles == m->triangles);
+    }
+}
+
+} // namespace
+
+TEST_CASE("The handshake carries each body's description unchanged", "[coupling][participant]") {
+    // No field at its default: a lost one (the centre of mass was, once) shows as a difference.
+    BodyDescription wheel;
+    wheel.name = "wheel";
+    wheel.mass = {2.5, Vec3(0.001, -0.002, 0.003), Vec3(0.02, 0.04, 0.021),
+                  Vec3(1e-4, -2e-4, 3e-4)};
+    WheelShape shape;
+    shape.diameter_m = 0.3;
+    shape.width_m = 0.12;
+    shape.rim_thickness_m = 0.004;
+    shape.grouser_count = 14;
+    shape.grouser_height_m = 0.012;
+    shape.grouser_thickness_m = 0.003;
+    shape.grouser_shape = GrouserShape::Chevron;
+    shape.chevron_angle_deg = 25.0;
+    shape.closed_sides = false;
+    wheel.geometry = shape;
+    BodyDescription hull;
+    hull.name = "hull";
+    hull.mass = {0.4, Vec3(0.0, 0.0, 0.21), Vec3(5e-3, 5e-3, 4e-5), Vec3::Zero()};
+    hull.geometry = MeshShape{{Vec3(0, 0, 0), Vec3(0.1, 0, 0), Vec3(0, 0.1, 0), Vec3(0, 0, 0.1)},
+                              {{0, 2, 1}, {0, 1, 3}, {0, 3, 2}, {1, 2, 3}}};
+
+    auto config = smallRun(0.01);
+    config.participants = {{"mbs", Role::Multibody, {}, false}, {"soil", Role::Soil, {}, false}};
+    Coordinator coordinator(config);
+    auto run = std::async(std::launch::async, [&] { return coordinator.run(); });
+    auto mbs = std::async(std::launch::async, [&, endpoint = coordinator.boundEndpoint()] {
+        ParticipantConfig c;
+        c.name = "mbs";
+        c.endpoint = endpoint;
+        c.provides = {wheel, hull};
+        c.initial_states = {BodyState{"wheel"}, BodyState{"hull"}};
+        Participant p(c);
+        p.initialize();
+        for (Command command = p.waitForCommand(); command != Command::Finish;
+             command = p.waitForCommand()) {
+            WindowOutputs out;
+            out.states = {BodyState{"wheel"}, BodyState{"hull"}};
+            p.writeOutputs(out);
+            p.advance();
+        }
+        p.finalize();
+    });
+    ParticipantConfig c;
+    c.name = "soil";
+    c.role = Role::Soil;
+    c.endpoint = coordinator.boundEndpoint();
+    c.consumes = {"wheel", "hull"};
+    Participant soil(c);
+    const auto bodies = soil.initialize().bodies;
+    for (Command command = soil.waitForCommand(); command != Command::Finish;
+         command = soil.waitForCommand()) {
+        WindowOutputs out;
+        out.wrenches.resize(2);
+        out.wrenches[0].body = "wheel";
+        out.wrenches[1].body = "hull";
+        soil.writeOutputs(out);
+        soil.advance();
+    }
+    soil.finalize();
+    run.get();
+    mbs.get();
+    REQUIRE(bodies.size() == 2);
+    checkSameBody(bodies[0], wheel);
+    checkSameBody(bodies[1], hull);
+}

@@ -363,8 +363,9 @@ TEST_CASE("Mole hull mesh: closed, outward, volume of cylinder plus cone", "[mbs
     CHECK(volume == Approx(round).epsilon(1.0 - std::sin(2 * M_PI / n) * n / (2 * M_PI) + 1e-6));
     const auto bodies = Mole(quickMole()).coupledBodies();
     REQUIRE(bodies.size() == 1);
-    REQUIRE(bodies[0].mesh.has_value());
-    CHECK(bodies[0].mesh->triangles.size() == mesh.triangles.size());
+    const auto *hull = std::get_if<MeshShape>(&bodies[0].geometry);
+    REQUIRE(hull);
+    CHECK(hull->triangles.size() == mesh.triangles.size());
 }
 
 TEST_CASE("Mole: save/restore and a checkpoint continue identically", "[mbs][mole]") {

@@ -93,9 +93,10 @@ TEST_CASE("URDF rig moves like the built-in single-wheel rig", "[mbs][urdf]") {
 
         const auto rb = rig.coupledBodies()[0], ub = urdf.coupledBodies()[0];
         CHECK(ub.name == "wheel");
-        CHECK(ub.mass_kg == rb.mass_kg);
-        CHECK((ub.inertia_diagonal_kg_m2 - rb.inertia_diagonal_kg_m2).norm() < 1e-15);
-        CHECK(ub.wheel.diameter_m == rb.wheel.diameter_m);
+        CHECK(ub.mass.mass_kg == rb.mass.mass_kg);
+        CHECK((ub.mass.inertia_diagonal_kg_m2 - rb.mass.inertia_diagonal_kg_m2).norm() < 1e-15);
+        CHECK(std::get<WheelShape>(ub.geometry).diameter_m ==
+              std::get<WheelShape>(rb.geometry).diameter_m);
         diff.add(rig.bodyStates()[0], urdf.bodyStates()[0]);
 
         rig.applyWrenches({Wrench{}});
@@ -224,10 +225,11 @@ TEST_CASE("URDF floating root with an STL mesh falls under gravity and the soil 
     const auto bodies = m.coupledBodies();
     REQUIRE(bodies.size() == 1);
     CHECK(bodies[0].name == "box");
-    REQUIRE(bodies[0].mesh);
-    CHECK(bodies[0].mesh->triangles.size() == 12);
+    const auto *box = std::get_if<MeshShape>(&bodies[0].geometry);
+    REQUIRE(box);
+    CHECK(box->triangles.size() == 12);
     double extent = 0.0;
-    for (const auto &v : bodies[0].mesh->vertices_m)
+    for (const auto &v : box->vertices_m)
         extent = std::max(extent, v.cwiseAbs().maxCoeff());
     CHECK(extent == Approx(0.05).margin(1e-12)); // 50 mm scaled by mesh_scale 0.001
     Wrench soil;
@@ -295,6 +297,13 @@ TEST_CASE("URDF and YAML errors name the file, the key and the line", "[mbs][urd
         const std::string msg =
             messageOf<ConfigError>([&] { parseUrdfModel(kData + "/wrong_unit.yaml"); });
         CHECK_THAT(msg, Catch::Contains("wrong_unit.yaml:5: unknown key 'joints[0].position_m'"));
+    }
+    SECTION("a spring's rest position without a stiffness, which would change nothing") {
+        const std::string msg = messageOf<ConfigError>(
+            [&] { parseUrdfModel(kData + "/spring_rest_without_stiffness.yaml"); });
+        CHECK_THAT(msg, Catch::Contains("spring_rest_without_stiffness.yaml:6: key "
+                                        "'joints[0].spring.rest_position_m'") &&
+                            Catch::Contains("no rest position"));
     }
     SECTION("a massless link at the end of a moving joint") {
         UrdfModelSettings s;

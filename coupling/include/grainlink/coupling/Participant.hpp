@@ -1,6 +1,8 @@
 #pragma once
 // The participant side of a coupled run, for our DEM and Simbody nodes and for a user's own code.
-// Lifecycle (preCICE-like), enforced; a call out of order throws LifecycleError saying what to do:
+// Most code runs a node through the one loop of ParticipantNode.hpp (runParticipant), which
+// makes these calls. The lifecycle (preCICE-like) is enforced; a call out of order throws
+// LifecycleError saying what to do:
 //
 //   Participant p(config);
 //   const RunInfo &run = p.initialize();          // handshake; run.restore set when resuming
@@ -18,6 +20,7 @@
 //       case Command::Finish: p.finalize(); return;
 //       }
 //   }
+//   // on any exception of the model: p.fail(what) before giving up
 #include "grainlink/coupling/Security.hpp"
 #include "grainlink/coupling/Types.hpp"
 
@@ -104,7 +107,10 @@ public:
     /// Sends the window's outputs; the window is done on this side.
     void advance();
     void finalize();
-    /// Tells the coordinator this participant cannot go on (the run stops everywhere).
+    /// Tells the coordinator this participant cannot go on: it stops the run everywhere and
+    /// prints `reason` naming this participant and the window. Waits (at most 2 s) until the
+    /// coordinator confirms, so that it reports this reason, not the process's exit. Sends
+    /// nothing when the coordinator stopped the run itself, or was told already.
     void fail(const std::string &reason) noexcept;
 
     State state() const;

@@ -1,6 +1,8 @@
 #pragma once
 // The coupling's vocabulary as plain C++ values. Wire (protobuf) types never appear outside
 // coupling/src; participants and the coordinator's users see only these.
+#include "grainlink/body/BodyDescription.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -8,7 +10,6 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
-#include <variant>
 #include <vector>
 
 namespace grainlink::coupling {
@@ -44,38 +45,13 @@ public:
     using std::logic_error::logic_error;
 };
 
-struct MassProperties {
-    double mass_kg = 0.0;                           ///< [kg]
-    Vec3 center_of_mass_m = Vec3::Zero();           ///< [m] in the body frame
-    Vec3 inertia_diagonal_kg_m2 = Vec3::Zero();     ///< [kg m^2] about the centre of mass
-    Vec3 inertia_off_diagonal_kg_m2 = Vec3::Zero(); ///< [kg m^2] (xy, xz, yz)
-};
-
-struct MeshGeometry {
-    std::vector<Vec3> vertices_m;         ///< [m] body frame
-    std::vector<std::uint32_t> triangles; ///< three vertex indices per triangle
-};
-
-enum class GrouserShape { Straight, Chevron };
-
-/// A wheel both sides build identically from its parameters (axis = body y).
-struct WheelGeometry {
-    double diameter_m = 0.0;      ///< [m] rim outer diameter, grousers excluded
-    double width_m = 0.0;         ///< [m]
-    double rim_thickness_m = 0.0; ///< [m]
-    unsigned grouser_count = 0;
-    double grouser_height_m = 0.0;    ///< [m]
-    double grouser_thickness_m = 0.0; ///< [m]
-    GrouserShape grouser_shape = GrouserShape::Straight;
-    double chevron_angle_deg = 0.0; ///< [deg]
-    bool closed_sides = true;
-};
-
-struct BodyDescription {
-    std::string name;
-    MassProperties mass;
-    std::variant<std::monostate, MeshGeometry, WheelGeometry> geometry;
-};
+// A coupled body's description is the value the multibody models give and the soil builds its
+// mesh from (grainlink/body): the handshake carries it unchanged.
+using body::BodyDescription;
+using body::GrouserShape;
+using body::MassProperties;
+using body::MeshShape;
+using body::WheelShape;
 
 /// A rigid body's state in the world frame.
 struct BodyState {

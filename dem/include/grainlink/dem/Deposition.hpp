@@ -1,5 +1,7 @@
 #pragma once
-// Particle generation and settling: the seed's step 1, run once per soil setup and cached.
+// Particle generation, settling and the bed's preparation: the seed's step 1, run once per soil
+// setup and cached.
+#include "grainlink/dem/BedPreparation.hpp"
 #include "grainlink/dem/DemSystem.hpp"
 
 #include <cstdint>
@@ -17,6 +19,7 @@ struct RadiusDistribution {
     std::vector<double> radii_m;     ///< Discrete: radii ...
     std::vector<double> fractions;   ///< ... and their number fractions (normalised)
     double largest() const;
+    double smallest() const; ///< of the radii drawn with a fraction > 0
     void validate() const;
 };
 
@@ -50,14 +53,26 @@ struct DepositionSpec {
     /// rolling laws. deposit() does not switch laws; its callers do (prepareSoil, the repose
     /// test): DemSystem::setRolling before deposit() and back to the run's law after it.
     std::optional<RollingModel> rolling;
+    // The settled bed's preparation, in this order, each followed by settling again
+    // (docs/physics.md §6.1): struck off, compacted, given a crust.
+    std::optional<double> strike_off_height_m; ///< [m] grains with centres above it go
+    std::optional<CompactionSpec> compaction;
+    std::optional<CrustSpec> crust;
     std::string describe() const;
 };
 
 struct DepositionReport {
     std::size_t inserted = 0;
-    double settle_time_s = 0.0;
+    double settle_time_s = 0.0; ///< [s] simulated while raining and settling
     double final_kinetic_energy_per_particle_J = 0.0;
     bool settled = false;
+    double packing_fraction_settled = 0.0; ///< after the first settling
+    double packing_fraction = 0.0;         ///< of the finished bed
+    std::size_t struck_off = 0;            ///< grains removed by the strike-off
+    std::optional<CompactionReport> compaction;
+    std::size_t crust_grains = 0;
+    /// One line on the preparation (empty when the bed was only settled).
+    std::string preparationSummary() const;
 };
 
 /// Inserts up to `count` non-overlapping spheres in the region (also avoiding existing
@@ -65,7 +80,8 @@ struct DepositionReport {
 std::size_t insertRandom(DemSystem &system, const DepositionSpec &spec, Random &random,
                          std::size_t count, const Vec3 &lower_m, const Vec3 &upper_m);
 
-/// Inserts and settles; `progress` is called every few hundred steps with the report so far.
+/// Inserts, settles and prepares; `progress` is called every few hundred steps with the report
+/// so far. The packing fraction's footprint is the region's x-y rectangle.
 DepositionReport deposit(DemSystem &system, const DepositionSpec &spec,
                          const std::function<void(const DepositionReport &)> &progress = {});
 

@@ -31,6 +31,8 @@ public:
 
     /// Reorders every array so that new index k holds old index `order[k]`.
     void permute(const std::vector<std::size_t> &order);
+    /// Keeps only the particles at storage indices `kept` (ascending), dropping the others.
+    void keep(const std::vector<std::size_t> &kept);
 
     /// True when all three principal moments of particle i are equal (no frame transforms needed).
     bool isotropic(std::size_t i) const {
@@ -55,6 +57,7 @@ public:
     std::vector<int> material;          ///< index into the material table
 
 private:
+    void select(const std::vector<std::size_t> &order); ///< new index k holds old order[k]
     ParticleId next_id_ = 0;
 };
 

@@ -26,8 +26,6 @@ struct RunSummary {
 /// soil setup was settled before, else deposited, settled and cached. No bodies yet.
 std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progress_interval_s,
                                        bool *from_cache = nullptr);
-/// Height of a settled bed's surface: 98th percentile of grain tops (robust to stray grains).
-double bedSurface(const ParticleStore &particles);
 
 /// Runs to the end; throws (after saving what is readable) on bad input or a failed step.
 RunSummary runScenario(const DemScenario &scenario, const RunOptions &options);

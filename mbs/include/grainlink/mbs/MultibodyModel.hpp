@@ -2,6 +2,8 @@
 // The one interface every multibody model implements (design.md, mbs/): the bodies it couples to
 // the soil, the wrenches it applies, how it advances, the states it reports, save/restore.
 // No ZeroMQ, no protobuf: the multibody node (apps/) translates to and from the wire.
+#include "grainlink/body/BodyDescription.hpp"
+
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
@@ -22,35 +24,13 @@ public:
     using std::runtime_error::runtime_error;
 };
 
-/// Parameters of a wheel both sides build the same mesh from (axis = body y).
-struct WheelShape {
-    double diameter_m = 0.25;       ///< [m] rim outer diameter
-    double width_m = 0.1;           ///< [m]
-    double rim_thickness_m = 0.005; ///< [m]
-    unsigned grouser_count = 0;
-    double grouser_height_m = 0.0;    ///< [m]
-    double grouser_thickness_m = 0.0; ///< [m]
-    bool chevron = false;
-    double chevron_angle_deg = 0.0; ///< [deg]
-    bool closed_sides = true;
-};
-
-/// A closed triangle mesh in the body frame (outward normals by the right-hand rule), for
-/// coupled bodies that are not wheels (the mole's hull, a user's mesh).
-struct MeshShape {
-    std::vector<Vec3> vertices_m;              ///< [m] body frame
-    std::vector<std::array<int, 3>> triangles; ///< vertex indices, counter-clockwise from outside
-};
-
-/// A body that touches the soil.
-struct CoupledBody {
-    std::string name;
-    double mass_kg = 0.0;                       ///< [kg]
-    Vec3 center_of_mass_m = Vec3::Zero();       ///< [m] body frame
-    Vec3 inertia_diagonal_kg_m2 = Vec3::Zero(); ///< [kg m^2] about the centre of mass
-    WheelShape wheel;                           ///< its geometry, unless `mesh` is set
-    std::optional<MeshShape> mesh;              ///< replaces `wheel` when set
-};
+// A body that touches the soil, described once (grainlink/body): the handshake carries it
+// unchanged and the soil builds its mesh from it.
+using body::BodyDescription;
+using body::GrouserShape;
+using body::MassProperties;
+using body::MeshShape;
+using body::WheelShape;
 
 /// Pose and velocity of a body origin, world frame.
 struct RigidState {
@@ -70,7 +50,7 @@ class MultibodyModel {
 public:
     virtual ~MultibodyModel() = default;
 
-    virtual std::vector<CoupledBody> coupledBodies() const = 0;
+    virtual std::vector<BodyDescription> coupledBodies() const = 0;
     /// The soil's wrench on each coupled body (in coupledBodies() order) until the next call.
     virtual void applyWrenches(const std::vector<Wrench> &wrenches) = 0;
     /// Integrates to `time_s`; returns the work [J] the applied wrenches did on each body.

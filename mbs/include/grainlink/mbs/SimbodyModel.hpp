@@ -17,7 +17,7 @@ struct IntegratorSettings {
 
 class SimbodyModel : public MultibodyModel {
 public:
-    std::vector<CoupledBody> coupledBodies() const override { return coupled_; }
+    std::vector<BodyDescription> coupledBodies() const override { return coupled_; }
     void applyWrenches(const std::vector<Wrench> &wrenches) override;
     std::vector<double> advanceTo(double time_s) override;
     double time() const override { return state_.getTime(); }
@@ -31,7 +31,7 @@ public:
 protected:
     SimbodyModel(const Vec3 &gravity_m_s2, const IntegratorSettings &integrator);
     /// Registers a body that touches the soil (in the order wrenches and states use).
-    void addCoupled(const CoupledBody &body, const SimTK::MobilizedBody &mobod);
+    void addCoupled(const BodyDescription &body, const SimTK::MobilizedBody &mobod);
     /// Call once every body, force and constraint exists: builds the initial State.
     void finishBuilding();
     /// A derived model's own state beyond Q and U (its controller), one line, for checkpoints.
@@ -48,7 +48,7 @@ protected:
 
 private:
     IntegratorSettings integrator_settings_;
-    std::vector<CoupledBody> coupled_;
+    std::vector<BodyDescription> coupled_;
     std::vector<SimTK::MobilizedBody> coupled_bodies_;
     std::vector<Wrench> applied_;
     SimTK::State state_, saved_;

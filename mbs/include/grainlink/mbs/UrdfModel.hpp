@@ -8,6 +8,7 @@
 
 #include <optional>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace grainlink::mbs {
@@ -48,9 +49,8 @@ struct UrdfJointSettings {
 struct UrdfCoupledLink {
     std::string link;
     std::string name;              ///< name on the wire; the link name unless given
-    WheelShape wheel;              ///< parametric wheel (axis = link y, centre = link origin)
-    std::optional<MeshShape> mesh; ///< replaces `wheel`: an STL read at parse time
-    std::string mesh_file;         ///< where the mesh came from (for messages)
+    /// A parametric wheel (axis = link y, centre = link origin) or an STL read at parse time.
+    std::variant<std::monostate, MeshShape, WheelShape> geometry;
 };
 
 struct UrdfModelSettings {

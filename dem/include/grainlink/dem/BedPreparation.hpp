@@ -1,0 +1,60 @@
+#pragma once
+// A settled bed prepared the way test beds are: struck off level at a height, compacted by a
+// plate held at a pressure, topped by a stiffer crust; and the bed's surface and packing
+// fraction (docs/physics.md §6.1). deposit() runs these steps in that order.
+#include "grainlink/dem/DemSystem.hpp"
+
+#include <cstddef>
+
+namespace grainlink::dem {
+
+/// `deposition.compaction`: a rigid plate over the region's footprint comes down at speed_m_s,
+/// is held by a force servo at pressure_Pa x footprint area for hold_time_s, and is lifted off.
+struct CompactionSpec {
+    double pressure_Pa = 0.0; ///< [Pa] on the footprint; > 0
+    double hold_time_s = 0.1; ///< [s] at the pressure
+    double speed_m_s = 0.05;  ///< [m/s] approach and lift speed (the servo's clamp)
+    void validate() const;    ///< throws std::invalid_argument naming the member
+};
+
+/// `deposition.crust`: the grains whose tops lie within thickness_m of the bed surface get a
+/// stiffer copy of their material (crustMaterial()).
+struct CrustSpec {
+    double thickness_m = 0.0;           ///< [m] below the surface; > 0
+    double youngs_modulus_factor = 1.0; ///< E_crust / E; > 0 and not 1
+    int material = 1;                   ///< the crust's index in the system's material table
+    void validate() const;              ///< throws std::invalid_argument naming the member
+};
+
+/// The crust's material: the soil's, Young's modulus times the factor (density and Poisson
+/// ratio unchanged).
+Material crustMaterial(const Material &soil, const CrustSpec &crust);
+
+/// Height of a settled bed's surface: 98th percentile of grain tops (robust to stray grains).
+double bedSurface(const ParticleStore &particles);
+/// Solid fraction of the bed below its surface: grain volume / (footprint area x (surface -
+/// floor)), the floor being the lowest grain bottom.
+double packingFraction(const ParticleStore &particles, double footprint_area_m2);
+
+/// Removes every grain whose centre lies above height_m (a blade there carries those off and
+/// presses the others down); keeps every other grain's contact histories. Returns how many
+/// went; throws if none would be left. Does not settle.
+std::size_t strikeOff(DemSystem &system, double height_m);
+
+struct CompactionReport {
+    double target_force_N = 0.0; ///< [N] pressure x footprint area
+    double hold_force_N = 0.0;   ///< [N] plate's mean reaction over the second half of the hold
+    double time_s = 0.0;         ///< [s] simulated from the plate's approach to its lift-off
+};
+
+/// Compacts the bed under a plate spanning the x-y footprint [lower_m, upper_m] (docs/physics.md
+/// §6.1). The system must have no mesh bodies; it has none afterwards. Does not settle.
+CompactionReport compact(DemSystem &system, const CompactionSpec &spec, const Vec3 &lower_m,
+                         const Vec3 &upper_m);
+
+/// Gives the crust's grains material crust.material, which the system's table must hold as
+/// crustMaterial() of their own; returns how many. Throws if the stiffer crust needs a smaller
+/// time step (docs/physics.md §3.3). Does not settle.
+std::size_t applyCrust(DemSystem &system, const CrustSpec &crust);
+
+} // namespace grainlink::dem
