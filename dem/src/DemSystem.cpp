@@ -487,22 +487,31 @@ void DemSystem::meshContacts() {
 void DemSystem::checkOverlaps() {
     PhaseTimer::Scope scope(timer_, phase_.check);
     max_overlap_ratio_ = 0.0;
-    std::pair<ParticleId, ParticleId> worst{0, 0};
+    WorstOverlap worst;
     for (WorstOverlap &w : worst_) {
         if (w.ratio > max_overlap_ratio_) {
             max_overlap_ratio_ = w.ratio;
-            worst = {w.i, w.j};
+            worst = w;
         }
         w.ratio = 0.0;
     }
     if (max_overlap_ratio_ > settings_.max_overlap_ratio) {
+        // Name what the grain overlaps: a plane (a box's side) and a mesh body (a plate, a
+        // wheel) are both walls to the contact law, but call for different looks.
+        std::string against;
+        if (worst.i != worst.j)
+            against = "particle " + std::to_string(worst.j);
+        else if (worst.plane >= 0)
+            against = "plane '" + planes_.planes()[std::size_t(worst.plane)].name + "'";
+        else if (worst.body >= 0)
+            against = "body '" + meshes_.body(worst.body).name() + "'";
+        else
+            against = "a wall";
         std::ostringstream msg;
-        msg << "= " << max_overlap_ratio_ << " of the radius"
-            << (worst.first != worst.second ? " against particle " + std::to_string(worst.second)
-                                            : std::string(" against a wall"))
+        msg << "= " << max_overlap_ratio_ << " of the radius against " << against
             << " exceeds max_overlap_ratio " << settings_.max_overlap_ratio
             << " (time step too large or stiffness too low)";
-        throw SimulationError(step_ + 1, worst.first, "overlap", msg.str());
+        throw SimulationError(step_ + 1, worst.i, "overlap", msg.str());
     }
 }
 

@@ -171,3 +171,76 @@ TEST_CASE("A flat mesh acts exactly like its plane for a sliding and rolling sph
         }
     }
 }
+
+TEST_CASE("A grain under a disc's centre, in reach of every fan triangle, feels the face it "
+          "presses on",
+          "[dem][contact][walls][mesh]") {
+    // The bevameter's plate: a closed disc whose bottom cap is a fan of 48 triangles around a
+    // centre vertex. A grain pressing on the cap near the centre has every fan triangle within
+    // its radius: 48 touches, more than a particle keeps (16). The nearest (the face under the
+    // grain) must be among those kept, wherever the grain is around the centre: the force must be
+    // the plane's. Keeping the first 16 candidates instead (fan triangles 0..15 by index) lost the
+    // face under a grain in the other 32 wedges: only a far, tilted edge contact was left (in the
+    // lab bevameter ~2 N where Hertz gives ~60 N), the plate sank into the grain and the run
+    // stopped at overlap 0.74 r "against a wall", a grain 1.4 mm from a 20 mm plate's centre.
+    const int segments = 48;
+    const double disc_radius = 10.0 * kRadius, thickness = 2.0 * kRadius;
+    TriangleMesh disc = makeCylinder(disc_radius, thickness, segments);
+    for (Vec3& v : disc.vertices_m)
+        v = Vec3(v.x(), -v.z(), v.y() + 0.5 * thickness); // axis z, bottom cap in z = 0
+    const ContactLaw law = hertzViscous(0.1, 1000.0, 30.0, 20.0);
+    const DemSettings settings = quietSettings(1e-7);
+    const double overlap = 0.2 * kRadius, off_centre = 0.3 * kRadius;
+    for (int wedge = 0; wedge < segments; ++wedge) {
+        // Cap triangle k spans the angles [k, k + 1] * 2 pi / segments (measured x -> -y here).
+        const double a = 2.0 * M_PI * (wedge + 0.5) / segments;
+        const Vec3 at(off_centre * std::cos(a), -off_centre * std::sin(a), -(kRadius - overlap));
+        INFO("wedge " << wedge);
+        DemSystem plane(law, {kMaterial}, settings), mesh(law, {kMaterial}, settings);
+        PlaneWall bottom;
+        bottom.name = "bottom";
+        bottom.normal = Vec3(0, 0, -1);
+        plane.addPlane(bottom);
+        mesh.addBody(MeshBody("disc", disc, {}));
+        for (DemSystem* sys : {&plane, &mesh})
+            sys->particles().add(sphere(at, kRadius, kMaterial.density_kg_m3));
+        plane.step();
+        mesh.step();
+        // Every fan triangle is in reach: the grain is nearer the centre vertex than its radius.
+        REQUIRE(std::hypot(off_centre, kRadius - overlap) < kRadius);
+        const Vec3 expected = plane.particles().force[0];
+        REQUIRE(expected.z() < -1.0); // Hertz at 0.2 r: a few N, pushing the grain down
+        CHECK((mesh.particles().force[0] - expected).norm() < 1e-9 * expected.norm());
+        CHECK((mesh.body(0).force_N + expected).norm() < 1e-9 * expected.norm());
+        CHECK(mesh.maxOverlapRatio() == Approx(plane.maxOverlapRatio()).epsilon(1e-9));
+    }
+}
+
+TEST_CASE("An overlap beyond max_overlap_ratio names the plane or the mesh body it is against",
+          "[dem][contact][walls][mesh]") {
+    // Both are walls to the contact law, but a box's side and a plate call for different looks:
+    // the message used to say "against a wall" for either.
+    const ContactLaw law = hertzViscous(0.1, 1000.0, 30.0, 20.0);
+    const DemSettings settings = quietSettings(1e-7);
+    const Vec3 deep(0.001, 0.002, kRadius - 0.5 * kRadius); // 0.5 r into z = 0, from above
+    const auto message = [&](DemSystem& sys) {
+        sys.particles().add(sphere(deep, kRadius, kMaterial.density_kg_m3));
+        try {
+            sys.step();
+        } catch (const SimulationError& e) {
+            CHECK(e.quantity == "overlap");
+            return std::string(e.what());
+        }
+        return std::string("no error");
+    };
+    DemSystem plane(law, {kMaterial}, settings), mesh(law, {kMaterial}, settings);
+    PlaneWall floor;
+    floor.name = "bin.zmin";
+    plane.addPlane(floor);
+    mesh.addBody(MeshBody("plate", makeRectangle(0.1, 0.1, 4, 4), {}));
+    const std::string at_plane = message(plane), at_mesh = message(mesh);
+    INFO(at_plane << "\n" << at_mesh);
+    CHECK(at_plane.find("= 0.5 of the radius against plane 'bin.zmin' exceeds") !=
+          std::string::npos);
+    CHECK(at_mesh.find("= 0.5 of the radius against body 'plate' exceeds") != std::string::npos);
+}

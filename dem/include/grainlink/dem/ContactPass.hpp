@@ -16,12 +16,16 @@ constexpr std::size_t kContactBatch = 128;
 /// Largest overlap relative to the smaller radius that one thread met in a step, and where.
 struct WorstOverlap {
     double ratio = 0.0;
-    ParticleId i = 0, j = 0; ///< the pair; j == i against a wall
-    void offer(double overlap_m, double radius_m, ParticleId a, ParticleId b) {
+    ParticleId i = 0, j = 0;   ///< the pair; j == i against a wall
+    int plane = -1, body = -1; ///< against a wall: the plane's or the mesh body's index
+    void offer(double overlap_m, double radius_m, ParticleId a, ParticleId b, int plane_k = -1,
+               int body_k = -1) {
         if (overlap_m > ratio * radius_m) { // no division for the (common) smaller overlap
             ratio = overlap_m / radius_m;
             i = a;
             j = b;
+            plane = plane_k;
+            body = body_k;
         }
     }
 };

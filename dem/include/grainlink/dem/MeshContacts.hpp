@@ -131,6 +131,13 @@ void MeshContacts::compute(ParticleStore &p, const Law &law, double dt_s,
         };
         constexpr int kMaxTouches = 16;
         Touch touches[kMaxTouches];
+        // Nearest first, ties by (body, triangle): the order of the touches, and of which are
+        // kept when more than kMaxTouches are in reach.
+        const auto nearer = [](const Touch &a, const Touch &b) {
+            return a.dist != b.dist
+                       ? a.dist < b.dist
+                       : (a.body != b.body ? a.body < b.body : a.triangle < b.triangle);
+        };
         MeshContactSlot next[kSlots];
         WorstOverlap worst = worst_by_thread[std::size_t(t)]; // the pair pass's
         const std::size_t candidates = particles_.size();
@@ -147,20 +154,29 @@ void MeshContacts::compute(ParticleStore &p, const Law &law, double dt_s,
                 const auto &ids = bodies_[std::size_t(b)].mesh().triangles[std::size_t(tri)];
                 const Vec3 q = closestPointOnTriangle(xi, v[ids[0]], v[ids[1]], v[ids[2]]);
                 const double dist_sq = (xi - q).squaredNorm();
-                if (dist_sq >= ri * ri || count == kMaxTouches)
+                if (dist_sq >= ri * ri)
                     continue;
-                touches[count++] = {b, tri, q, std::sqrt(dist_sq)};
+                const Touch touch{b, tri, q, std::sqrt(dist_sq)};
+                if (count < kMaxTouches) {
+                    touches[count++] = touch;
+                    continue;
+                }
+                // Full (a grain at a vertex many triangles share, such as a disc's centre): the
+                // farthest gives way, so the nearest kMaxTouches are kept, the face the grain
+                // presses on among them. Keeping the first ones in candidate order could drop it.
+                int farthest = 0;
+                for (int k = 1; k < count; ++k)
+                    if (nearer(touches[farthest], touches[k]))
+                        farthest = k;
+                if (nearer(touch, touches[farthest]))
+                    touches[farthest] = touch;
             }
             // Nearest first. A touch whose point lies in (or behind) the tangent plane of a
             // nearer accepted touch of the same body is that surface again, seen through a
             // neighbouring triangle's edge or vertex (a point shared by two triangles is the
             // extreme case): counting it would add a second, tilted force wherever a sphere
             // overlaps a flat mesh near an edge. Concave corners keep both faces.
-            std::sort(touches, touches + count, [](const Touch &a, const Touch &b) {
-                return a.dist != b.dist
-                           ? a.dist < b.dist
-                           : (a.body != b.body ? a.body < b.body : a.triangle < b.triangle);
-            });
+            std::sort(touches, touches + count, nearer);
             int used = 0, accepted_count = 0;
             int accepted[kMaxTouches];
             Vec3 accepted_normal[kMaxTouches];
@@ -208,7 +224,7 @@ void MeshContacts::compute(ParticleStore &p, const Law &law, double dt_s,
                 auto &loads = triangle_force[std::size_t(touch.body)];
                 if (!loads.empty())
                     loads[std::size_t(touch.triangle)] -= r.force_on_i_N;
-                worst.offer(g.overlap_m, ri, p.id[i], p.id[i]);
+                worst.offer(g.overlap_m, ri, p.id[i], p.id[i], -1, touch.body);
                 if (used < kSlots)
                     next[used++] = {touch.body, touch.triangle, n_c, h};
             }

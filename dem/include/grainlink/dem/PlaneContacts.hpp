@@ -164,7 +164,7 @@ public:
                 force[i] += r.force_on_i_N;
                 torque[i] += r.torque_on_i_N_m;
                 force_sum_[w] -= r.force_on_i_N;
-                worst.offer(g.overlap_m, ri, p_.id[i], p_.id[i]);
+                worst.offer(g.overlap_m, ri, p_.id[i], p_.id[i], int(w));
             }
         }
         next_ = stop;
