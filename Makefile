@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: deps configure build demo test bench clean
+.PHONY: deps configure build demo test bench gap-selftest clean
 
 deps:
 	@scripts/install-deps
@@ -22,6 +22,11 @@ test: build
 
 bench: build
 	@bench/run-all $(BUILD)
+
+# The full blind self-test of the sim-to-real diagnosis (docs/gap.md, "The self-test"): hours on
+# two cores; prints the score line and the confusion matrix.
+gap-selftest: build
+	OMP_WAIT_POLICY=PASSIVE $(BUILD)/apps/grainlink gap selftest --scale full --jobs 2
 
 clean:
 	rm -rf $(BUILD)

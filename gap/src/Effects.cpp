@@ -426,9 +426,9 @@ YAML::Node applyEffect(const Effect &effect, double s, const YAML::Node &scenari
         return out;
     }
     if (effect.builtin == "domain_size") {
-        // A direct shear box is the test's own geometry (its size is a measured condition),
-        // not a container around the bed.
-        if (type != ExperimentType::DirectShear)
+        // A direct shear box and a repose tube are the test's own geometry (their sizes are
+        // measured conditions), not a container around the bed.
+        if (type != ExperimentType::DirectShear && type != ExperimentType::AngleOfRepose)
             applyDomainSize(out, s);
         return out;
     }

@@ -33,8 +33,11 @@ void acceptedByTheLab(const StudySimulator &sim, const Design &design, const Var
 
 } // namespace
 
-TEST_CASE("every effect and numerical check on the CI design is a scenario the lab accepts",
+TEST_CASE("every effect and numerical check on the self-tests' designs is a scenario the lab "
+          "accepts",
           "[gap][simulator]") {
+    const std::string kDir = GENERATE(std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-ci",
+                                      std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-full");
     const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-simulator-test";
     fs::remove_all(scratch);
     fs::create_directories(scratch);
