@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <sstream>
 
 namespace grainlink::config {
@@ -19,8 +20,14 @@ ConfigNode::ConfigNode(YAML::Node node, std::shared_ptr<const std::string> file,
       used_(std::make_shared<std::set<std::string>>()) {}
 
 ConfigNode ConfigNode::loadFile(const std::string &path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec))
+        throw ConfigError(path + ": is a folder, not a YAML file");
     try {
-        return ConfigNode(YAML::LoadFile(path), std::make_shared<std::string>(path), "");
+        YAML::Node root = YAML::LoadFile(path);
+        if (!root || root.IsNull())
+            throw ConfigError(path + ":1: the file is empty");
+        return ConfigNode(std::move(root), std::make_shared<std::string>(path), "");
     } catch (const YAML::BadFile &) {
         throw ConfigError(path + ": cannot open file");
     } catch (const YAML::ParserException &e) {
@@ -51,9 +58,29 @@ bool ConfigNode::has(const std::string &key) const {
     return node_.IsMap() && node_[key];
 }
 
+void ConfigNode::refuseDuplicate(const std::string &key) const {
+    // yaml-cpp keeps every pair of a mapping and looks up the first: a second one would be
+    // silently ignored.
+    int first_line = 0;
+    for (const auto &entry : node_) {
+        if (!entry.first.IsScalar() || entry.first.Scalar() != key)
+            continue;
+        if (first_line == 0) {
+            first_line = entry.first.Mark().line + 1;
+            continue;
+        }
+        std::ostringstream out;
+        out << *file_ << ":" << entry.first.Mark().line + 1 << ": key '"
+            << (path_.empty() ? key : path_ + "." + key) << "' given twice (first at line "
+            << first_line << ")";
+        throw ConfigError(out.str());
+    }
+}
+
 ConfigNode ConfigNode::operator[](const std::string &key) const {
     if (!node_.IsMap())
         fail("expected a mapping with key '" + key + "'");
+    refuseDuplicate(key);
     used_->insert(key);
     const YAML::Node child = node_[key];
     const std::string child_path = path_.empty() ? key : path_ + "." + key;
@@ -97,6 +124,7 @@ bool ConfigNode::isNumber() const {
 std::optional<ConfigNode> ConfigNode::optional(const std::string &key) const {
     if (!node_.IsMap())
         fail("expected a mapping");
+    refuseDuplicate(key);
     used_->insert(key);
     if (!node_[key] || node_[key].IsNull())
         return std::nullopt;
@@ -134,11 +162,48 @@ double ConfigNode::positive() const {
     return v;
 }
 
+double ConfigNode::nonNegative() const {
+    const double v = number();
+    if (!(v >= 0.0))
+        fail("must be >= 0, got " + node_.Scalar());
+    return v;
+}
+
+double ConfigNode::number(double lo, double hi) const {
+    const double v = number();
+    if (!(v >= lo && v <= hi)) {
+        std::ostringstream range;
+        range << "must be in [" << lo << ", " << hi << "], got " << node_.Scalar();
+        fail(range.str());
+    }
+    return v;
+}
+
 long long ConfigNode::integer() const {
     const double v = number();
     if (v != std::floor(v))
         fail("expected a whole number, got " + node_.Scalar());
+    // Beyond 2^53 a double no longer holds every whole number, and the cast may overflow.
+    if (std::abs(v) > 9.0e15)
+        fail("whole number out of range, got " + node_.Scalar());
     return static_cast<long long>(v);
+}
+
+long long ConfigNode::integer(long long lo, long long hi) const {
+    const long long v = integer();
+    if (v < lo || v > hi)
+        fail("must be a whole number in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+             "], got " + node_.Scalar());
+    return v;
+}
+
+std::vector<double> ConfigNode::positives() const {
+    std::vector<double> out;
+    for (const ConfigNode &item : items())
+        out.push_back(item.positive());
+    if (out.empty())
+        fail("give at least one value");
+    return out;
 }
 
 bool ConfigNode::boolean() const {
@@ -184,6 +249,12 @@ std::vector<double> ConfigNode::numbers() const {
 double ConfigNode::number(const std::string &key, double fallback) const {
     const auto n = optional(key);
     return n ? n->number() : fallback;
+}
+
+long long ConfigNode::integer(const std::string &key, long long lo, long long hi,
+                              long long fallback) const {
+    const auto n = optional(key);
+    return n ? n->integer(lo, hi) : fallback;
 }
 
 std::string ConfigNode::text(const std::string &key, const std::string &fallback) const {

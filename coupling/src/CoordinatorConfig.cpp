@@ -29,10 +29,7 @@ SchemeKind schemeFrom(const ConfigNode &node) {
 }
 
 unsigned count(const ConfigNode &node, long long minimum) {
-    const long long n = node.integer();
-    if (n < minimum)
-        node.fail("must be at least " + std::to_string(minimum));
-    return static_cast<unsigned>(n);
+    return static_cast<unsigned>(node.integer(minimum, std::numeric_limits<unsigned>::max()));
 }
 
 } // namespace

@@ -333,12 +333,10 @@ DepositionSpec parseDeposition(const ConfigNode &node) {
     region.finish();
     if ((d.region_upper_m - d.region_lower_m).minCoeff() <= 0.0)
         region.fail("upper_m must exceed lower_m on every axis");
-    d.count = std::size_t(node["count"].integer());
-    if (d.count == 0)
-        node["count"].fail("must be > 0");
+    d.count = std::size_t(node["count"].integer(1, kMaxGrains));
     d.radius = parseRadius(node["radius"]);
     d.seed = std::uint64_t(node.number("seed", 1.0));
-    d.layers = int(node.number("layers", 1.0));
+    d.layers = int(node.integer("layers", 1, kMaxLayers, 1));
     d.layer_interval_s = node.number("layer_interval_s", 0.1);
     d.settle_kinetic_energy_J = node.number("settle_kinetic_energy_J", 1e-9);
     d.max_settle_time_s = node.number("max_settle_time_s", 5.0);
@@ -354,7 +352,7 @@ TriangleMesh parseMesh(const ConfigNode &node, const std::string &scenario_dir) 
     TriangleMesh mesh;
     if (type == "cylinder") {
         mesh = makeCylinder(node["radius_m"].positive(), node["width_m"].positive(),
-                            int(node.number("segments", 72)));
+                            int(node.integer("segments", 3, kMaxMeshSegments, 72)));
     } else {
         std::string file = node["file"].text();
         if (!file.empty() && file[0] != '/')
@@ -429,11 +427,9 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
         s.settings.gravity_m_s2 = gravityOf(*g);
     if (const auto g = sim.optional("gravity_m_s2"))
         s.settings.gravity_m_s2 = g->vec3();
-    s.settings.threads = int(sim.number("threads", 1.0));
-    if (s.settings.threads < 1)
-        sim["threads"].fail("must be >= 1");
+    s.settings.threads = int(sim.integer("threads", 1, kMaxThreads, 1));
     s.settings.skin_m = sim.number("skin_m", 0.0);
-    s.settings.resort_every_builds = int(sim.number("resort_every_builds", 25.0));
+    s.settings.resort_every_builds = int(sim.integer("resort_every_builds", 0, 1000000, 25));
     s.settings.max_overlap_ratio = sim.number("max_overlap_ratio", 0.4);
     s.settings.check_time_step = sim.boolean("check_time_step", true);
     sim.finish();

@@ -43,7 +43,7 @@ Plan loadPlan(const std::string &path) {
         for (const ConfigNode &e : root["catalogue"].items())
             p.catalogue.push_back(e.text());
     if (root.has("nulls"))
-        p.nulls = int(root["nulls"].integer());
+        p.nulls = int(root["nulls"].integer(0, 100));
     if (const auto o = root.optional("out_of_catalogue"))
         for (const ConfigNode &e : o->items()) {
             p.out_of_catalogue.emplace_back(e["effect"].text(), e["strength"].number());

@@ -1,6 +1,7 @@
 #include "grainlink/gap/StudySimulator.hpp"
 
 #include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/LabSummary.hpp"
 #include "grainlink/study/ScenarioEdit.hpp"
 
@@ -168,18 +169,10 @@ BaseModel loadBaseModel(const std::string &path) {
             box.finish();
         }
     if (const auto n = root.optional("numerics")) {
-        const auto count = [&](const char *key, int fallback, int lo, int hi) {
-            if (!n->has(key))
-                return fallback;
-            const long long v = (*n)[key].integer();
-            if (v < lo || v > hi)
-                (*n)[key].fail("must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
-            return int(v);
-        };
-        b.seeds = count("seeds", 3, 2, 64);
-        b.signature_seeds = count("signature_seeds", 2, 1, 64);
-        b.check_seeds = count("check_seeds", 2, 1, 64);
-        b.threads = count("threads", 1, 1, 256);
+        b.seeds = int(n->integer("seeds", 2, 64, 3));
+        b.signature_seeds = int(n->integer("signature_seeds", 1, 64, 2));
+        b.check_seeds = int(n->integer("check_seeds", 1, 64, 2));
+        b.threads = int(n->integer("threads", 1, dem::kMaxThreads, 1));
         if (const auto checks = n->optional("checks"))
             for (const std::string &c : checks->keys()) {
                 static const std::set<std::string> known{"resolution", "time_step", "domain", "rate"};

@@ -90,10 +90,7 @@ Design loadDesign(const std::string &path) {
             stand_in.curves[e.observables[0]] = Curve{{0.0, reach}, {0.0, 0.0}};
         }
         e.trials.push_back(stand_in);
-        const long long repeats = n.has("repeats") ? n["repeats"].integer() : 2;
-        if (repeats < 1 || repeats > 32)
-            n["repeats"].fail("must be in [1, 32]");
-        d.repeats[e.id] = int(repeats);
+        d.repeats[e.id] = int(n.integer("repeats", 1, 32, 2));
         n.finish();
         d.set.experiments.push_back(std::move(e));
     }

@@ -2,6 +2,7 @@
 
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/dem/TriangleMesh.hpp"
 #include "grainlink/lab/LabBed.hpp"
 #include "grainlink/lab/LabConfig.hpp"
 
@@ -46,32 +47,16 @@ BevameterScenario parseBevameter(const config::ConfigNode &root) {
     s.soil = parseLabSoil(root, {"the bevameter adds its own plate", {}, {}});
     const auto b = root["bevameter"];
     BevameterSpec &t = s.test;
-    const auto radii = b["plate_radii_m"];
-    t.plate_radii_m = radii.numbers();
-    if (t.plate_radii_m.empty())
-        radii.fail("give at least one plate radius");
-    for (double r : t.plate_radii_m)
-        if (!(r > 0.0))
-            radii.fail("every plate radius must be > 0");
+    t.plate_radii_m = b["plate_radii_m"].positives();
     if (b.has("plate_thickness_m"))
         t.plate_thickness_m = b["plate_thickness_m"].positive();
-    if (b.has("plate_segments")) {
-        t.plate_segments = int(b["plate_segments"].integer());
-        if (t.plate_segments < 8)
-            b["plate_segments"].fail("must be >= 8");
-    }
-    if (b.has("plate_friction_coefficient")) {
-        t.plate_friction_coefficient = b["plate_friction_coefficient"].number();
-        if (*t.plate_friction_coefficient < 0.0)
-            b["plate_friction_coefficient"].fail("must be >= 0");
-    }
+    t.plate_segments = int(b.integer("plate_segments", 8, dem::kMaxMeshSegments, t.plate_segments));
+    if (b.has("plate_friction_coefficient"))
+        t.plate_friction_coefficient = b["plate_friction_coefficient"].nonNegative();
     t.speed_m_s = b["speed_m_s"].positive();
     t.max_sinkage_m = b["max_sinkage_m"].positive();
-    if (b.has("start_clearance_m")) {
-        t.start_clearance_m = b["start_clearance_m"].number();
-        if (t.start_clearance_m < 0.0)
-            b["start_clearance_m"].fail("must be >= 0");
-    }
+    if (b.has("start_clearance_m"))
+        t.start_clearance_m = b["start_clearance_m"].nonNegative();
     if (b.has("sample_interval_s"))
         t.sample_interval_s = b["sample_interval_s"].positive();
     if (b.has("min_resolution"))

@@ -126,13 +126,7 @@ DirectShearScenario parseDirectShear(const config::ConfigNode &root) {
     t.width_m = b["width_m"].positive();
     t.lower_height_m = b["lower_height_m"].positive();
     t.upper_height_m = b["upper_height_m"].positive();
-    const auto stresses = b["normal_stresses_Pa"];
-    t.normal_stresses_Pa = stresses.numbers();
-    if (t.normal_stresses_Pa.empty())
-        stresses.fail("give at least one normal stress");
-    for (double p : t.normal_stresses_Pa)
-        if (!(p > 0.0))
-            stresses.fail("every normal stress must be > 0");
+    t.normal_stresses_Pa = b["normal_stresses_Pa"].positives();
     t.shear_speed_m_s = b["shear_speed_m_s"].positive();
     t.max_displacement_m = b["max_displacement_m"].positive();
     if (t.max_displacement_m >= 0.5 * t.length_m)
@@ -145,18 +139,12 @@ DirectShearScenario parseDirectShear(const config::ConfigNode &root) {
         if (t.residual_fraction > 1.0)
             b["residual_fraction"].fail("must be in (0, 1]");
     }
-    if (b.has("wall_friction_coefficient")) {
-        t.wall_friction_coefficient = b["wall_friction_coefficient"].number();
-        if (*t.wall_friction_coefficient < 0.0)
-            b["wall_friction_coefficient"].fail("must be >= 0");
-    }
+    if (b.has("wall_friction_coefficient"))
+        t.wall_friction_coefficient = b["wall_friction_coefficient"].nonNegative();
     if (b.has("plate_clearance_m"))
         t.plate_clearance_m = b["plate_clearance_m"].positive();
-    if (b.has("start_clearance_m")) {
-        t.start_clearance_m = b["start_clearance_m"].number();
-        if (t.start_clearance_m < 0.0)
-            b["start_clearance_m"].fail("must be >= 0");
-    }
+    if (b.has("start_clearance_m"))
+        t.start_clearance_m = b["start_clearance_m"].nonNegative();
     const auto servo = b["servo"];
     t.servo = parseServo(servo, t.servo, s.warnings);
     if (const auto old = servo.optional("max_consolidation_time_s")) {

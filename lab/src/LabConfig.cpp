@@ -56,22 +56,16 @@ ServoSpec parseServo(const config::ConfigNode &node, const ServoSpec &defaults,
             warnings.push_back(deprecationWarning(*value, node.path() + ".servo." + block_key));
         return value;
     };
-    auto atLeastZero = [](const config::ConfigNode &value) {
-        const double x = value.number();
-        if (x < 0.0)
-            value.fail("must be >= 0");
-        return x;
-    };
     ServoSpec s = defaults;
     s.gain_m_s_per_N = read(names.gain, block.gain, true)->positive();
     if (const auto v = read(names.max_speed, block.max_speed, !(defaults.max_speed_m_s > 0.0)))
         s.max_speed_m_s = v->positive();
     if (const auto v = read(names.deadband, block.deadband, false))
-        s.deadband_N = atLeastZero(*v);
+        s.deadband_N = v->nonNegative();
     if (const auto v = read(names.integral_gain, block.integral_gain, false))
-        s.integral_gain_m_s2_per_N = atLeastZero(*v);
+        s.integral_gain_m_s2_per_N = v->nonNegative();
     if (const auto v = read(names.hold, block.hold, false))
-        s.hold_s = atLeastZero(*v);
+        s.hold_s = v->nonNegative();
     if (const auto v = read(names.max_load_time, block.max_load_time, false))
         s.max_load_time_s = v->positive();
     return s;

@@ -2,6 +2,7 @@
 
 #include "grainlink/dem/Deposition.hpp"
 #include "grainlink/dem/Progress.hpp"
+#include "grainlink/dem/TriangleMesh.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
 #include "grainlink/lab/LabBed.hpp"
 #include "grainlink/lab/LabConfig.hpp"
@@ -62,11 +63,7 @@ ReposeScenario parseRepose(const config::ConfigNode &root) {
     ReposeSpec &t = s.test;
     t.tube_radius_m = r["tube_radius_m"].positive();
     t.tube_height_m = r["tube_height_m"].positive();
-    if (r.has("tube_segments")) {
-        t.tube_segments = int(r["tube_segments"].integer());
-        if (t.tube_segments < 8)
-            r["tube_segments"].fail("must be >= 8");
-    }
+    t.tube_segments = int(r.integer("tube_segments", 8, dem::kMaxMeshSegments, t.tube_segments));
     t.lift_speed_m_s = r["lift_speed_m_s"].positive();
     if (r.has("settle_kinetic_energy_J"))
         t.settle_kinetic_energy_J = r["settle_kinetic_energy_J"].positive();

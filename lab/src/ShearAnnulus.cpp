@@ -1,5 +1,6 @@
 #include "grainlink/lab/ShearAnnulus.hpp"
 
+#include "grainlink/body/WheelShape.hpp"
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
@@ -270,30 +271,14 @@ ShearAnnulusScenario parseShearAnnulus(const config::ConfigNode &root) {
     g.outer_radius_m = b["outer_radius_m"].positive();
     if (!(g.outer_radius_m > g.inner_radius_m))
         b["outer_radius_m"].fail("must exceed inner_radius_m");
-    if (b.has("grouser_count")) {
-        g.grouser_count = int(b["grouser_count"].integer());
-        if (g.grouser_count < 0)
-            b["grouser_count"].fail("must be >= 0");
-    }
-    g.grouser_height_m = b["grouser_height_m"].number();
-    if (g.grouser_height_m < 0.0)
-        b["grouser_height_m"].fail("must be >= 0");
+    g.grouser_count = int(b.integer("grouser_count", 0, body::kMaxGrousers, g.grouser_count));
+    g.grouser_height_m = b["grouser_height_m"].nonNegative();
     if (b.has("grouser_thickness_m"))
         g.grouser_thickness_m = b["grouser_thickness_m"].positive();
     if (b.has("ring_thickness_m"))
         g.ring_thickness_m = b["ring_thickness_m"].positive();
-    if (b.has("ring_segments")) {
-        g.ring_segments = int(b["ring_segments"].integer());
-        if (g.ring_segments < 8)
-            b["ring_segments"].fail("must be >= 8");
-    }
-    const auto pressures = b["normal_pressures_Pa"];
-    t.normal_pressures_Pa = pressures.numbers();
-    if (t.normal_pressures_Pa.empty())
-        pressures.fail("give at least one normal pressure");
-    for (double p : t.normal_pressures_Pa)
-        if (!(p > 0.0))
-            pressures.fail("every normal pressure must be > 0");
+    g.ring_segments = int(b.integer("ring_segments", 8, dem::kMaxMeshSegments, g.ring_segments));
+    t.normal_pressures_Pa = b["normal_pressures_Pa"].positives();
     t.angular_speed_rad_s = b["angular_speed_rad_s"].positive();
     t.max_shear_displacement_m = b["max_shear_displacement_m"].positive();
     if (b.has("approach_speed_m_s"))
@@ -313,18 +298,12 @@ ShearAnnulusScenario parseShearAnnulus(const config::ConfigNode &root) {
     } else {
         (void)b["servo"]; // throws: missing key bevameter_shear.servo
     }
-    if (b.has("start_clearance_m")) {
-        t.start_clearance_m = b["start_clearance_m"].number();
-        if (t.start_clearance_m < 0.0)
-            b["start_clearance_m"].fail("must be >= 0");
-    }
+    if (b.has("start_clearance_m"))
+        t.start_clearance_m = b["start_clearance_m"].nonNegative();
     if (b.has("sample_interval_s"))
         t.sample_interval_s = b["sample_interval_s"].positive();
-    if (b.has("friction_coefficient")) {
-        t.friction_coefficient = b["friction_coefficient"].number();
-        if (*t.friction_coefficient < 0.0)
-            b["friction_coefficient"].fail("must be >= 0");
-    }
+    if (b.has("friction_coefficient"))
+        t.friction_coefficient = b["friction_coefficient"].nonNegative();
     if (b.has("min_resolution"))
         t.min_resolution = b["min_resolution"].positive();
     t.centre_m = parseCentre(b);

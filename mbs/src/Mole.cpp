@@ -1,5 +1,7 @@
 #include "grainlink/mbs/Mole.hpp"
 
+#include "grainlink/dem/TriangleMesh.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -603,12 +605,7 @@ MoleSettings parseMole(const config::ConfigNode &node) {
     };
     auto number = [&](const char *key, double &value) { value = node.number(key, value); };
     auto count = [&](const char *key, unsigned &value, long long least) {
-        if (auto n = node.optional(key)) {
-            const long long v = n->integer();
-            if (v < least)
-                n->fail("must be at least " + std::to_string(least));
-            value = static_cast<unsigned>(v);
-        }
+        value = static_cast<unsigned>(node.integer(key, least, dem::kMaxMeshSegments, value));
     };
     s.hull_name = node.text("hull_name", s.hull_name);
     positive("hull_length_m", s.hull_length_m);

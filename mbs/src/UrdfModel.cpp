@@ -311,13 +311,11 @@ UrdfModelSettings parseUrdfModel(const std::string &yaml_path) {
             }
             if (auto sp = item.optional("spring")) {
                 JointSpring spring;
-                spring.stiffness = sp->number(u.stiffness, 0.0);
-                spring.damping = sp->number(u.damping, 0.0);
+                if (const auto k = sp->optional(u.stiffness))
+                    spring.stiffness = k->nonNegative();
+                if (const auto c = sp->optional(u.damping))
+                    spring.damping = c->nonNegative();
                 spring.rest_position = sp->number(u.rest, 0.0);
-                if (spring.stiffness < 0.0)
-                    (*sp)[u.stiffness].fail("must be >= 0");
-                if (spring.damping < 0.0)
-                    (*sp)[u.damping].fail("must be >= 0");
                 if (spring.stiffness == 0.0 && sp->has(u.rest))
                     (*sp)[u.rest].fail(std::string("a spring without stiffness has no rest "
                                                    "position: give ") +
@@ -331,9 +329,8 @@ UrdfModelSettings parseUrdfModel(const std::string &yaml_path) {
                              "' has no position limits in the URDF to stop at");
                 JointStop stop;
                 stop.stiffness = (*st)[u.stiffness].positive();
-                stop.dissipation = st->number(u.dissipation, 0.0);
-                if (stop.dissipation < 0.0)
-                    (*st)[u.dissipation].fail("must be >= 0");
+                if (const auto d = st->optional(u.dissipation))
+                    stop.dissipation = d->nonNegative();
                 st->finish();
                 j.stop = stop;
             }

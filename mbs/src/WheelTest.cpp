@@ -154,10 +154,7 @@ WheelShape parseWheelShape(const config::ConfigNode &w) {
             t->fail("must be less than the rim radius, " + std::to_string(0.5 * shape.diameter_m) +
                     " m");
     }
-    const long long count = w.has("grouser_count") ? w["grouser_count"].integer() : 0;
-    if (count < 0)
-        w["grouser_count"].fail("must be >= 0");
-    shape.grouser_count = static_cast<unsigned>(count);
+    shape.grouser_count = unsigned(w.integer("grouser_count", 0, body::kMaxGrousers, 0));
     if (shape.grouser_count == 0) {
         for (const char *key :
              {"grouser_height_m", "grouser_thickness_m", "grouser_shape", "chevron_angle_deg"})

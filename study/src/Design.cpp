@@ -15,6 +15,10 @@ using config::ConfigNode;
 
 namespace {
 
+// Bounds against typos: a study of more points than this is a mistake on any cluster we know.
+constexpr long long kMaxPoints = 100'000;
+constexpr long long kMaxReplicates = 10'000;
+
 /// One varied key: its values, each with the line of the study file it came from.
 struct Factor {
     std::string key;
@@ -33,9 +37,7 @@ std::vector<YAML::Node> rangeValues(const ConfigNode &range) {
     const double from = range["from"].number(), to = range["to"].number();
     std::vector<YAML::Node> values;
     if (range.has("count")) {
-        const long long n = range["count"].integer();
-        if (n < 2)
-            range["count"].fail("must be at least 2 (from and to)");
+        const long long n = range["count"].integer(2, kMaxPoints); // from and to at least
         for (long long k = 0; k < n; ++k)
             values.push_back(number(from + (to - from) * double(k) / double(n - 1)));
     } else {
@@ -176,9 +178,9 @@ Study loadStudy(const std::string &path, const std::string &directory,
         if ((replicate_node = design->optional("replicates"))) {
             const ConfigNode &r = *replicate_node;
             if (r.isScalar()) {
-                replicates = int(r.integer());
+                replicates = int(r.integer(1, kMaxReplicates));
             } else {
-                replicates = int(r["count"].integer());
+                replicates = int(r["count"].integer(1, kMaxReplicates));
                 seed_key = r.text("key", seed_key);
                 first_seed = r.has("first") ? r["first"].integer() : 1;
                 r.finish();

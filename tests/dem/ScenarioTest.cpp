@@ -87,6 +87,18 @@ TEST_CASE("scenario errors name the file, the key and the line", "[dem][scenario
         CHECK(msg.find("bad.yaml:8:") == 0);
         CHECK(msg.find("slip_angle_deg") != std::string::npos);
     }
+    SECTION("counts out of range stop at their key, before any memory is taken") {
+        CHECK(errorOf(replaced(kValid, "count: 100", "count: -5")) ==
+              "bad.yaml:13: key 'deposition.count': must be a whole number in [1, 50000000], got -5");
+        CHECK(errorOf(replaced(kValid, "count: 100", "count: 1e9")).find("in [1, 50000000], got 1e9") !=
+              std::string::npos);
+        CHECK(errorOf(replaced(kValid, "gravity: mars", "gravity: mars\n  threads: 100000")) ==
+              "bad.yaml:5: key 'simulation.threads': must be a whole number in [1, 1024], got 100000");
+    }
+    SECTION("a key given twice") {
+        CHECK(errorOf(replaced(kValid, "  count: 100\n", "  count: 100\n  count: 200\n")) ==
+              "bad.yaml:14: key 'deposition.count' given twice (first at line 13)");
+    }
     SECTION("YAML syntax error") {
         const std::string msg =
             errorOf(replaced(kValid, "run: {duration_s: 0.1}", "run: {duration_s: 0.1"));

@@ -9,6 +9,10 @@ enum class GrouserShape {
     Chevron,  ///< a V of two swept-back arms, apex at the mid-plane y = 0
 };
 
+/// The most grousers a wheel or a shear annulus may carry (a bound against typos, far above the
+/// seed's 28).
+constexpr long long kMaxGrousers = 1000;
+
 /// A wheel about the body y axis, centred on the body origin.
 struct WheelShape {
     double diameter_m = 0.25; ///< [m] rim outer diameter, grousers excluded

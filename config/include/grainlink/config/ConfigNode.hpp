@@ -42,8 +42,15 @@ public:
     bool isNumber() const;                 ///< a scalar that reads as a finite number
 
     double number() const;
-    double positive() const;
+    // Range rules: each fails with the file, the key and the line, naming the range.
+    double positive() const;                    ///< > 0
+    double nonNegative() const;                 ///< >= 0
+    double number(double lo, double hi) const;  ///< in [lo, hi]
     long long integer() const;
+    /// A whole number in [lo, hi]: counts and sizes are bounded, so that a wrapped negative or
+    /// an absurd value stops here instead of exhausting memory or a library later.
+    long long integer(long long lo, long long hi) const;
+    std::vector<double> positives() const;      ///< a non-empty list, every item > 0
     bool boolean() const;
     std::string text() const;
     /// One of `choices`; otherwise an error listing them.
@@ -54,6 +61,7 @@ public:
     const YAML::Node &yaml() const { return node_; }
 
     double number(const std::string &key, double fallback) const;
+    long long integer(const std::string &key, long long lo, long long hi, long long fallback) const;
     std::string text(const std::string &key, const std::string &fallback) const;
     bool boolean(const std::string &key, bool fallback) const;
 
@@ -62,6 +70,8 @@ public:
     [[noreturn]] void fail(const std::string &message) const;
 
 private:
+    /// Throws when `key` appears twice in this mapping, naming both lines.
+    void refuseDuplicate(const std::string &key) const;
     ConfigNode(YAML::Node node, std::shared_ptr<const std::string> file, std::string path);
     YAML::Node node_;
     std::shared_ptr<const std::string> file_;

@@ -61,6 +61,13 @@ struct DemScenario {
     OutputSpec output;
 };
 
+/// Bounds on the counts a scenario may ask for: a typo or a wrapped negative stops at its key
+/// instead of exhausting memory (a grain with its contacts costs about 0.5 kB) or crashing a
+/// library (libgomp segfaults at 1e5 threads).
+constexpr long long kMaxGrains = 50'000'000;
+constexpr long long kMaxThreads = 1024;
+constexpr long long kMaxLayers = 100'000;
+
 /// Reads and validates a scenario; errors name the file, key and line.
 DemScenario loadScenario(const std::string &path);
 /// `coupled`: the soil section of a coupled run (no `run:`; bodies come from the coupling).

@@ -29,6 +29,10 @@ void writeStlBinary(const TriangleMesh &mesh, const std::string &path);
 /// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5).
 Vec3 closestPointOnTriangle(const Vec3 &p, const Vec3 &a, const Vec3 &b, const Vec3 &c);
 
+/// The most facets around a parametric body (wheel, plate, ring, tube) a scenario may ask for:
+/// far beyond any grain-resolved need, and small enough that a typo cannot exhaust memory.
+constexpr int kMaxMeshSegments = 100000;
+
 /// Closed cylinder about the body y axis (a wheel without grousers): `segments` facets around.
 TriangleMesh makeCylinder(double radius_m, double width_m, int segments);
 /// Flat rectangle in the z = 0 plane, normal +z, split into 2 * nx * ny triangles.
