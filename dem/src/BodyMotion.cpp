@@ -12,11 +12,11 @@ RigidBodyState SegmentedMotion::at(double t_s) const {
     double remaining = std::max(t_s - start_s, 0.0);
     for (const MotionSegment &seg : segments) {
         const double span = std::min(remaining, seg.duration_s);
-        s.position_m += seg.velocity_m_s * span;
+        s.position_m += seg.linear_velocity_m_s * span;
         s.orientation = rotationFromVector(seg.angular_velocity_rad_s * span) * s.orientation;
         remaining -= span;
         if (remaining <= 0.0) {
-            s.linear_velocity_m_s = seg.velocity_m_s;
+            s.linear_velocity_m_s = seg.linear_velocity_m_s;
             s.angular_velocity_rad_s = seg.angular_velocity_rad_s;
             break;
         }

@@ -388,7 +388,7 @@ BodySpec parseBody(const ConfigNode &node, const std::string &scenario_dir) {
         for (const ConfigNode &seg : motion->items()) {
             MotionSegment m;
             m.duration_s = seg["duration_s"].positive();
-            m.velocity_m_s =
+            m.linear_velocity_m_s =
                 seg.optional("velocity_m_s") ? seg["velocity_m_s"].vec3() : Vec3::Zero();
             m.angular_velocity_rad_s = seg.optional("angular_velocity_rad_s")
                                            ? seg["angular_velocity_rad_s"].vec3()

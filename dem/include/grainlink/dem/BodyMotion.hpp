@@ -26,7 +26,7 @@ struct HeldMotion {};
 /// A stretch of constant linear and angular velocity.
 struct MotionSegment {
     double duration_s = 0.0;
-    Vec3 velocity_m_s = Vec3::Zero();
+    Vec3 linear_velocity_m_s = Vec3::Zero();
     Vec3 angular_velocity_rad_s = Vec3::Zero();
 };
 
