@@ -526,10 +526,16 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // 5. Effects the design cannot tell apart from the leader: the experiment that would.
     if (!winner && !applicable.empty()) {
         // Without an explanation, the leader's near twins (signature overlap >= 0.8 both ways)
-        // are what the design cannot separate.
-        for (std::size_t b = 1; b < applicable.size(); ++b)
-            if (D.overlap[0][b] >= 0.8 && D.overlap[b][0] >= 0.8)
-                D.indistinguishable.push_back(live[applicable[b]].result.name);
+        // are what the design cannot separate. A candidate that the calibration leaves at off,
+        // or whose signature is within the noise, reproduces nothing: not a twin of anything.
+        const auto acts = [&](const CandidateResult &R) {
+            return R.calibration_gain > 1.0 && R.signature_chi2 >= 1.0;
+        };
+        if (acts(live[applicable[0]].result))
+            for (std::size_t b = 1; b < applicable.size(); ++b)
+                if (acts(live[applicable[b]].result) && D.overlap[0][b] >= 0.8 &&
+                    D.overlap[b][0] >= 0.8)
+                    D.indistinguishable.push_back(live[applicable[b]].result.name);
     }
     if (!D.indistinguishable.empty()) {
         const std::string leader = winner ? winner->name : live[applicable.front()].result.name;
