@@ -20,8 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string thisExecutable() { return fs::read_symlink("/proc/self/exe").string(); }
-
 /// A file the program ships (data/..., tools/...): beside the installed program
 /// (<prefix>/share/grainlink), in the source tree of a build (build/apps/grainlink), or under
 /// the current directory.
@@ -46,13 +44,8 @@ std::string duration(double s) {
     return text;
 }
 
-study::ExecutorOptions executorOptions(const std::string &executor, int jobs, double interval) {
-    study::ExecutorOptions o;
-    o.executor = executor == "slurm" ? study::ExecutorOptions::Executor::Slurm
-                                     : study::ExecutorOptions::Executor::Local;
-    o.grainlink = thisExecutable();
-    o.jobs = jobs;
-    o.progress_interval_s = interval;
+study::ExecutorOptions executorOptions(const ExecutorFlags &flags) {
+    study::ExecutorOptions o = flags.options();
     o.progress = [](const study::StudyProgress &p) {
         std::fprintf(stderr, "[gap] simulations: %zu/%zu done (%zu reused), %zu running, %zu failed; %s "
                              "elapsed, ETA %s\n",
@@ -120,13 +113,11 @@ GapCommand::GapCommand(CLI::App &app) {
     selftest_->add_option("--out", out_, "output folder (default out/gap/selftest-<scale>)");
     selftest_->add_option("--seed", seed_, "seed of the strengths and the twins' beds");
 
+    executor_.progress_interval_s = 30.0; // a diagnosis runs for tens of minutes
     for (auto *c : {diagnose_, twin_, selftest_}) {
         c->add_option("--effects", effects_file_, "an effects file added to the catalogue");
         c->add_option("--sims", sims_, "the simulation cache (a study folder; default <out>/sims)");
-        c->add_option("--jobs", jobs_, "simulations at once (local executor)");
-        c->add_option("--executor", executor_, "local or slurm (docs/study.md)")
-            ->check(CLI::IsMember({"local", "slurm"}));
-        c->add_option("--progress-interval", progress_interval_s_, "seconds between progress lines");
+        executor_.addTo(*c);
     }
 
     import_ = command_->add_subcommand("import", "write a measurements folder from raw data");
@@ -181,7 +172,7 @@ int GapCommand::diagnose() const {
         catalogue.find(name); // names an unknown effect
     const std::string out = out_.empty() ? "out/gap/" + set.name : out_;
     gap::StudySimulator sim(base, sims_.empty() ? out + "/sims" : sims_,
-                            executorOptions(executor_, jobs_, progress_interval_s_));
+                            executorOptions(executor_));
     gap::DiagnosisOptions options = diagnosisOptions(base);
     options.held_out = held_out_;
     const gap::Diagnosis d = gap::diagnose(set, effects, sim, options);
@@ -202,7 +193,7 @@ int GapCommand::twin() const {
     const gap::EffectCatalogue catalogue = catalogueWith(effects_file_);
     const gap::Design design = gap::loadDesign(design_);
     gap::StudySimulator sim(base, sims_.empty() ? out_ + ".sims" : sims_,
-                            executorOptions(executor_, jobs_, progress_interval_s_));
+                            executorOptions(executor_));
     gap::TwinOptions o;
     o.seed = seed_;
     o.noise = noise_;
@@ -231,7 +222,7 @@ int GapCommand::selftest() const {
     o.base_model = shipped("scenarios/gap/selftest-" + scale_ + "/base.yaml");
     o.design = shipped("scenarios/gap/selftest-" + scale_ + "/design.yaml");
     o.catalogue = catalogueWith(effects_file_);
-    o.executor = executorOptions(executor_, jobs_, progress_interval_s_);
+    o.executor = executorOptions(executor_);
     o.plot_tool = shipped("tools/gap_report.py");
     const gap::SelftestResult r = gap::runSelftest(o);
     std::printf("%s", r.report.c_str());

@@ -1,6 +1,8 @@
 #pragma once
 // `grainlink gap`: the sim-to-real diagnosis (docs/gap.md) — import measurements, diagnose
 // them against a base model, make twins whose cause is known, and the blind self-test.
+#include "ExecutorFlags.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <optional>
@@ -24,9 +26,8 @@ private:
 
     CLI::App *command_, *diagnose_, *twin_, *selftest_, *import_, *import_cmu_, *import_csv_;
     // shared
-    std::string model_, out_, sims_, effects_file_, executor_ = "local";
-    int jobs_ = 1;
-    double progress_interval_s_ = 30.0;
+    std::string model_, out_, sims_, effects_file_;
+    ExecutorFlags executor_;
     // diagnose
     std::string measurements_;
     std::vector<std::string> held_out_, only_;

@@ -45,10 +45,6 @@ study::Kind kindOf(const std::string &kind, const std::string &test) {
     return k;
 }
 
-std::string thisExecutable() {
-    return fs::read_symlink("/proc/self/exe").string();
-}
-
 /// The closing report: counts, every failed or unfinished point, the tables; exit code.
 int report(const study::Study &s, const std::vector<PointResult> &results) {
     std::size_t done = 0, failed = 0, unfinished = 0, ran = 0;
@@ -84,22 +80,11 @@ StudyCommand::StudyCommand(CLI::App &app) {
                  "observables, locally or through Slurm (docs/study.md)");
     command_->add_option("study", study_path_, "study YAML file");
     command_->add_option("--out", directory_, "the study folder");
-    command_->add_option("--executor", executor_, "local (a process pool) or slurm (a job array)")
-        ->check(CLI::IsMember({"local", "slurm"}));
-    command_->add_option("--jobs", jobs_, "local: runs at once (jobs x threads <= cores)");
+    executor_.addTo(*command_);
     command_->add_option("--threads", threads_,
                          "threads per run (sets each point's simulation.threads)");
-    command_->add_flag("--oversubscribe", oversubscribe_, "local: allow jobs x threads > cores");
-    command_->add_flag("--retry-failed", retry_failed_, "rerun the points that failed before");
-    command_->add_option("--partition", partition_, "slurm: sbatch --partition");
-    command_->add_option("--account", account_, "slurm: sbatch --account");
-    command_->add_option("--time", time_limit_, "slurm: time limit per point (sbatch --time)");
-    command_->add_option("--max-running", max_running_, "slurm: array tasks at once (%M)");
-    command_->add_option("--sbatch-arg", sbatch_args_, "slurm: one more sbatch argument");
     command_->add_flag("--submit-only", submit_only_,
                        "slurm: submit and return; `grainlink study collect DIR` later");
-    command_->add_option("--progress-interval", progress_interval_s_,
-                         "seconds between progress lines");
     collect_ = command_->add_subcommand(
         "collect", "tables of a study folder as it stands (after --submit-only)");
     collect_->add_option("directory", directory_, "the study folder")->required();
@@ -107,7 +92,7 @@ StudyCommand::StudyCommand(CLI::App &app) {
     run_point_->group(""); // not for people: the generated job script calls it
     run_point_->add_option("directory", directory_, "the study folder")->required();
     run_point_->add_option("id", point_id_, "the point's id")->required();
-    run_point_->add_flag("--retry-failed", retry_failed_, "rerun it if it failed before");
+    run_point_->add_flag("--retry-failed", executor_.retry_failed, "rerun it if it failed before");
 }
 
 int StudyCommand::run() const {
@@ -129,23 +114,11 @@ int StudyCommand::runStudy() const {
     design.kind_of = kindOf;
     const study::Study s = study::loadStudy(study_path_, directory_, design);
 
-    study::ExecutorOptions options;
-    options.executor = executor_ == "slurm" ? study::ExecutorOptions::Executor::Slurm
-                                            : study::ExecutorOptions::Executor::Local;
-    options.grainlink = thisExecutable();
-    options.jobs = jobs_;
-    options.oversubscribe = oversubscribe_;
-    options.retry_failed = retry_failed_;
-    options.slurm.partition = partition_;
-    options.slurm.account = account_;
-    options.slurm.time_limit = time_limit_;
-    options.slurm.max_running = max_running_;
-    options.slurm.extra = sbatch_args_;
+    study::ExecutorOptions options = executor_.options();
     options.slurm.submit_only = submit_only_;
-    options.progress_interval_s = progress_interval_s_;
     options.progress = printProgress;
     std::fprintf(stderr, "[study] '%s': %zu points into %s (%s)\n", s.name.c_str(), s.points.size(),
-                 s.directory.c_str(), executor_.c_str());
+                 s.directory.c_str(), executor_.executor.c_str());
     const std::vector<PointResult> results = study::run(s, options);
     const int code = report(s, results);
 
@@ -163,7 +136,7 @@ int StudyCommand::runStudy() const {
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (ran > 0 && options.executor == study::ExecutorOptions::Executor::Local) {
         const double shared_s = std::max(
-            0.0, total_s - runs_s / double(std::min<std::size_t>(std::size_t(jobs_), ran)));
+            0.0, total_s - runs_s / double(std::min<std::size_t>(std::size_t(executor_.jobs), ran)));
         std::printf("study machinery: %.3f s per point (start-up, bookkeeping, collection) over "
                     "%zu runs; %.2f s wall in all\n",
                     point_overhead_s / double(ran) + shared_s / double(results.size()), ran,
@@ -188,7 +161,7 @@ int StudyCommand::runPoint() const {
         if (p.id != point_id_)
             continue;
         const PointResult r =
-            folder.runPoint(p, thisExecutable(), fs::current_path().string(), retry_failed_);
+            folder.runPoint(p, thisExecutable(), fs::current_path().string(), executor_.retry_failed);
         std::printf("point %s (%s): %s%s%s\n", p.id.c_str(), p.label.c_str(),
                     r.status == PointStatus::Done     ? "done"
                     : r.status == PointStatus::Failed ? "failed: "

@@ -1,5 +1,7 @@
 #pragma once
 // `grainlink study STUDY.yaml --out DIR`, `grainlink study collect DIR` (docs/study.md).
+#include "ExecutorFlags.hpp"
+
 #include <CLI/CLI.hpp>
 
 #include <string>
@@ -22,14 +24,9 @@ private:
 
     CLI::App *command_, *collect_, *run_point_;
     std::string study_path_, directory_, point_id_;
-    std::string executor_ = "local";
-    int jobs_ = 1;
+    ExecutorFlags executor_;
     int threads_ = 0; ///< 0: each scenario's own simulation.threads
-    bool oversubscribe_ = false, retry_failed_ = false, submit_only_ = false;
-    std::string partition_, account_, time_limit_;
-    int max_running_ = 0;
-    std::vector<std::string> sbatch_args_;
-    double progress_interval_s_ = 10.0;
+    bool submit_only_ = false;
 };
 
 } // namespace grainlink::apps

@@ -89,11 +89,12 @@ private:
     std::string file_;
 };
 
-/// The multibody side: mass 1 under the coupling force.
-class MassOneNode final : public TwoMassNode {
+/// A side's node around its model: the state handling both sides share (save/restore for
+/// implicit coupling, the checkpoint file, the position the tests read).
+template <class Model> class TwoMassSideNode : public TwoMassNode {
 public:
-    MassOneNode(coupling::Participant &participant, const TwoMassParameters &p,
-                const SideHooks &hooks)
+    TwoMassSideNode(coupling::Participant &participant, const TwoMassParameters &p,
+                    const SideHooks &hooks)
         : TwoMassNode(participant, hooks), model_(p) {}
     void saveState() override { model_.save(); }
     void restoreState() override { model_.restore(); }
@@ -102,6 +103,15 @@ public:
     }
     void readCheckpoint(const std::string &directory) override { model_.read(directory + file()); }
     double x() const override { return model_.x(); }
+
+protected:
+    Model model_;
+};
+
+/// The multibody side: mass 1 under the coupling force.
+class MassOneNode final : public TwoMassSideNode<MassOneSide> {
+public:
+    using TwoMassSideNode::TwoMassSideNode;
 
 private:
     coupling::WindowOutputs advanceModel(const coupling::WindowInputs &in) override {
@@ -111,22 +121,12 @@ private:
         out.work = {{"mass1", work}};
         return out;
     }
-    MassOneSide model_;
 };
 
 /// The soil side: mass 2 and the coupling spring, following mass 1's motion.
-class MassTwoNode final : public TwoMassNode {
+class MassTwoNode final : public TwoMassSideNode<MassTwoSide> {
 public:
-    MassTwoNode(coupling::Participant &participant, const TwoMassParameters &p,
-                const SideHooks &hooks)
-        : TwoMassNode(participant, hooks), model_(p) {}
-    void saveState() override { model_.save(); }
-    void restoreState() override { model_.restore(); }
-    void writeCheckpoint(const std::string &directory) override {
-        model_.write(directory + file());
-    }
-    void readCheckpoint(const std::string &directory) override { model_.read(directory + file()); }
-    double x() const override { return model_.x(); }
+    using TwoMassSideNode::TwoMassSideNode;
 
 private:
     coupling::WindowOutputs advanceModel(const coupling::WindowInputs &in) override {
@@ -139,7 +139,6 @@ private:
                         r.work_on_mass1_J);
         return loads.outputs(in.duration_s);
     }
-    MassTwoSide model_;
 };
 
 /// Runs one side until the coordinator ends the run; returns mass 1's (or mass 2's) final x.
