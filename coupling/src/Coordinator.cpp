@@ -662,6 +662,8 @@ Coordinator::Coordinator(CoordinatorConfig config)
     if (!(c.tick_s > 0.0) || !(c.macro_step_s >= c.tick_s) || !(c.end_time_s > c.start_time_s))
         throw CouplingError(
             "need tick_s > 0, macro_step_s >= tick_s and end_time_s > start_time_s");
+    if (!((c.end_time_s - c.start_time_s) / c.tick_s <= kMaxTicks))
+        throw CouplingError("the run would be more than 1e15 ticks of tick_s long");
     const auto ticks = [&](double seconds) {
         return static_cast<Ticks>(std::llround(seconds / c.tick_s));
     };

@@ -46,6 +46,11 @@ CoordinatorConfig coordinatorConfigFrom(const ConfigNode &root) {
     c.start_time_s = coupling.number("start_time_s", 0.0);
     c.end_time_s = coupling["end_time_s"].number();
     c.macro_step_s = coupling["macro_step_s"].positive();
+    // Time is counted in whole ticks (64-bit); past 1e15 of them a double no longer holds every
+    // tick and the count overflows: a run would end at once, 'complete'.
+    if (!((c.end_time_s - c.start_time_s) / c.tick_s <= kMaxTicks))
+        coupling[coupling.has("tick_s") ? "tick_s" : "end_time_s"].fail(
+            "the run would be more than 1e15 ticks long: raise tick_s or shorten end_time_s");
     if (auto adaptive = coupling.optional("adaptive")) {
         c.min_macro_step_s = (*adaptive)["min_macro_step_s"].positive();
         c.max_macro_step_s = (*adaptive)["max_macro_step_s"].positive();

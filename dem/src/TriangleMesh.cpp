@@ -89,13 +89,19 @@ TriangleMesh readStlAscii(const std::string &path, const std::string &text) {
     std::string line;
     int line_no = 0;
     std::vector<Vec3> facet;
+    bool ended = false;
     while (std::getline(in, line)) {
         ++line_no;
         std::istringstream words(line);
         std::string word;
         if (!(words >> word))
             continue;
-        if (word == "vertex") {
+        if (ended)
+            throw std::runtime_error("STL file '" + path + "', line " + std::to_string(line_no) +
+                                     ": text after 'endsolid'");
+        if (word == "endsolid") {
+            ended = true;
+        } else if (word == "vertex") {
             Vec3 v;
             if (!(words >> v.x() >> v.y() >> v.z()))
                 throw std::runtime_error("STL file '" + path + "', line " +
@@ -110,7 +116,12 @@ TriangleMesh readStlAscii(const std::string &path, const std::string &text) {
             facet.clear();
         }
     }
-    mesh.validate("STL file '" + path + "'");
+    // A file cut off mid-way (a copy that failed, a full disk) would otherwise give a part.
+    if (!ended)
+        throw std::runtime_error("STL file '" + path + "' ends at line " +
+                                 std::to_string(line_no) + " without 'endsolid' after " +
+                                 std::to_string(mesh.triangles.size()) +
+                                 " complete facets: the file is cut off");
     return mesh;
 }
 

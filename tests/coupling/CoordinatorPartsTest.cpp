@@ -413,6 +413,11 @@ TEST_CASE("Limits: read from coupling.limits, checked with the file and line",
                       Catch::Contains("run.yaml:6") && Catch::Contains("max_message_bytes") &&
                           Catch::Contains("in [1024, "));
     CHECK_THROWS_WITH(load("  limits:\n    max_bodys: 8\n"), Catch::Contains("max_bodys"));
+    // A tick so fine that the run's tick count overflows: once a run 'completed' after one
+    // window of 9e-12 s with exit 0.
+    CHECK_THROWS_WITH(load("  tick_s: 1.0e-30\n"),
+                      Catch::Contains("run.yaml:5") && Catch::Contains("tick_s") &&
+                          Catch::Contains("more than 1e15 ticks"));
     // Beats every 10 ms are 100 a second: a limit of 100 would drop them.
     CHECK_THROWS_WITH(load("  heartbeat_interval_s: 0.01\n"),
                       Catch::Contains("heartbeat_interval_s") &&

@@ -88,6 +88,17 @@ TEST_CASE("A malformed STL names the file and the line", "[dem][stl]") {
     CHECK_THROWS_WITH(readStl(file.path), Catch::Contains(file.path) && Catch::Contains("line 6") &&
                                               Catch::Contains("2 vertices"));
 
+    // Cut off after the first of two facets: refused, not read as one triangle.
+    const std::string facet = " facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
+                              "   vertex 0 1 0\n  endloop\n endfacet\n";
+    write("solid cut\n" + facet + " facet normal 0 0 1\n  outer loop\n   vertex 0 0 1\n");
+    CHECK_THROWS_WITH(readStl(file.path), Catch::Contains(file.path) &&
+                                              Catch::Contains("without 'endsolid' after 1 complete") &&
+                                              Catch::Contains("cut off"));
+    write("solid two\n" + facet + "endsolid two\nsolid three\n" + facet + "endsolid three\n");
+    CHECK_THROWS_WITH(readStl(file.path), Catch::Contains("line 10") &&
+                                              Catch::Contains("text after 'endsolid'"));
+
     write("neither ascii nor binary");
     CHECK_THROWS_WITH(readStl(file.path), Catch::Contains(file.path));
     CHECK_THROWS_WITH(readStl(file.path + ".missing"), Catch::Contains("cannot open"));

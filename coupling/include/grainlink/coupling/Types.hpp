@@ -18,6 +18,8 @@ using Vec3 = Eigen::Vector3d;
 using Quat = Eigen::Quaterniond;
 /// Time on the wire is an integer count of ticks (RunInfo::tick_s seconds each).
 using Ticks = std::uint64_t;
+/// The longest run in ticks: below 2^53, so that every tick count is exact as a double.
+constexpr double kMaxTicks = 1e15;
 
 /// The protocol this build speaks; a peer with another major version is refused.
 constexpr std::uint32_t kProtocolMajor = 1;
