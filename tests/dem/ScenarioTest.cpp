@@ -126,6 +126,30 @@ TEST_CASE("a time step above the stability estimate is refused with both numbers
     }
 }
 
+TEST_CASE("the stability estimate is half the Rayleigh time: just above it refused, just below "
+          "it runs",
+          "[dem][scenario]") {
+    // physics.md §3.3 by hand for tiny.yaml's grain (r 4 mm, 2400 kg/m^3, E 3 MPa, nu 0.2):
+    // G = E / (2 (1 + nu)) = 1.25 MPa; T_R = pi r sqrt(rho / G) / (0.1631 nu + 0.8766)
+    // = 6.05608e-4 s; the estimate T_R / 2 = 3.02804e-4 s.
+    const double estimate = 3.02804e-4;
+    for (const double factor : {1.01, 0.99}) {
+        DemScenario s = parseScenario(ConfigNode::loadString(kValid, "tiny.yaml"));
+        s.settings.time_step_s = factor * estimate;
+        auto system = makeSystem(s);
+        ParticleSpec p;
+        p.radius_m = 0.004;
+        p.density_kg_m3 = 2400;
+        p.position_m = Vec3(0.05, 0.05, 0.05);
+        system->particles().add(p);
+        INFO("time step " << factor << " x the estimate");
+        if (factor > 1.0)
+            CHECK_THROWS_WITH(system->step(), Catch::Contains("above the stability estimate 0.000302804 s"));
+        else
+            CHECK_NOTHROW(system->step());
+    }
+}
+
 TEST_CASE("the packing key changes with the soil and not with the run", "[dem][scenario]") {
     const DemScenario a = parseScenario(ConfigNode::loadString(kValid, "tiny.yaml"));
     DemScenario b = a;
