@@ -16,7 +16,7 @@ struct ParamsOptions {
 int runParams(const ParamsOptions &options);
 
 struct LabOptions {
-    std::string test; ///< "bevameter", "repose", "direct_shear" or "bevameter_shear"
+    std::string test; ///< one of lab::labTestNames()
     std::string scenario_path;
     std::string output_directory; ///< empty: out/<scenario name>
     double progress_interval_s = 5.0;

@@ -5,6 +5,7 @@
 #include "Nodes.hpp"
 #include "StudyCommand.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/lab/LabTest.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -105,9 +106,9 @@ int main(int argc, char **argv) {
     grainlink::apps::LabOptions lab_options;
     auto *lab = app.add_subcommand("lab", "virtual soil laboratory test (docs/lab.md)");
     lab->add_option("test", lab_options.test,
-                    "the test: bevameter, repose, direct_shear or bevameter_shear")
+                    "the test: bevameter, repose, direct_shear, bevameter_shear or wheel")
         ->required()
-        ->check(CLI::IsMember({"bevameter", "repose", "direct_shear", "bevameter_shear"}));
+        ->check(CLI::IsMember(grainlink::lab::labTestNames()));
     lab->add_option("scenario", lab_options.scenario_path, "lab scenario YAML")->required();
     lab->add_option("--out", lab_options.output_directory, "output directory (default out/<name>)");
     lab->add_option("--progress-interval", lab_options.progress_interval_s,

@@ -9,6 +9,8 @@ direct_shear: tau against displacement per normal stress, and the peak and resid
 with their Mohr-Coulomb lines.
 bevameter_shear: tau(j) per normal pressure with the Janosi-Hanamoto fit, and the normal pressure
 the servo held while shearing.
+wheel: steady traction, vertical load, motor torque and sinkage against slip (mean +- sd over the
+steady stretch), and traction against travel per slip.
 
 Usage: tools/plot_lab.py RUN_DIR
 Runs under Debian's /usr/bin/python3 (python3-matplotlib).
@@ -164,6 +166,30 @@ def bevameter(summary, ax):
     ax.set_title("Virtual bevameter: pressure-sinkage")
 
 
+def wheel(summary, axes):
+    runs = sorted(summary["runs"], key=lambda r: r["slip"])
+    slip = [r["slip"] for r in runs]
+    panels = (("traction_N", "traction_sd_N", "traction [N]", 1),
+              ("vertical_load_N", "vertical_load_sd_N", "vertical load [N]", 1),
+              ("torque_N_m", "torque_sd_N_m", "motor torque [N m]", 1),
+              ("sinkage_m", "sinkage_sd_m", "sinkage [mm]", 1e3))
+    for ax, (key, sd, label, scale) in zip(axes[:4], panels):
+        ax.errorbar(slip, [scale * r[key] for r in runs], yerr=[scale * r[sd] for r in runs],
+                    fmt="o-", capsize=3)
+        ax.set_xlabel("slip s [-]")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+    for r in runs:
+        axes[4].plot([1e3 * x for x in r["travel_m"]], r["traction_series_N"], lw=0.8,
+                     label=f"s = {r['slip']:g}")
+    axes[4].set_xlabel("travel [mm]")
+    axes[4].set_ylabel("traction [N]")
+    axes[4].legend(fontsize=8)
+    axes[4].grid(alpha=0.3)
+    axes[5].axis("off")
+    axes[0].set_title("Single-wheel test: steady values (mean +- sd)")
+
+
 def main():
     if len(sys.argv) != 2:
         sys.exit(__doc__)
@@ -180,6 +206,9 @@ def main():
     elif test == "bevameter":
         fig, ax = plt.subplots(figsize=(7, 5))
         bevameter(summary, ax)
+    elif test == "wheel":
+        fig, axes = plt.subplots(2, 3, figsize=(13, 7))
+        wheel(summary, axes.flat)
     else:
         sys.exit(f"plot_lab.py: {run_dir}/summary.json: unknown test '{test}'")
     fig.tight_layout()

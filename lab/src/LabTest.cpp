@@ -30,6 +30,11 @@ template <> struct TestOf<ReposeScenario> {
     static constexpr auto run = runRepose;
     static constexpr auto check = checkRepose;
 };
+template <> struct TestOf<WheelScenario> {
+    using Result = WheelResult;
+    static constexpr auto run = runWheel;
+    static constexpr auto check = checkWheel;
+};
 
 template <class Scenario> using ResultOf = typename TestOf<std::decay_t<Scenario>>::Result;
 
@@ -45,7 +50,7 @@ std::vector<std::string> split(const std::string &list) {
 
 std::vector<std::string> labTestNames() {
     return {BevameterResult::kTest, ShearAnnulusResult::kTest, DirectShearResult::kTest,
-            ReposeResult::kTest};
+            ReposeResult::kTest, WheelResult::kTest};
 }
 
 std::string labTestName(const LabScenario &scenario) {
@@ -71,6 +76,8 @@ LabScenario loadLabScenario(const std::string &test, const std::string &path) {
         return loadDirectShear(path);
     if (test == ReposeResult::kTest)
         return loadRepose(path);
+    if (test == WheelResult::kTest)
+        return loadWheel(path);
     std::string names;
     for (const auto &name : labTestNames())
         names += (names.empty() ? "" : ", ") + name;

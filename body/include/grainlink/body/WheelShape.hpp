@@ -2,6 +2,8 @@
 // The parametric wheel (seed Fig. 8) as the numbers that describe it. The multibody model reads
 // it from the scenario, the handshake carries it, and the soil builds its mesh from it
 // (dem/WheelMesh.hpp): one value, never copied field by field.
+#include "grainlink/config/ConfigNode.hpp"
+
 namespace grainlink::body {
 
 enum class GrouserShape {
@@ -27,5 +29,10 @@ struct WheelShape {
     double chevron_angle_deg = 30.0; ///< [deg] sweep of each chevron arm from the axial direction
     bool closed_sides = true;        ///< side discs; false: a rim only, open at both ends
 };
+
+/// The `wheel:` block of every scenario with a parametric wheel (the rig, the rover, a URDF
+/// link, the lab's wheel test; docs/scenario.md). Every key changes the mesh the grains touch;
+/// one that would not (a grouser's height without grousers) is an error.
+WheelShape parseWheelShape(const config::ConfigNode &node);
 
 } // namespace grainlink::body

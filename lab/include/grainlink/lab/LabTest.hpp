@@ -13,6 +13,7 @@
 #include "grainlink/lab/NumericalChecks.hpp"
 #include "grainlink/lab/Repose.hpp"
 #include "grainlink/lab/ShearAnnulus.hpp"
+#include "grainlink/lab/Wheel.hpp"
 
 #include <string>
 #include <variant>
@@ -21,11 +22,11 @@
 namespace grainlink::lab {
 
 /// The scenario of any lab test.
-using LabScenario =
-    std::variant<BevameterScenario, ShearAnnulusScenario, DirectShearScenario, ReposeScenario>;
+using LabScenario = std::variant<BevameterScenario, ShearAnnulusScenario, DirectShearScenario,
+                                 ReposeScenario, WheelScenario>;
 
 /// The tests' names as `grainlink lab TEST` and summary.json spell them: bevameter,
-/// bevameter_shear, direct_shear, repose.
+/// bevameter_shear, direct_shear, repose, wheel.
 std::vector<std::string> labTestNames();
 std::string labTestName(const LabScenario &scenario);
 /// The scenario's `name` (the default output directory is out/<name>).

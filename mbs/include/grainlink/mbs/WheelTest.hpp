@@ -65,6 +65,6 @@ private:
 WheelTestSettings parseWheelTest(const config::ConfigNode &node);
 SingleWheelRigSettings parseSingleWheelRig(const config::ConfigNode &node);
 /// The `wheel:` block shared by every model with parametric wheels (docs/scenario.md).
-WheelShape parseWheelShape(const config::ConfigNode &node);
+using body::parseWheelShape;
 
 } // namespace grainlink::mbs

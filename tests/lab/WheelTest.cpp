@@ -1,0 +1,109 @@
+// Single-wheel test at set slips (docs/lab.md, physics.md §12.15): the slip convention by hand,
+// a driven and a braked wheel on a tiny bed against the laws every such test obeys, and the
+// input checks.
+#include "grainlink/lab/LabTest.hpp"
+#include "grainlink/lab/Wheel.hpp"
+
+#include "TextEdit.hpp"
+#include "TinyBed.hpp"
+
+#include <catch2/catch.hpp>
+
+#include <string>
+
+using namespace grainlink;
+using Catch::Matchers::Contains;
+
+namespace {
+
+/// A tiny bin 200 x 50 mm, ~30 mm of 2.5 mm grains (the tiny beds' contacts); a smooth wheel
+/// 60 mm across and 30 mm wide (Gamma = 6) under 2 N, spun at 4 rad/s (rim 0.12 m/s) over 60 mm.
+const std::string kTiny = "name: tiny-wheel\nsoil:\n  simulation: {time_step_s: 5.0e-5, threads: 1}\n" +
+                          kTinyGrainContacts + R"(  walls:
+    - {name: bin, type: box, lower_m: [0, 0, 0], upper_m: [0.2, 0.05, 0.2]}
+  deposition:
+    region: {lower_m: [0, 0, 0], upper_m: [0.2, 0.05, 0.07]}
+    count: 2700
+    radius: {distribution: constant, value_m: 0.0025}
+    seed: 3
+    settle_kinetic_energy_J: 1.0e-8
+    max_settle_time_s: 0.4
+  packing_cache_directory: ""
+wheel:
+  shape: {diameter_m: 0.06, width_m: 0.03}
+  load_N: 2
+  slips: [-0.4, 0.0, 0.5]
+  angular_speed_rad_s: 4
+  travel_m: 0.06
+  servo: {gain_m_s_per_N: 0.01, integral_gain_m_s2_per_N: 0.5, max_speed_m_s: 0.05}
+  sample_interval_s: 0.001
+)";
+
+lab::WheelScenario parse(const std::string &text) {
+    return lab::parseWheel(config::ConfigNode::loadString(text, "wheel.yaml"));
+}
+
+} // namespace
+
+TEST_CASE("wheel: the carriage speed of a slip, driven and braked, by hand", "[lab][wheel]") {
+    // s = (v_rim - v) / max(v_rim, v): driven, v = v_rim (1 - s); braked, v = v_rim / (1 + s).
+    CHECK(lab::carriageSpeed(0.1, 0.0) == Approx(0.1));
+    CHECK(lab::carriageSpeed(0.1, 0.25) == Approx(0.075));
+    CHECK(lab::carriageSpeed(0.1, -0.25) == Approx(0.1 / 0.75));
+    CHECK(lab::carriageSpeed(0.1, 0.9) == Approx(0.01));
+    CHECK_THROWS_WITH(lab::carriageSpeed(0.1, 1.0), Contains("(-1, 1)"));
+}
+
+TEST_CASE("wheel: a braked wheel is pushed back, a driven one pulls, the servo holds the load and "
+          "the motor's power covers the drawbar's",
+          "[lab][wheel]") {
+    const lab::WheelScenario s = parse(kTiny);
+    const lab::WheelResult r = lab::runWheel(s, {});
+    REQUIRE(r.runs.size() == 3);
+    const lab::WheelRun &braked = r.runs[0], &rolling = r.runs[1], &driven = r.runs[2];
+    for (const lab::WheelRun &run : r.runs) {
+        INFO("slip " << run.slip << ": traction " << run.traction_N.mean << " +- "
+                     << run.traction_N.sd << " N, load " << run.vertical_load_N.mean << " +- "
+                     << run.vertical_load_N.sd << " N, torque " << run.torque_N_m.mean
+                     << " N m, sinkage " << run.sinkage_m.mean * 1e3 << " mm");
+        // The servo: the steady vertical load within 10 % of the set load on average.
+        CHECK(run.vertical_load_N.mean == Approx(2.0).epsilon(0.10));
+        // Steady state: the power the motor puts in, T omega, covers the drawbar's, F_x v
+        // (what the soil dissipates is never negative), within the steady scatter.
+        const double motor = run.torque_N_m.mean * 4.0, drawbar = run.traction_N.mean *
+                                                                   run.carriage_speed_m_s;
+        const double scatter = 4.0 * run.torque_N_m.sd / std::sqrt(double(run.steady_samples)) +
+                               run.carriage_speed_m_s * 2.0 * run.traction_N.sd /
+                                   std::sqrt(double(run.steady_samples));
+        CHECK(motor - drawbar > -scatter);
+        CHECK(run.sinkage_m.mean > 0.0);
+    }
+    // Traction grows with slip: the soil resists a braked wheel and pushes a driven one on.
+    CHECK(braked.traction_N.mean < 0.0);
+    CHECK(braked.traction_N.mean < rolling.traction_N.mean);
+    CHECK(rolling.traction_N.mean < driven.traction_N.mean);
+    CHECK(driven.traction_N.mean > 0.0);
+    // So does the motor torque.
+    CHECK(braked.torque_N_m.mean < driven.torque_N_m.mean);
+    // The summary holds each slip's steady values, as the diagnosis reads them.
+    const lab::LabSummary sum = r.summary();
+    CHECK(sum.test == "wheel");
+    CHECK(sum.runs[2].value("slip") == 0.5);
+    CHECK(sum.runs[2].value("traction_N") == driven.traction_N.mean);
+    CHECK(sum.runs[2].curve("travel_m").size() == driven.samples.size());
+}
+
+TEST_CASE("wheel: bad input names the file, the key and the line", "[lab][wheel]") {
+    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "slips: [-0.4, 0.0, 0.5]", "slips: [0.2, 1.0]")),
+                      Contains("wheel.yaml:") && Contains("wheel.slips[1]") && Contains("(-1, 1)"));
+    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "travel_m: 0.06", "travel_m: 0.5")),
+                      Contains("wheel.travel_m") && Contains("can travel at most"));
+    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "width_m: 0.03", "width_m: 0.01")),
+                      Contains("wheel.shape.width_m") && Contains("min_resolution"));
+    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "{diameter_m: 0.06, width_m: 0.03}",
+                                         "{diameter_m: 0.06, width_m: 0.03, grouser_height_m: 0.005}")),
+                      Contains("grouser_count 0"));
+    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "load_N: 2", "load_N: 0")),
+                      Contains("wheel.load_N") && Contains("must be > 0"));
+    CHECK_THROWS_WITH(lab::loadLabScenario("wheels", "x.yaml"), Contains("wheel"));
+}
