@@ -161,7 +161,9 @@ void applyPolydispersity(YAML::Node scenario, double w) {
 
 /// The container's horizontal size times f about the deposition region's centre, with the
 /// grain count times f^2 (the same bed depth).
-void applyDomainSize(YAML::Node scenario, double f) {
+/// The container f_x times as long and f_y times as wide about the region's centre, the same
+/// depth of grains.
+void applyDomainSize(YAML::Node scenario, double f_x, double f_y) {
     YAML::Node soil = scenario["soil"];
     YAML::Node region = soil["deposition"]["region"];
     const auto lo = region["lower_m"].as<std::vector<double>>();
@@ -170,8 +172,8 @@ void applyDomainSize(YAML::Node scenario, double f) {
     const auto scalePoint = [&](YAML::Node p) {
         if (!p || !p.IsSequence() || p.size() != 3)
             return;
-        p[0] = cx + f * (p[0].as<double>() - cx);
-        p[1] = cy + f * (p[1].as<double>() - cy);
+        p[0] = cx + f_x * (p[0].as<double>() - cx);
+        p[1] = cy + f_y * (p[1].as<double>() - cy);
     };
     scalePoint(region["lower_m"]);
     scalePoint(region["upper_m"]);
@@ -182,7 +184,8 @@ void applyDomainSize(YAML::Node scenario, double f) {
             scalePoint(w["upper_m"]);
             scalePoint(w["point_m"]);
         }
-    soil["deposition"]["count"] = std::llround(soil["deposition"]["count"].as<double>() * f * f);
+    soil["deposition"]["count"] =
+        std::llround(soil["deposition"]["count"].as<double>() * f_x * f_y);
 }
 
 } // namespace
@@ -427,9 +430,12 @@ YAML::Node applyEffect(const Effect &effect, double s, const YAML::Node &scenari
     }
     if (effect.builtin == "domain_size") {
         // A direct shear box and a repose tube are the test's own geometry (their sizes are
-        // measured conditions), not a container around the bed.
-        if (type != ExperimentType::DirectShear && type != ExperimentType::AngleOfRepose)
-            applyDomainSize(out, s);
+        // measured conditions), not a container around the bed; a wheel's bin confines it
+        // across its width (y), its length being the travel.
+        if (type == ExperimentType::WheelSteadyState)
+            applyDomainSize(out, 1.0, s);
+        else if (type != ExperimentType::DirectShear && type != ExperimentType::AngleOfRepose)
+            applyDomainSize(out, s, s);
         return out;
     }
     const std::string type_name = typeName(type);

@@ -224,8 +224,18 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
                          "CMU 3d-terramechanics steady-state wheel tests (MIT licence, (c) 2022 "
                          "Catherine Pavlov, CMU), " + wheel + " wheel; Z_mm with the authors' "
                          "31.5 mm offset convention");
+            const std::size_t load_col = column(c, "F_load_N", f);
             for (int beta : betas) {
                 const std::string id = wheel + "_beta" + std::to_string(beta);
+                // The load the carriage put on the wheel: the runs' mean measured F_load (the
+                // lab's wheel test holds it with a servo).
+                double load = 0.0;
+                int runs = 0;
+                for (const auto &row : c.rows)
+                    if (std::stoi(row[beta_col]) == beta) {
+                        load += std::stod(row[load_col]);
+                        ++runs;
+                    }
                 YAML::Node e;
                 e["id"] = id;
                 e["type"] = "wheel_steady_state";
@@ -236,6 +246,7 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
                 cond["grouser_height_m"] = wheel == "grouser" ? 0.005 : 0.0;
                 cond["slip_angle_deg"] = double(beta);
                 cond["carriage_speed_m_s"] = 0.01;
+                cond["load_N"] = std::round(100.0 * load / runs) / 100.0;
                 e["conditions"] = flow(cond);
                 YAML::Node data;
                 data["files"] = flow(YAML::Node(std::vector<std::string>{copy}));
@@ -257,7 +268,8 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
                 obs("traction_N", "F_tractive_N", "N");
                 obs("side_force_N", "F_side_N", "N");
                 obs("vertical_load_N", "F_load_N", "N");
-                obs("sinkage_m", "Z_mm", "mm");
+                // Z_mm is not kept: its zero (the authors' 31.5 mm offset convention) is not the
+                // bed surface, so a simulated sinkage could not be compared with it.
                 data["y"] = y;
                 e["data"] = data;
                 list.push_back(e);

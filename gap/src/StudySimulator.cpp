@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <optional>
+#include <tuple>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -46,6 +48,34 @@ void mergeInto(YAML::Node target, const YAML::Node &over) {
 std::string boxOf(const Experiment &e) {
     const auto it = e.labels.find("box");
     return it == e.labels.end() ? "" : it->second;
+}
+
+/// The conditions of a wheel experiment that make its test (the wheel and its load): wheel
+/// experiments that share them run as one test, one slip per run.
+constexpr const char *kWheelConditions[] = {"wheel_radius_m", "wheel_width_m", "grouser_count",
+                                            "grouser_height_m", "load_N"};
+
+/// What a test is run for besides its type and box: a wheel's geometry and load.
+std::string rigOf(const Experiment &e) {
+    if (e.type != ExperimentType::WheelSteadyState)
+        return "";
+    std::ostringstream key;
+    key.precision(12);
+    for (const char *c : kWheelConditions)
+        if (const auto it = e.numbers.find(c); it != e.numbers.end())
+            key << c << '=' << it->second << ';';
+    return key.str();
+}
+
+/// Why the lab cannot run an experiment of a type it simulates; empty: it can.
+std::string unsupported(const Experiment &e) {
+    if (e.type == ExperimentType::WheelSteadyState) {
+        const auto beta = e.numbers.find("slip_angle_deg");
+        if (beta != e.numbers.end() && beta->second != 0.0)
+            return "slip angle " + std::to_string(beta->second) +
+                   " deg: the lab's wheel runs straight (slip angle 0)";
+    }
+    return "";
 }
 
 /// The numbers of a condition over a group, sorted and unique.
@@ -86,6 +116,77 @@ void scaleAll(YAML::Node node, double f) {
     }
 }
 
+/// The wheel test's section for a group of wheel experiments (one wheel under one load): a run at
+/// the centre of every slip bin they are compared in, and the wheel's size, grousers and load
+/// from their conditions over the base model's `wheel:` section.
+void wheelSection(YAML::Node section, const ExperimentSet &design, const FeatureDesign &fd,
+                  const std::vector<std::string> &group, const std::string &base_path) {
+    std::set<double> slips;
+    for (const auto &id : group)
+        if (const auto it = fd.by_experiment.find(id); it != fd.by_experiment.end())
+            for (Eigen::Index k : it->second)
+                slips.insert(std::round(fd.keys[std::size_t(k)].centre() * 1e6) / 1e6);
+    if (slips.empty())
+        throw std::invalid_argument("wheel experiment '" + group.front() +
+                                    "' has no slip bin to simulate");
+    section["slips"] = flowList(std::vector<double>(slips.begin(), slips.end()));
+    YAML::Node shape = section["shape"];
+    if (!shape || !shape.IsMap())
+        throw std::invalid_argument(base_path + ": tests.wheel_steady_state.wheel needs its shape "
+                                                "(the wheel's keys; conditions override them)");
+    const Experiment &e = design.find(group.front());
+    const auto condition = [&](const char *key) -> std::optional<double> {
+        const auto it = e.numbers.find(key);
+        return it == e.numbers.end() ? std::nullopt : std::optional<double>(it->second);
+    };
+    const auto noGrousers = [&] {
+        shape["grouser_count"] = 0;
+        for (const char *k : {"grouser_height_m", "grouser_thickness_m", "grouser_shape",
+                              "chevron_angle_deg"})
+            shape.remove(k);
+    };
+    if (const auto r = condition("wheel_radius_m"))
+        shape["diameter_m"] = 2.0 * *r;
+    if (const auto b = condition("wheel_width_m"))
+        shape["width_m"] = *b;
+    if (const auto h = condition("grouser_height_m")) {
+        if (*h == 0.0)
+            noGrousers();
+        else
+            shape["grouser_height_m"] = *h;
+    }
+    if (const auto n = condition("grouser_count")) {
+        if (*n == 0.0)
+            noGrousers();
+        else
+            shape["grouser_count"] = std::llround(*n);
+    }
+    if (const auto load = condition("load_N"))
+        section["load_N"] = *load;
+}
+
+/// A wheel experiment's observable over slip from the wheel test's runs: each run's steady
+/// value at its slip. The mean side force of a wheel running straight is zero by symmetry.
+Curve wheelCurve(const lab::LabSummary &summary, const std::string &observable) {
+    static const std::set<std::string> steady{"traction_N", "vertical_load_N", "sinkage_m",
+                                              "torque_N_m"};
+    const std::string key = observable == "drawbar_pull_N" ? "traction_N" : observable;
+    if (key != "side_force_N" && !steady.count(key))
+        throw std::invalid_argument("the lab's wheel test gives no '" + observable +
+                                    "' (traction_N, drawbar_pull_N, vertical_load_N, sinkage_m, "
+                                    "torque_N_m, side_force_N)");
+    std::vector<std::pair<double, double>> points;
+    for (const auto &run : summary.runs)
+        points.emplace_back(run.value("slip"), key == "side_force_N" ? 0.0 : run.value(key));
+    std::sort(points.begin(), points.end());
+    Curve c;
+    for (const auto &[x, y] : points) {
+        c.x.push_back(x);
+        c.y.push_back(y);
+    }
+    return c;
+}
+
 bool close(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b)); }
 
 } // namespace
@@ -95,11 +196,13 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     ExperimentSet out = set;
     out.experiments.clear();
     for (const Experiment &e : set.experiments)
-        if (base.tests.count(typeName(e.type)))
-            out.experiments.push_back(e);
-        else
+        if (!base.tests.count(typeName(e.type)))
             left_out.push_back(e.id + " (" + typeName(e.type) + ": " + base.path + " has no tests." +
                                typeName(e.type) + ")");
+        else if (const std::string why = unsupported(e); !why.empty())
+            left_out.push_back(e.id + " (" + typeName(e.type) + ": " + why + ")");
+        else
+            out.experiments.push_back(e);
     if (out.experiments.empty())
         throw std::invalid_argument(base.path + ": no test in `tests` simulates any experiment of " +
                                     set.directory);
@@ -117,12 +220,14 @@ std::string labTestOf(ExperimentType type) {
     case ExperimentType::AngleOfRepose:
         return "repose";
     case ExperimentType::WheelSteadyState:
+        return "wheel";
     case ExperimentType::Mole:
         break;
     }
     throw std::invalid_argument(std::string("grainlink gap cannot simulate ") + typeName(type) +
                                 " experiments from a base model yet (plate_sinkage, "
-                                "bevameter_shear, direct_shear and angle_of_repose it can)");
+                                "bevameter_shear, direct_shear, angle_of_repose and "
+                                "wheel_steady_state it can)");
 }
 
 BaseModel loadBaseModel(const std::string &path) {
@@ -216,10 +321,11 @@ YAML::Node StudySimulator::referenceScenario() const {
 }
 
 std::vector<std::vector<std::string>> StudySimulator::groups(const ExperimentSet &design) const {
-    // Experiments of one type in one box share a bed: one lab test runs them all.
-    std::map<std::pair<ExperimentType, std::string>, std::vector<std::string>> g;
+    // Experiments of one type in one box share a bed: one lab test runs them all (wheels: those
+    // of one wheel under one load).
+    std::map<std::tuple<ExperimentType, std::string, std::string>, std::vector<std::string>> g;
     for (const Experiment &e : design.experiments)
-        g[{e.type, boxOf(e)}].push_back(e.id);
+        g[{e.type, boxOf(e), rigOf(e)}].push_back(e.id);
     std::vector<std::vector<std::string>> out;
     for (auto &[key, ids] : g)
         out.push_back(ids);
@@ -267,6 +373,8 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
     } else if (test == "bevameter_shear") {
         section["normal_pressures_Pa"] = flowList(conditionValues(design, group, "normal_pressure_Pa", 1.0));
         section["max_shear_displacement_m"] = 1.1 * reach;
+    } else if (test == "wheel") {
+        wheelSection(section, design, fd, group, base_.path);
     }
     root[test] = section;
     YAML::Node soil = root["soil"];
@@ -371,6 +479,11 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
                 const lab::LabSummary &sum = *summaries[slot.point];
                 for (const std::string &id : gs[slot.group]) {
                     const Experiment &e = design.find(id);
+                    if (e.type == ExperimentType::WheelSteadyState) {
+                        for (const std::string &o : e.observables)
+                            c[id][o] = wheelCurve(sum, o);
+                        continue;
+                    }
                     Curve curve;
                     const auto pick = [&](const char *value_key, double want, const char *x,
                                           const char *y) {

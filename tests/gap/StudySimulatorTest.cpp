@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <tuple>
 
 using namespace grainlink::gap;
 namespace fs = std::filesystem;
@@ -88,4 +89,98 @@ TEST_CASE("experiments of a type the base model does not simulate are left out, 
     only_wheels.experiments = {wheel};
     std::vector<std::string> all;
     CHECK_THROWS_WITH(simulable(only_wheels, base, all), Catch::Contains("no test in `tests`"));
+}
+
+TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, the wheel and "
+          "load from their conditions, every effect and check a scenario the lab accepts",
+          "[gap][simulator][wheel]") {
+    // The CMU base model's wheels, as `gap import cmu` describes them: straight runs of the
+    // smooth and the grousered wheel, and one at a slip angle the lab's wheel does not run.
+    const BaseModel base =
+        loadBaseModel(std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml");
+    ExperimentSet set;
+    set.name = "wheels";
+    for (const auto &[id, grouser, beta] :
+         {std::tuple{"smooth_beta0", 0.0, 0.0}, std::tuple{"grouser_beta0", 0.005, 0.0},
+          std::tuple{"smooth_beta30", 0.0, 30.0}}) {
+        Experiment e;
+        e.id = id;
+        e.type = ExperimentType::WheelSteadyState;
+        e.x_name = "slip";
+        e.scatter = true;
+        e.observables = {"traction_N", "vertical_load_N", "side_force_N"};
+        e.numbers = {{"wheel_radius_m", 0.058}, {"wheel_width_m", 0.05},
+                     {"grouser_height_m", grouser}, {"slip_angle_deg", beta}, {"load_N", 21.5}};
+        for (double s : {-0.5, -0.2, 0.0, 0.2, 0.4, 0.6, 0.8}) {
+            Trial t;
+            for (const auto &o : e.observables)
+                t.curves[o] = Curve{{s}, {1.0 + s}};
+            e.trials.push_back(t);
+        }
+        set.experiments.push_back(e);
+    }
+    std::vector<std::string> left_out;
+    const ExperimentSet kept = simulable(set, base, left_out);
+    REQUIRE(kept.experiments.size() == 2);
+    REQUIRE(left_out.size() == 1);
+    CHECK(left_out[0].find("smooth_beta30 (wheel_steady_state: slip angle 30") == 0);
+
+    const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-wheel-test";
+    fs::remove_all(scratch);
+    fs::create_directories(scratch);
+    const StudySimulator sim(base, (scratch / "sims").string(), {});
+    // One test per wheel: the two wheels differ in their grousers.
+    CHECK(sim.groups(kept).size() == 2);
+    const FeatureDesign fd = designFeatures(kept);
+    const auto check = [&](const std::string &id, const VariantRequest &r) {
+        const fs::path file = scratch / (r.label + "-" + id + ".yaml");
+        std::ofstream(file) << sim.scenarioText(kept, {id}, r, 1);
+        INFO(r.label << " on " << id);
+        const auto scenario = grainlink::lab::loadLabScenario("wheel", file.string());
+        return std::get<grainlink::lab::WheelScenario>(scenario);
+    };
+    VariantRequest plain;
+    plain.label = "base";
+    const auto smooth = check("smooth_beta0", plain), grouser = check("grouser_beta0", plain);
+    CHECK(smooth.test.shape.grouser_count == 0);
+    CHECK(grouser.test.shape.grouser_count == 12);
+    CHECK(grouser.test.shape.grouser_height_m == 0.005);
+    CHECK(smooth.test.shape.diameter_m == Approx(0.116));
+    CHECK(smooth.test.load_N == 21.5);
+    // A run at the centre of every slip bin the measurements are compared in.
+    std::vector<double> centres;
+    for (Eigen::Index k : fd.by_experiment.at("smooth_beta0"))
+        centres.push_back(fd.keys[std::size_t(k)].centre());
+    std::sort(centres.begin(), centres.end());
+    centres.erase(std::unique(centres.begin(), centres.end(),
+                              [](double a, double b) { return std::abs(a - b) < 1e-9; }),
+                  centres.end());
+    REQUIRE(smooth.test.slips.size() == centres.size());
+    for (std::size_t i = 0; i < centres.size(); ++i)
+        CHECK(smooth.test.slips[i] == Approx(centres[i]).margin(1e-6));
+
+    const EffectCatalogue catalogue =
+        loadEffects(std::string(GRAINLINK_SOURCE_DIR) + "/data/effects.yaml");
+    const YAML::Node reference = sim.referenceScenario();
+    for (const std::string &c : sim.checks()) {
+        VariantRequest r;
+        r.label = "check-" + c;
+        r.check = c;
+        for (const char *id : {"smooth_beta0", "grouser_beta0"})
+            CHECK_NOTHROW(check(id, r));
+    }
+    for (const Effect &raw : catalogue.effects) {
+        if (!inapplicable(raw, reference).empty())
+            continue;
+        const Effect e = resolveAgainst(raw, reference);
+        for (double s : e.signature) {
+            VariantRequest r;
+            r.label = e.name + "-" + std::to_string(s);
+            r.effect = &e;
+            r.strength = s;
+            for (const char *id : {"smooth_beta0", "grouser_beta0"})
+                CHECK_NOTHROW(check(id, r));
+        }
+    }
+    fs::remove_all(scratch);
 }

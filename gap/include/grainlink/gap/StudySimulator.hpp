@@ -66,13 +66,16 @@ public:
     std::string scenarioText(const ExperimentSet &design, const std::vector<std::string> &group,
                              const VariantRequest &request, int seed) const;
 
+    /// The experiments that run as one lab test: one type in one box (wheels: one wheel under
+    /// one load).
+    std::vector<std::vector<std::string>> groups(const ExperimentSet &design) const;
+
     int runsDone() const { return runs_done_; }
     int runsReused() const { return runs_reused_; }
 
 private:
     YAML::Node scenarioNode(const ExperimentSet &design, const std::vector<std::string> &group,
                             const VariantRequest &request, int seed) const;
-    std::vector<std::vector<std::string>> groups(const ExperimentSet &design) const;
     BaseModel base_;
     std::string directory_;
     study::ExecutorOptions executor_;
