@@ -1,4 +1,4 @@
-// Single-wheel test at set slips (docs/lab.md, physics.md §12.15): the slip convention by hand,
+// Single-wheel test at set slips (docs/lab.md, physics.md §12.17): the slip convention by hand,
 // a driven and a braked wheel on a tiny bed against the laws every such test obeys, and the
 // input checks.
 #include "grainlink/lab/LabTest.hpp"

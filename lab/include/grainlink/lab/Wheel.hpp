@@ -1,5 +1,5 @@
 #pragma once
-// Single-wheel test at a set slip (docs/lab.md, physics.md §12.15): the slip-controlled test bed
+// Single-wheel test at a set slip (docs/lab.md, physics.md §12.17): the slip-controlled test bed
 // of terramechanics labs. A wheel is pressed onto a settled bed until a force servo holds its
 // vertical load, then spun at a set angular speed while its carriage moves at the speed the slip
 // asks for and the servo keeps the load. Per slip: the steady traction, vertical load, motor
