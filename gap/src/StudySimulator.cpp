@@ -116,16 +116,34 @@ void scaleAll(YAML::Node node, double f) {
     }
 }
 
-/// The wheel test's section for a group of wheel experiments (one wheel under one load): a run at
-/// the centre of every slip bin they are compared in, and the wheel's size, grousers and load
-/// from their conditions over the base model's `wheel:` section.
+/// The wheel test's section for a group of wheel experiments (one wheel under one load): a run in
+/// every slip bin they are compared in, at the mean slip of the measured runs in it (the bin's
+/// centre when it holds none), so that a steep curve is compared where it was measured; and the
+/// wheel's size, grousers and load from their conditions over the base model's `wheel:`.
 void wheelSection(YAML::Node section, const ExperimentSet &design, const FeatureDesign &fd,
                   const std::vector<std::string> &group, const std::string &base_path) {
     std::set<double> slips;
-    for (const auto &id : group)
-        if (const auto it = fd.by_experiment.find(id); it != fd.by_experiment.end())
-            for (Eigen::Index k : it->second)
-                slips.insert(std::round(fd.keys[std::size_t(k)].centre() * 1e6) / 1e6);
+    for (const auto &id : group) {
+        const Experiment &e = design.find(id);
+        for (const std::string &o : e.observables) {
+            const auto edges = fd.edges.find(id + "/" + o);
+            if (edges == fd.edges.end())
+                continue;
+            // The measured runs' slips binned as their values are (scatterBinMeans of x).
+            std::vector<std::pair<double, double>> xx;
+            for (const Trial &t : e.trials)
+                if (const auto c = t.curves.find(o); e.scatter && c != t.curves.end() && !c->second.empty())
+                    xx.emplace_back(c->second.x[0], c->second.x[0]);
+            std::vector<int> counts;
+            const std::vector<double> mean = scatterBinMeans(xx, edges->second, counts);
+            for (std::size_t b = 0; b < mean.size(); ++b)
+                if (counts[b] > 0 || !e.scatter)
+                    slips.insert(std::round((counts[b] > 0 ? mean[b]
+                                                       : 0.5 * (edges->second[b] + edges->second[b + 1])) *
+                                        1e6) /
+                             1e6);
+        }
+    }
     if (slips.empty())
         throw std::invalid_argument("wheel experiment '" + group.front() +
                                     "' has no slip bin to simulate");

@@ -147,17 +147,18 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     CHECK(grouser.test.shape.grouser_height_m == 0.005);
     CHECK(smooth.test.shape.diameter_m == Approx(0.116));
     CHECK(smooth.test.load_N == 21.5);
-    // A run at the centre of every slip bin the measurements are compared in.
-    std::vector<double> centres;
-    for (Eigen::Index k : fd.by_experiment.at("smooth_beta0"))
-        centres.push_back(fd.keys[std::size_t(k)].centre());
-    std::sort(centres.begin(), centres.end());
-    centres.erase(std::unique(centres.begin(), centres.end(),
-                              [](double a, double b) { return std::abs(a - b) < 1e-9; }),
-                  centres.end());
-    REQUIRE(smooth.test.slips.size() == centres.size());
-    for (std::size_t i = 0; i < centres.size(); ++i)
-        CHECK(smooth.test.slips[i] == Approx(centres[i]).margin(1e-6));
+    // A run in every slip bin the measurements are compared in, at the mean measured slip in
+    // it (not the bin's centre): the bins here are 0.2 wide and hold one run each, so the
+    // runs are at the measured slips the bins cover.
+    const std::vector<double> &edges = fd.edges.at("smooth_beta0/traction_N");
+    CHECK(edges[1] - edges[0] == Approx(0.2));
+    std::vector<double> measured;
+    for (double s : {-0.5, -0.2, 0.0, 0.2, 0.4, 0.6, 0.8})
+        if (s >= edges.front() && s <= edges.back())
+            measured.push_back(s);
+    REQUIRE(smooth.test.slips.size() == measured.size());
+    for (std::size_t i = 0; i < measured.size(); ++i)
+        CHECK(smooth.test.slips[i] == Approx(measured[i]).margin(1e-6));
 
     const EffectCatalogue catalogue =
         loadEffects(std::string(GRAINLINK_SOURCE_DIR) + "/data/effects.yaml");
