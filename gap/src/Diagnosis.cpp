@@ -110,6 +110,30 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         checks.push_back({first[i].check, first_rows[i]});
     D.validation = validate(meas, base_rows, checks);
     const ValidationResult &V = D.validation;
+    // Nothing compared is no evidence of agreement: a diagnosis whose base runs all failed, or
+    // reached none of the measured range, stops here instead of reporting "no gap".
+    {
+        std::vector<std::string> compared, not_compared;
+        for (const Experiment &e : set.experiments) {
+            bool any = false;
+            for (Eigen::Index k = 0; k < n; ++k)
+                any = any || (meas.keys[std::size_t(k)].experiment == e.id &&
+                              std::isfinite(V.standardised[k]));
+            (any ? compared : not_compared).push_back(e.id);
+        }
+        std::string list;
+        for (const auto &id : not_compared)
+            list += (list.empty() ? "" : ", ") + id;
+        if (compared.empty())
+            throw std::runtime_error(
+                "no experiment could be compared with the base model: its simulations failed or "
+                "reached none of the measured range (" + list + "; the failed runs and their logs "
+                "are named above)");
+        if (!not_compared.empty()) {
+            D.not_compared = not_compared;
+            log("not compared (no simulated feature in the measured range): " + list);
+        }
+    }
     const BlockCorrelation correlation(meas.keys, base_rows);
     D.verdict = testGap(meas.keys, V.z, opt.alpha, opt.flag_at);
     D.findings = localise(meas.keys, V, [&] {
@@ -172,10 +196,18 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     D.null_variance = null_var;
     const double n_eff = correlation.effectiveCount(D.held_out);
 
+    const auto notCompared = [&] {
+        std::string list;
+        for (const auto &id : D.not_compared)
+            list += (list.empty() ? "" : ", ") + id;
+        return list.empty() ? std::string() : "; not compared (no simulated feature): " + list;
+    };
     if (!D.verdict.gap) {
         D.outcome = Diagnosis::Outcome::NoGap;
-        D.claim = "no gap: every experiment agrees with the base model within its validation "
-                  "uncertainty (" + D.verdict.summary + ")";
+        D.claim = std::string(D.not_compared.empty() ? "no gap: every experiment agrees"
+                                                     : "no gap: every compared experiment agrees") +
+                  " with the base model within its validation uncertainty (" + D.verdict.summary +
+                  ")" + notCompared();
         return D;
     }
 
@@ -492,7 +524,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                       << fmt(best->p_value, 2) << ")";
         }
     }
-    D.claim = claim.str();
+    D.claim = claim.str() + notCompared();
 
     // What remains after the chosen (or closest) model, in words.
     {

@@ -1,5 +1,6 @@
 #include "grainlink/lab/LabTest.hpp"
 
+#include <algorithm>
 #include <sstream>
 #include <stdexcept>
 #include <type_traits>
@@ -38,6 +39,13 @@ template <> struct TestOf<WheelScenario> {
 
 template <class Scenario> using ResultOf = typename TestOf<std::decay_t<Scenario>>::Result;
 
+std::invalid_argument unknownTest(const std::string &test) {
+    std::string names;
+    for (const auto &name : labTestNames())
+        names += (names.empty() ? "" : ", ") + name;
+    return std::invalid_argument("lab test '" + test + "' is not implemented; available: " + names);
+}
+
 std::vector<std::string> split(const std::string &list) {
     std::vector<std::string> items;
     std::stringstream in(list);
@@ -68,20 +76,24 @@ const std::vector<std::string> &labWarnings(const LabScenario &scenario) {
 }
 
 LabScenario loadLabScenario(const std::string &test, const std::string &path) {
+    const auto names = labTestNames();
+    if (std::find(names.begin(), names.end(), test) == names.end())
+        throw unknownTest(test); // before the file: a wrong test name is the likelier mistake
+    return parseLabScenario(test, config::ConfigNode::loadFile(path));
+}
+
+LabScenario parseLabScenario(const std::string &test, const config::ConfigNode &root) {
     if (test == BevameterResult::kTest)
-        return loadBevameter(path);
+        return parseBevameter(root);
     if (test == ShearAnnulusResult::kTest)
-        return loadShearAnnulus(path);
+        return parseShearAnnulus(root);
     if (test == DirectShearResult::kTest)
-        return loadDirectShear(path);
+        return parseDirectShear(root);
     if (test == ReposeResult::kTest)
-        return loadRepose(path);
+        return parseRepose(root);
     if (test == WheelResult::kTest)
-        return loadWheel(path);
-    std::string names;
-    for (const auto &name : labTestNames())
-        names += (names.empty() ? "" : ", ") + name;
-    throw std::invalid_argument("lab test '" + test + "' is not implemented; available: " + names);
+        return parseWheel(root);
+    throw unknownTest(test);
 }
 
 LabRun runLabTest(const LabScenario &scenario, const LabRunOptions &options,

@@ -1,11 +1,9 @@
 #include "grainlink/study/Kind.hpp"
 
 #include "grainlink/dem/Scenario.hpp"
-#include "grainlink/lab/Bevameter.hpp"
-#include "grainlink/lab/DirectShear.hpp"
-#include "grainlink/lab/Repose.hpp"
-#include "grainlink/lab/ShearAnnulus.hpp"
+#include "grainlink/lab/LabTest.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace grainlink::study {
@@ -31,21 +29,19 @@ Kind standardKind(const std::string &kind, const std::string &test) {
             {}};
     }
     if (kind == "lab") {
-        std::function<void(const config::ConfigNode &)> parse;
-        if (test == "bevameter")
-            parse = [](const config::ConfigNode &root) { lab::parseBevameter(root); };
-        else if (test == "repose")
-            parse = [](const config::ConfigNode &root) { lab::parseRepose(root); };
-        else if (test == "direct_shear")
-            parse = [](const config::ConfigNode &root) { lab::parseDirectShear(root); };
-        else if (test == "bevameter_shear")
-            parse = [](const config::ConfigNode &root) { lab::parseShearAnnulus(root); };
-        else
-            throw std::invalid_argument("lab test '" + test +
-                                        "' is not one of: bevameter, repose, direct_shear, "
-                                        "bevameter_shear");
-        return {"lab " + test,          {"lab", test}, "summary.json", "soil.simulation.threads",
-                "soil.deposition.seed", parse};
+        const auto names = lab::labTestNames();
+        if (std::find(names.begin(), names.end(), test) == names.end()) {
+            std::string list;
+            for (const auto &n : names)
+                list += (list.empty() ? "" : ", ") + n;
+            throw std::invalid_argument("lab test '" + test + "' is not one of: " + list);
+        }
+        return {"lab " + test,
+                {"lab", test},
+                "summary.json",
+                "soil.simulation.threads",
+                "soil.deposition.seed",
+                [test](const config::ConfigNode &root) { lab::parseLabScenario(test, root); }};
     }
     throw std::invalid_argument("kind '" + kind + "' is not one of: dem, run, lab");
 }

@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <random>
+#include <set>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
@@ -291,4 +292,50 @@ TEST_CASE("diagnosis against another code's soil: a strong hidden effect still l
             if (c.explains)
                 CHECK(c.name == t.effect);
     }
+}
+
+namespace {
+/// The analytic soil whose runs of some experiments all fail: their features are missing.
+class FailingSimulator final : public Simulator {
+public:
+    explicit FailingSimulator(std::set<std::string> failing) : failing_(std::move(failing)) {}
+    std::vector<std::string> checks() const override { return inner_.checks(); }
+    YAML::Node referenceScenario() const override { return inner_.referenceScenario(); }
+    std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &set, const FeatureDesign &design,
+                                          const std::vector<VariantRequest> &requests) override {
+        auto rows = inner_.simulate(set, design, requests);
+        for (auto &m : rows)
+            for (const auto &id : failing_)
+                for (Eigen::Index k : design.by_experiment.at(id))
+                    m.col(k).setConstant(std::numeric_limits<double>::quiet_NaN());
+        return rows;
+    }
+
+private:
+    AnalyticSimulator inner_;
+    std::set<std::string> failing_;
+};
+} // namespace
+
+TEST_CASE("diagnosis: failed simulations are never read as agreement", "[gap][diagnosis]") {
+    const EffectCatalogue c = catalogue();
+    DiagnosisOptions o;
+    o.seeds = 3;
+    o.signature_seeds = 2;
+    const ExperimentSet set = measuredSet({}, 1);
+    std::set<std::string> every;
+    for (const Experiment &e : set.experiments)
+        every.insert(e.id);
+    FailingSimulator none_ran(every);
+    CHECK_THROWS_WITH(diagnose(set, c.diagnosable(), none_ran, o),
+                      Catch::Contains("no experiment could be compared") &&
+                          Catch::Contains("large_50"));
+    // Some ran: the result speaks for those, and names the others.
+    FailingSimulator some_ran({"small_90", "small_110"});
+    const Diagnosis d = diagnose(set, c.diagnosable(), some_ran, o);
+    INFO(d.claim);
+    CHECK(d.outcome == Diagnosis::Outcome::NoGap);
+    CHECK(d.claim.find("every compared experiment agrees") != std::string::npos);
+    CHECK(d.claim.find("not compared (no simulated feature): small_90, small_110") !=
+          std::string::npos);
 }

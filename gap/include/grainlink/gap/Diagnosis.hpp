@@ -106,6 +106,9 @@ struct Diagnosis {
     std::vector<RegimeFinding> findings;
     std::vector<Eigen::Index> calibration, held_out; ///< feature indices
     std::vector<std::string> calibration_experiments, held_out_experiments;
+    /// Experiments with no simulated feature to compare (their runs failed or fell short):
+    /// named in the claim, never counted as agreeing.
+    std::vector<std::string> not_compared;
     HeldOutScore held_out_base;  ///< the base model on the held-out features
     HeldOutScore held_out_null;  ///< base + the fitted discrepancy
     Eigen::VectorXd null_mean, null_variance; ///< the null model's prediction (held-out features)
@@ -118,7 +121,7 @@ struct Diagnosis {
     std::string separating_experiment;         ///< the probe that would separate them best
     enum class Outcome { NoGap, Explained, ExplainedByPair, Unexplained };
     Outcome outcome = Outcome::NoGap;
-    std::string claim;        ///< one sentence: the result
+    std::string claim;        ///< one sentence: the result (and what was not compared)
     std::string unexplained;  ///< what remains (features still flagged after the best model)
     int simulations = 0;      ///< variant x seed runs requested
 };

@@ -37,6 +37,8 @@ const std::vector<std::string> &labWarnings(const LabScenario &scenario);
 /// Reads `path` as a scenario of `test`; throws std::invalid_argument naming the tests for an
 /// unknown one, config::ConfigError for a bad file.
 LabScenario loadLabScenario(const std::string &test, const std::string &path);
+/// The same for a scenario already read (a study checks its points so, in-process).
+LabScenario parseLabScenario(const std::string &test, const config::ConfigNode &root);
 
 /// What a lab test gave.
 struct LabRun {
