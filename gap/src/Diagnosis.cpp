@@ -510,8 +510,13 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                   << fmt(100.0 * pair->held_out.gap, 2) << " % (p = " << fmt(pair->p_value, 2) << ")";
         } else {
             D.outcome = Diagnosis::Outcome::Unexplained;
-            claim << "unexplained: no catalogued effect, alone or in a pair, predicts the held-out "
-                     "experiments better than the null model and leaves no gap";
+            if (D.held_out.empty())
+                claim << "unexplained: no held-out experiment to test a candidate on (a claim "
+                         "needs experiments it was not fitted to: give two or more experiments "
+                         "of a type, or name them with --hold-out)";
+            else
+                claim << "unexplained: no catalogued effect, alone or in a pair, predicts the "
+                         "held-out experiments better than the null model and leaves no gap";
             const CandidateResult *best = nullptr;
             for (const CandidateResult &R : D.candidates)
                 if (R.confirmed && (!best || R.held_out.gap < best->held_out.gap))

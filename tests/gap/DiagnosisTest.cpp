@@ -339,3 +339,21 @@ TEST_CASE("diagnosis: failed simulations are never read as agreement", "[gap][di
     CHECK(d.claim.find("not compared (no simulated feature): small_90, small_110") !=
           std::string::npos);
 }
+
+TEST_CASE("diagnosis: without a held-out experiment a gap is found but nothing is claimed, and "
+          "it says why",
+          "[gap][diagnosis]") {
+    const EffectCatalogue c = catalogue();
+    AnalyticSimulator sim;
+    DiagnosisOptions o;
+    o.seeds = 4;
+    o.signature_seeds = 3;
+    ExperimentSet set = measuredSet({"cohesion", 6.0e4}, 7);
+    set.experiments.resize(1); // one plate: nothing to hold out
+    const Diagnosis d = diagnose(set, c.diagnosable(), sim, o);
+    INFO(d.claim);
+    CHECK(d.verdict.gap);
+    CHECK(d.held_out.empty());
+    CHECK(d.outcome == Diagnosis::Outcome::Unexplained);
+    CHECK(d.claim.find("no held-out experiment to test a candidate on") != std::string::npos);
+}
