@@ -22,10 +22,17 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 double sq(double v) { return v * v; }
 
-/// "pressure" from "pressure_Pa": the observable's name without its unit suffix.
+/// "pressure" from "pressure_Pa", "vertical load" from "vertical_load_N": the observable's name
+/// without its unit suffix (the last word; "N_m" is one unit), in words.
 std::string observableName(const std::string &observable) {
-    const auto cut = observable.find('_');
-    return cut == std::string::npos ? observable : observable.substr(0, cut);
+    std::string name = observable;
+    for (const char *unit : {"_N_m", "_"})
+        if (const auto cut = name.rfind(unit); cut != std::string::npos && cut > 0) {
+            name = name.substr(0, cut);
+            break;
+        }
+    std::replace(name.begin(), name.end(), '_', ' ');
+    return name;
 }
 
 std::string format(double v, int digits = 2) {

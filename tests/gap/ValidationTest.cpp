@@ -191,3 +191,20 @@ TEST_CASE("localise says where the simulation is too high, on which experiments,
     CHECK(findings[1].text.find("on 2 of 4 experiments (those with box small)") !=
           std::string::npos);
 }
+
+TEST_CASE("localise names an observable in words, without its unit", "[gap][validation]") {
+    for (const auto &[observable, words] :
+         std::vector<std::pair<std::string, std::string>>{{"vertical_load_N", "vertical load"},
+                                                          {"torque_N_m", "torque"},
+                                                          {"shear_stress_Pa", "shear stress"},
+                                                          {"angle_deg", "angle"}}) {
+        const std::vector<FeatureKey> keys{{"w", observable, "wheel_steady_state/" + observable, 0.0, 0.1}};
+        ValidationResult v;
+        v.standardised = Eigen::VectorXd::Constant(1, -5.0);
+        v.ratio = Eigen::VectorXd::Constant(1, 2.0);
+        const auto findings = localise(keys, v, {{"w", {}}}, {});
+        REQUIRE(findings.size() == 1);
+        INFO(findings[0].text);
+        CHECK(findings[0].text.rfind(words + " 2x too high", 0) == 0);
+    }
+}
