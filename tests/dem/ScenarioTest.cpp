@@ -42,6 +42,19 @@ std::string replaced(std::string text, const std::string &from, const std::strin
     return text.replace(at, from.size(), to);
 }
 
+/// tiny.yaml's system at time step `time_step_s`, holding one of its 4 mm grains.
+auto oneGrain(double time_step_s) {
+    DemScenario s = parseScenario(ConfigNode::loadString(kValid, "tiny.yaml"));
+    s.settings.time_step_s = time_step_s;
+    auto system = makeSystem(s);
+    ParticleSpec p;
+    p.radius_m = 0.004;
+    p.density_kg_m3 = 2400;
+    p.position_m = Vec3(0.05, 0.05, 0.05);
+    system->particles().add(p);
+    return system;
+}
+
 } // namespace
 
 TEST_CASE("a valid scenario parses into the documented settings", "[dem][scenario]") {
@@ -109,14 +122,7 @@ TEST_CASE("scenario errors name the file, the key and the line", "[dem][scenario
 
 TEST_CASE("a time step above the stability estimate is refused with both numbers",
           "[dem][scenario]") {
-    DemScenario s = parseScenario(ConfigNode::loadString(kValid, "tiny.yaml"));
-    s.settings.time_step_s = 1e-2;
-    auto system = makeSystem(s);
-    ParticleSpec p;
-    p.radius_m = 0.004;
-    p.density_kg_m3 = 2400;
-    p.position_m = Vec3(0.05, 0.05, 0.05);
-    system->particles().add(p);
+    auto system = oneGrain(1e-2);
     try {
         system->step();
         FAIL("expected an error");
@@ -134,14 +140,7 @@ TEST_CASE("the stability estimate is half the Rayleigh time: just above it refus
     // = 6.05608e-4 s; the estimate T_R / 2 = 3.02804e-4 s.
     const double estimate = 3.02804e-4;
     for (const double factor : {1.01, 0.99}) {
-        DemScenario s = parseScenario(ConfigNode::loadString(kValid, "tiny.yaml"));
-        s.settings.time_step_s = factor * estimate;
-        auto system = makeSystem(s);
-        ParticleSpec p;
-        p.radius_m = 0.004;
-        p.density_kg_m3 = 2400;
-        p.position_m = Vec3(0.05, 0.05, 0.05);
-        system->particles().add(p);
+        auto system = oneGrain(factor * estimate);
         INFO("time step " << factor << " x the estimate");
         if (factor > 1.0)
             CHECK_THROWS_WITH(system->step(), Catch::Contains("above the stability estimate 0.000302804 s"));

@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <tuple>
 
 using namespace grainlink::gap;
@@ -32,6 +33,36 @@ void acceptedByTheLab(const StudySimulator &sim, const Design &design, const Var
     }
 }
 
+/// Calls `visit` with the base, each numerical check of `sim` and each applicable catalogue
+/// effect at each of its signature strengths: every variant a diagnosis can ask for.
+void forEveryVariant(const StudySimulator &sim,
+                     const std::function<void(const VariantRequest &)> &visit) {
+    const EffectCatalogue catalogue =
+        loadEffects(std::string(GRAINLINK_SOURCE_DIR) + "/data/effects.yaml");
+    const YAML::Node reference = sim.referenceScenario();
+    VariantRequest base;
+    base.label = "base";
+    visit(base);
+    for (const std::string &check : sim.checks()) {
+        VariantRequest r;
+        r.label = "check-" + check;
+        r.check = check;
+        visit(r);
+    }
+    for (const Effect &raw : catalogue.effects) {
+        if (!inapplicable(raw, reference).empty())
+            continue;
+        const Effect e = resolveAgainst(raw, reference);
+        for (double s : e.signature) {
+            VariantRequest r;
+            r.label = e.name + "-" + std::to_string(s);
+            r.effect = &e;
+            r.strength = s;
+            visit(r);
+        }
+    }
+}
+
 } // namespace
 
 TEST_CASE("every effect and numerical check on the self-tests' designs is a scenario the lab "
@@ -44,30 +75,7 @@ TEST_CASE("every effect and numerical check on the self-tests' designs is a scen
     fs::create_directories(scratch);
     const StudySimulator sim(loadBaseModel(kDir + "/base.yaml"), (scratch / "sims").string(), {});
     const Design design = loadDesign(kDir + "/design.yaml");
-    const EffectCatalogue catalogue = loadEffects(std::string(GRAINLINK_SOURCE_DIR) + "/data/effects.yaml");
-    const YAML::Node reference = sim.referenceScenario();
-
-    VariantRequest base;
-    base.label = "base";
-    acceptedByTheLab(sim, design, base, scratch);
-    for (const std::string &check : sim.checks()) {
-        VariantRequest r;
-        r.label = "check-" + check;
-        r.check = check;
-        acceptedByTheLab(sim, design, r, scratch);
-    }
-    for (const Effect &raw : catalogue.effects) {
-        if (!inapplicable(raw, reference).empty())
-            continue;
-        const Effect e = resolveAgainst(raw, reference);
-        for (double s : e.signature) {
-            VariantRequest r;
-            r.label = e.name + "-" + std::to_string(s);
-            r.effect = &e;
-            r.strength = s;
-            acceptedByTheLab(sim, design, r, scratch);
-        }
-    }
+    forEveryVariant(sim, [&](const VariantRequest &r) { acceptedByTheLab(sim, design, r, scratch); });
     fs::remove_all(scratch);
 }
 
@@ -160,28 +168,9 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     for (std::size_t i = 0; i < measured.size(); ++i)
         CHECK(smooth.test.slips[i] == Approx(measured[i]).margin(1e-6));
 
-    const EffectCatalogue catalogue =
-        loadEffects(std::string(GRAINLINK_SOURCE_DIR) + "/data/effects.yaml");
-    const YAML::Node reference = sim.referenceScenario();
-    for (const std::string &c : sim.checks()) {
-        VariantRequest r;
-        r.label = "check-" + c;
-        r.check = c;
+    forEveryVariant(sim, [&](const VariantRequest &r) {
         for (const char *id : {"smooth_beta0", "grouser_beta0"})
             CHECK_NOTHROW(check(id, r));
-    }
-    for (const Effect &raw : catalogue.effects) {
-        if (!inapplicable(raw, reference).empty())
-            continue;
-        const Effect e = resolveAgainst(raw, reference);
-        for (double s : e.signature) {
-            VariantRequest r;
-            r.label = e.name + "-" + std::to_string(s);
-            r.effect = &e;
-            r.strength = s;
-            for (const char *id : {"smooth_beta0", "grouser_beta0"})
-                CHECK_NOTHROW(check(id, r));
-        }
-    }
+    });
     fs::remove_all(scratch);
 }
