@@ -425,7 +425,8 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
             root = applyEffect(domain, f, root, first.type);
         } else if (request.check == "rate") {
             YAML::Node sec = root[test];
-            for (const char *k : {"speed_m_s", "shear_speed_m_s", "angular_speed_rad_s", "lift_speed_m_s"})
+            for (const char *k : {"speed_m_s", "shear_speed_m_s", "angular_speed_rad_s",
+                                  "lift_speed_m_s", "carriage_speed_m_s"})
                 if (sec[k])
                     sec[k] = sec[k].as<double>() * f;
             if (sec["sample_interval_s"])

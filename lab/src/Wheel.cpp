@@ -18,11 +18,11 @@ namespace grainlink::lab {
 namespace fs = std::filesystem;
 using dem::Vec3;
 
-double carriageSpeed(double rim_speed_m_s, double slip) {
-    if (!(slip > -1.0 && slip < 1.0))
-        throw std::invalid_argument("carriageSpeed: slip must lie in (-1, 1), got " +
+double rimSpeed(double carriage_speed_m_s, double slip) {
+    if (!(slip >= -1.0 && slip < 1.0))
+        throw std::invalid_argument("rimSpeed: slip must lie in [-1, 1), got " +
                                     std::to_string(slip));
-    return slip >= 0.0 ? rim_speed_m_s * (1.0 - slip) : rim_speed_m_s / (1.0 + slip);
+    return slip >= 0.0 ? carriage_speed_m_s / (1.0 - slip) : carriage_speed_m_s * (1.0 + slip);
 }
 
 WheelScenario parseWheel(const config::ConfigNode &root) {
@@ -35,14 +35,14 @@ WheelScenario parseWheel(const config::ConfigNode &root) {
     t.load_N = w["load_N"].positive();
     for (const config::ConfigNode &slip : w["slips"].items()) {
         const double v = slip.number();
-        if (!(v > -1.0 && v < 1.0))
-            slip.fail("a slip lies in (-1, 1) (s = (v_rim - v) / max(v_rim, v)), got " +
-                      std::to_string(v));
+        if (!(v >= -1.0 && v < 1.0))
+            slip.fail("a slip lies in [-1, 1) (s = (v_rim - v) / max(v_rim, v); -1 a locked "
+                      "wheel), got " + std::to_string(v));
         t.slips.push_back(v);
     }
     if (t.slips.empty())
         w["slips"].fail("give at least one slip");
-    t.angular_speed_rad_s = w["angular_speed_rad_s"].positive();
+    t.carriage_speed_m_s = w["carriage_speed_m_s"].positive();
     t.travel_m = w["travel_m"].positive();
     if (w.has("steady_fraction"))
         t.steady_fraction = w["steady_fraction"].number(0.05, 1.0);
@@ -175,7 +175,8 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
     dem::DemSystem sys = *bed.system; // every slip drives on its own copy of the settled bed
     WheelRun run;
     run.slip = slip;
-    run.carriage_speed_m_s = carriageSpeed(t.angular_speed_rad_s * radius, slip);
+    run.carriage_speed_m_s = t.carriage_speed_m_s;
+    run.angular_speed_rad_s = rimSpeed(t.carriage_speed_m_s, slip) / radius;
     run.surface_m = surface;
     const double x0 = lower.x() + t.end_margin_m + reach;
     // The lowest point starts above every grain under the wheel's footprint.
@@ -238,11 +239,11 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
 
     // Drive: the spin and the carriage speed set, the servo holding the load.
     const double t_drive = sys.time(), x_drive = drive.x(t_drive);
-    drive.retarget(sys, t_drive, run.carriage_speed_m_s, drive.v_z, t.angular_speed_rad_s);
+    drive.retarget(sys, t_drive, run.carriage_speed_m_s, drive.v_z, run.angular_speed_rad_s);
     for (;;) {
         const Interval s = interval();
         drive.retarget(sys, sys.time(), run.carriage_speed_m_s,
-                       -servo.update(s.load.force_N.z(), interval_s), t.angular_speed_rad_s);
+                       -servo.update(s.load.force_N.z(), interval_s), run.angular_speed_rad_s);
         WheelSample x;
         x.time_s = s.t_mid_s - t_drive;
         x.travel_m = drive.x(s.t_mid_s) - x_drive;
@@ -275,10 +276,10 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
             run.max_load_error, std::abs(run.samples[i].vertical_load_N - t.load_N) / t.load_N);
     run.wall_s = secondsSince(run_start);
     std::fprintf(stderr,
-                 "[wheel] slip %.3g: carriage %.4g m/s, loaded in %.3f s (static sinkage %.2f "
+                 "[wheel] slip %.3g: carriage %.4g m/s, spin %.4g rad/s, loaded in %.3f s (static sinkage %.2f "
                  "mm); steady traction %.4g +- %.2g N, load %.4g +- %.2g N, torque %.4g +- %.2g "
                  "N m, sinkage %.2f +- %.2f mm; %llu steps in %.1f s\n",
-                 slip, run.carriage_speed_m_s, run.load_time_s, run.sinkage_at_load_m * 1e3,
+                 slip, run.carriage_speed_m_s, run.angular_speed_rad_s, run.load_time_s, run.sinkage_at_load_m * 1e3,
                  run.traction_N.mean, run.traction_N.sd, run.vertical_load_N.mean,
                  run.vertical_load_N.sd, run.torque_N_m.mean, run.torque_N_m.sd,
                  run.sinkage_m.mean * 1e3, run.sinkage_m.sd * 1e3,
@@ -321,6 +322,7 @@ LabSummary WheelResult::summary() const {
         LabRunSummary x;
         x.values = {{"slip", r.slip},
                     {"carriage_speed_m_s", r.carriage_speed_m_s},
+                    {"angular_speed_rad_s", r.angular_speed_rad_s},
                     {"traction_N", r.traction_N.mean},
                     {"traction_sd_N", r.traction_N.sd},
                     {"vertical_load_N", r.vertical_load_N.mean},
@@ -368,11 +370,12 @@ void WheelResult::writeCsvs(const std::string &directory) const {
                     << s.vertical_load_N << ',' << s.torque_N_m << ',' << s.sinkage_m << '\n';
     }
     auto csv = openCsv(dir, "wheel_slip.csv",
-                       "slip,carriage_speed_m_s,traction_N,traction_sd_N,vertical_load_N,"
+                       "slip,carriage_speed_m_s,angular_speed_rad_s,traction_N,traction_sd_N,vertical_load_N,"
                        "vertical_load_sd_N,torque_N_m,torque_sd_N_m,sinkage_m,sinkage_sd_m,"
                        "steady_samples");
     for (const auto &r : runs)
-        csv << r.slip << ',' << r.carriage_speed_m_s << ',' << r.traction_N.mean << ','
+        csv << r.slip << ',' << r.carriage_speed_m_s << ',' << r.angular_speed_rad_s << ','
+            << r.traction_N.mean << ','
             << r.traction_N.sd << ',' << r.vertical_load_N.mean << ',' << r.vertical_load_N.sd
             << ',' << r.torque_N_m.mean << ',' << r.torque_N_m.sd << ',' << r.sinkage_m.mean << ','
             << r.sinkage_m.sd << ',' << r.steady_samples << '\n';

@@ -17,7 +17,7 @@ using Catch::Matchers::Contains;
 namespace {
 
 /// A tiny bin 200 x 50 mm, ~30 mm of 2.5 mm grains (the tiny beds' contacts); a smooth wheel
-/// 60 mm across and 30 mm wide (Gamma = 6) under 2 N, spun at 4 rad/s (rim 0.12 m/s) over 60 mm.
+/// 60 mm across and 30 mm wide (Gamma = 6) under 2 N, its carriage at 0.12 m/s over 60 mm.
 const std::string kTiny = "name: tiny-wheel\nsoil:\n  simulation: {time_step_s: 5.0e-5, threads: 1}\n" +
                           kTinyGrainContacts + R"(  walls:
     - {name: bin, type: box, lower_m: [0, 0, 0], upper_m: [0.2, 0.05, 0.2]}
@@ -33,7 +33,7 @@ wheel:
   shape: {diameter_m: 0.06, width_m: 0.03}
   load_N: 2
   slips: [-0.4, 0.0, 0.5]
-  angular_speed_rad_s: 4
+  carriage_speed_m_s: 0.12
   travel_m: 0.06
   servo: {gain_m_s_per_N: 0.01, integral_gain_m_s2_per_N: 0.5, max_speed_m_s: 0.05}
   sample_interval_s: 0.001
@@ -45,13 +45,14 @@ lab::WheelScenario parse(const std::string &text) {
 
 } // namespace
 
-TEST_CASE("wheel: the carriage speed of a slip, driven and braked, by hand", "[lab][wheel]") {
-    // s = (v_rim - v) / max(v_rim, v): driven, v = v_rim (1 - s); braked, v = v_rim / (1 + s).
-    CHECK(lab::carriageSpeed(0.1, 0.0) == Approx(0.1));
-    CHECK(lab::carriageSpeed(0.1, 0.25) == Approx(0.075));
-    CHECK(lab::carriageSpeed(0.1, -0.25) == Approx(0.1 / 0.75));
-    CHECK(lab::carriageSpeed(0.1, 0.9) == Approx(0.01));
-    CHECK_THROWS_WITH(lab::carriageSpeed(0.1, 1.0), Contains("(-1, 1)"));
+TEST_CASE("wheel: the rim speed of a slip, driven, braked and locked, by hand", "[lab][wheel]") {
+    // s = (v_rim - v) / max(v_rim, v) with the carriage at v = 0.1 m/s.
+    CHECK(lab::rimSpeed(0.1, 0.0) == Approx(0.1));
+    CHECK(lab::rimSpeed(0.1, 0.5) == Approx(0.2));   // (0.2 - 0.1) / 0.2
+    CHECK(lab::rimSpeed(0.1, 0.9) == Approx(1.0));   // (1 - 0.1) / 1
+    CHECK(lab::rimSpeed(0.1, -0.25) == Approx(0.075)); // (0.075 - 0.1) / 0.1
+    CHECK(lab::rimSpeed(0.1, -1.0) == 0.0);          // locked
+    CHECK_THROWS_WITH(lab::rimSpeed(0.1, 1.0), Contains("[-1, 1)"));
 }
 
 TEST_CASE("wheel: a braked wheel is pushed back, a driven one pulls, the servo holds the load and "
@@ -70,9 +71,10 @@ TEST_CASE("wheel: a braked wheel is pushed back, a driven one pulls, the servo h
         CHECK(run.vertical_load_N.mean == Approx(2.0).epsilon(0.10));
         // Steady state: the power the motor puts in, T omega, covers the drawbar's, F_x v
         // (what the soil dissipates is never negative), within the steady scatter.
-        const double motor = run.torque_N_m.mean * 4.0, drawbar = run.traction_N.mean *
-                                                                   run.carriage_speed_m_s;
-        const double scatter = 4.0 * run.torque_N_m.sd / std::sqrt(double(run.steady_samples)) +
+        const double omega = run.angular_speed_rad_s;
+        const double motor = run.torque_N_m.mean * omega,
+                     drawbar = run.traction_N.mean * run.carriage_speed_m_s;
+        const double scatter = omega * run.torque_N_m.sd / std::sqrt(double(run.steady_samples)) +
                                run.carriage_speed_m_s * 2.0 * run.traction_N.sd /
                                    std::sqrt(double(run.steady_samples));
         CHECK(motor - drawbar > -scatter);
@@ -95,7 +97,7 @@ TEST_CASE("wheel: a braked wheel is pushed back, a driven one pulls, the servo h
 
 TEST_CASE("wheel: bad input names the file, the key and the line", "[lab][wheel]") {
     CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "slips: [-0.4, 0.0, 0.5]", "slips: [0.2, 1.0]")),
-                      Contains("wheel.yaml:") && Contains("wheel.slips[1]") && Contains("(-1, 1)"));
+                      Contains("wheel.yaml:") && Contains("wheel.slips[1]") && Contains("[-1, 1)"));
     CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "travel_m: 0.06", "travel_m: 0.5")),
                       Contains("wheel.travel_m") && Contains("can travel at most"));
     CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "width_m: 0.03", "width_m: 0.01")),

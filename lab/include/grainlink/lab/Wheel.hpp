@@ -16,17 +16,19 @@
 
 namespace grainlink::lab {
 
-/// The carriage speed [m/s] for rim speed `rim_speed_m_s` (omega r) at `slip`, with the
-/// test-bed convention s = (v_rim - v) / max(v_rim, v): v = v_rim (1 - s) when driving (s >= 0),
-/// v = v_rim / (1 + s) when braked (s < 0). Throws std::invalid_argument outside (-1, 1).
-double carriageSpeed(double rim_speed_m_s, double slip);
+/// The rim speed [m/s] (omega r) for carriage speed `carriage_speed_m_s` at `slip`, with the
+/// test-bed convention s = (v_rim - v) / max(v_rim, v): v_rim = v / (1 - s) when driving
+/// (s >= 0), v_rim = v (1 + s) when braked (s < 0; -1 is a locked wheel). Like the CMU test
+/// bed, the carriage keeps its speed and the wheel's spin sets the slip. Throws
+/// std::invalid_argument outside [-1, 1).
+double rimSpeed(double carriage_speed_m_s, double slip);
 
 /// The `wheel:` section.
 struct WheelSpec {
     body::WheelShape shape;           ///< the `shape:` block (the rig's `wheel:` keys)
     double load_N = 0.0;              ///< [N] vertical load the servo holds
-    std::vector<double> slips;        ///< [-] one run each, in (-1, 1)
-    double angular_speed_rad_s = 0.0; ///< [rad/s] spin while driving; rim speed omega r
+    std::vector<double> slips;        ///< [-] one run each, in [-1, 1)
+    double carriage_speed_m_s = 0.0;  ///< [m/s] while driving, every slip; the spin follows
     double travel_m = 0.0;            ///< [m] carriage travel while driving, per slip
     double steady_fraction = 0.5;     ///< [-] the last share of the travel that is averaged
     double approach_speed_m_s = 0.05; ///< [m/s] downward until the load is first reached
@@ -69,6 +71,7 @@ struct SteadyValue {
 struct WheelRun {
     double slip = 0.0;            ///< [-] the set slip
     double carriage_speed_m_s = 0.0;
+    double angular_speed_rad_s = 0.0; ///< [rad/s] the spin that gives the slip
     double surface_m = 0.0;       ///< [m] settled bed surface
     double load_time_s = 0.0;     ///< [s] approach and hold before the drive
     double sinkage_at_load_m = 0.0; ///< [m] static sinkage under the load
