@@ -31,6 +31,10 @@ __attribute__((constructor(101), target("arch=x86-64"))) static void requireX86_
 int main(int argc, char **argv) {
     CLI::App app{"grainlink: co-simulation of planetary locomotion on granular soil"};
     app.require_subcommand(1);
+    app.set_version_flag("--version", std::string("grainlink ") + GRAINLINK_VERSION + " (" +
+                                          (GRAINLINK_ISA_NAME[0] ? GRAINLINK_ISA_NAME
+                                                                 : "compiler's default") +
+                                          " instruction set)");
 
     auto *dem =
         app.add_subcommand("dem", "run a DEM-only scenario (deposition, then prescribed bodies)");
