@@ -33,6 +33,13 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> meanAndVariance(const Eigen::MatrixX
     return {s.mean, var};
 }
 
+std::string joined(const std::vector<std::string> &items) {
+    std::string list;
+    for (const auto &item : items)
+        list += (list.empty() ? "" : ", ") + item;
+    return list;
+}
+
 std::string strengthText(const Effect &e, double s) {
     return e.parameter + " " + fmt(s) + (e.unit == "-" ? "" : " " + e.unit);
 }
@@ -112,28 +119,21 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     const ValidationResult &V = D.validation;
     // Nothing compared is no evidence of agreement: a diagnosis whose base runs all failed, or
     // reached none of the measured range, stops here instead of reporting "no gap".
-    {
-        std::vector<std::string> compared, not_compared;
-        for (const Experiment &e : set.experiments) {
-            bool any = false;
-            for (Eigen::Index k = 0; k < n; ++k)
-                any = any || (meas.keys[std::size_t(k)].experiment == e.id &&
-                              std::isfinite(V.standardised[k]));
-            (any ? compared : not_compared).push_back(e.id);
-        }
-        std::string list;
-        for (const auto &id : not_compared)
-            list += (list.empty() ? "" : ", ") + id;
-        if (compared.empty())
-            throw std::runtime_error(
-                "no experiment could be compared with the base model: its simulations failed or "
-                "reached none of the measured range (" + list + "; the failed runs and their logs "
-                "are named above)");
-        if (!not_compared.empty()) {
-            D.not_compared = not_compared;
-            log("not compared (no simulated feature in the measured range): " + list);
-        }
+    for (const Experiment &e : set.experiments) {
+        bool any = false;
+        if (const auto it = design.by_experiment.find(e.id); it != design.by_experiment.end())
+            for (Eigen::Index k : it->second)
+                any = any || std::isfinite(V.standardised[k]);
+        if (!any)
+            D.not_compared.push_back(e.id);
     }
+    if (D.not_compared.size() == set.experiments.size())
+        throw std::runtime_error(
+            "no experiment could be compared with the base model: its simulations failed or "
+            "reached none of the measured range (" + joined(D.not_compared) +
+            "; the failed runs and their logs are named above)");
+    if (!D.not_compared.empty())
+        log("not compared (no simulated feature in the measured range): " + joined(D.not_compared));
     const BlockCorrelation correlation(meas.keys, base_rows);
     D.verdict = testGap(meas.keys, V.z, opt.alpha, opt.flag_at);
     D.findings = localise(meas.keys, V, [&] {
@@ -197,10 +197,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     const double n_eff = correlation.effectiveCount(D.held_out);
 
     const auto notCompared = [&] {
-        std::string list;
-        for (const auto &id : D.not_compared)
-            list += (list.empty() ? "" : ", ") + id;
-        return list.empty() ? std::string() : "; not compared (no simulated feature): " + list;
+        return D.not_compared.empty()
+                   ? std::string()
+                   : "; not compared (no simulated feature): " + joined(D.not_compared);
     };
     if (!D.verdict.gap) {
         D.outcome = Diagnosis::Outcome::NoGap;

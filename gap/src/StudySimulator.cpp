@@ -136,12 +136,13 @@ void wheelSection(YAML::Node section, const ExperimentSet &design, const Feature
                     xx.emplace_back(c->second.x[0], c->second.x[0]);
             std::vector<int> counts;
             const std::vector<double> mean = scatterBinMeans(xx, edges->second, counts);
-            for (std::size_t b = 0; b < mean.size(); ++b)
-                if (counts[b] > 0 || !e.scatter)
-                    slips.insert(std::round((counts[b] > 0 ? mean[b]
-                                                       : 0.5 * (edges->second[b] + edges->second[b + 1])) *
-                                        1e6) /
-                             1e6);
+            for (std::size_t b = 0; b < mean.size(); ++b) {
+                if (e.scatter && counts[b] == 0)
+                    continue; // no measured run there: no feature to compare
+                const double slip = counts[b] > 0 ? mean[b]
+                                                  : 0.5 * (edges->second[b] + edges->second[b + 1]);
+                slips.insert(std::round(slip * 1e6) / 1e6);
+            }
         }
     }
     if (slips.empty())

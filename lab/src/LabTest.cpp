@@ -75,10 +75,14 @@ const std::vector<std::string> &labWarnings(const LabScenario &scenario) {
                       scenario);
 }
 
-LabScenario loadLabScenario(const std::string &test, const std::string &path) {
+void requireLabTest(const std::string &test) {
     const auto names = labTestNames();
     if (std::find(names.begin(), names.end(), test) == names.end())
-        throw unknownTest(test); // before the file: a wrong test name is the likelier mistake
+        throw unknownTest(test);
+}
+
+LabScenario loadLabScenario(const std::string &test, const std::string &path) {
+    requireLabTest(test); // before the file: a wrong test name is the likelier mistake
     return parseLabScenario(test, config::ConfigNode::loadFile(path));
 }
 

@@ -3,7 +3,6 @@
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/LabTest.hpp"
 
-#include <algorithm>
 #include <stdexcept>
 
 namespace grainlink::study {
@@ -29,13 +28,7 @@ Kind standardKind(const std::string &kind, const std::string &test) {
             {}};
     }
     if (kind == "lab") {
-        const auto names = lab::labTestNames();
-        if (std::find(names.begin(), names.end(), test) == names.end()) {
-            std::string list;
-            for (const auto &n : names)
-                list += (list.empty() ? "" : ", ") + n;
-            throw std::invalid_argument("lab test '" + test + "' is not one of: " + list);
-        }
+        lab::requireLabTest(test);
         return {"lab " + test,
                 {"lab", test},
                 "summary.json",

@@ -29,6 +29,8 @@ using LabScenario = std::variant<BevameterScenario, ShearAnnulusScenario, Direct
 /// bevameter_shear, direct_shear, repose, wheel.
 std::vector<std::string> labTestNames();
 std::string labTestName(const LabScenario &scenario);
+/// Throws std::invalid_argument naming the tests unless `test` is one of them.
+void requireLabTest(const std::string &test);
 /// The scenario's `name` (the default output directory is out/<name>).
 const std::string &labScenarioName(const LabScenario &scenario);
 /// Deprecated spellings its file used (file:line: warning: ...), to print.
