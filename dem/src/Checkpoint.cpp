@@ -268,8 +268,19 @@ CheckpointExtras readCheckpoint(DemSystem &system, const std::string &path) {
     ParticleStore particles;
     DemSystem::Internals internals;
     CheckpointExtras extras = load(path, particles, internals);
+    for (int m : particles.material)
+        if (m < 0 || std::size_t(m) >= system.materials().size())
+            throw std::runtime_error("'" + path + "': checkpoint has grains of material " +
+                                     std::to_string(m) + ", the scenario defines " +
+                                     std::to_string(system.materials().size()) +
+                                     " (a checkpoint of another scenario?)");
     system.particles() = std::move(particles);
-    system.restoreInternals(internals);
+    try {
+        system.restoreInternals(internals);
+    } catch (const std::runtime_error &e) {
+        throw std::runtime_error("'" + path + "': " + e.what() +
+                                 " (a checkpoint of another scenario?)");
+    }
     return extras;
 }
 

@@ -52,6 +52,16 @@ private:
     int fd_;
 };
 
+/// A number a scenario run keeps in its checkpoint; a checkpoint without it was written by
+/// another program or another scenario (a bare std::map::at would say neither).
+double extra(const CheckpointExtras &extras, const std::string &key, const std::string &path) {
+    const auto found = extras.find(key);
+    if (found == extras.end())
+        throw std::runtime_error("cannot resume from '" + path + "': it has no '" + key +
+                                 "' (not a checkpoint of this scenario's run)");
+    return found->second;
+}
+
 } // namespace
 
 std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progress_interval_s,
@@ -267,10 +277,11 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
             throw std::runtime_error("cannot resume: no checkpoint at '" + checkpoint + "'");
         // Bodies must exist before their state is restored; their start is stored in extras.
         extras = readCheckpointExtras(checkpoint);
-        run_start_s = extras.at("run_start_s");
+        run_start_s = extra(extras, "run_start_s", checkpoint);
         for (std::size_t b = 0; b < scenario.bodies.size(); ++b) {
             RigidBodyState start = scenario.bodies[b].start;
-            start.position_m.z() = extras.at("body" + std::to_string(b) + "_start_z_m");
+            start.position_m.z() =
+                extra(extras, "body" + std::to_string(b) + "_start_z_m", checkpoint);
             starts.push_back(start);
             addBody(*sys, scenario.bodies[b], start, run_start_s);
         }
@@ -307,8 +318,8 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
     if (options.resume) {
         truncateSeries(series_path, sys->stepCount());
         std::vector<double> times;
-        for (int k = 0; k < int(extras.at("snapshots")); ++k)
-            times.push_back(extras.at("snapshot" + std::to_string(k) + "_s"));
+        for (int k = 0; k < int(extra(extras, "snapshots", checkpoint)); ++k)
+            times.push_back(extra(extras, "snapshot" + std::to_string(k) + "_s", checkpoint));
         vtk.resumeAt(int(times.size()), times);
     }
     std::vector<BodyLoad> loads;

@@ -298,6 +298,48 @@ TEST_CASE("an interrupted scenario run resumes to the same series as an uninterr
     CHECK(fs::exists(dir / "broken" / "particles.pvd"));
 }
 
+TEST_CASE("resume: a missing or mismatched checkpoint is refused naming the file",
+          "[dem][checkpoint][scenario]") {
+    const Scratch scratch("resume-refused");
+    const fs::path &dir = scratch.dir;
+    const fs::path out = dir / "run";
+    const std::string checkpoint = (out / "checkpoint.bin").string();
+    RunOptions resume{out.string(), true, 1e9};
+    CHECK_THROWS_WITH(runScenario(smallScenario(dir, 0.3), resume),
+                      "cannot resume: no checkpoint at '" + checkpoint + "'");
+
+    // A bed checkpointed without the run's numbers (another program's): the first one missing.
+    auto bed = busySystem(1);
+    bed->run(5);
+    writeCheckpoint(*bed, checkpoint);
+    CHECK_THROWS_WITH(runScenario(smallScenario(dir, 0.3), resume),
+                      "cannot resume from '" + checkpoint +
+                          "': it has no 'run_start_s' (not a checkpoint of this scenario's run)");
+    // The run's numbers, but one body fewer than the scenario has.
+    writeCheckpoint(*bed, checkpoint, {{"run_start_s", 0.0}, {"snapshots", 0.0}});
+    CHECK_THROWS_WITH(runScenario(smallScenario(dir, 0.3), resume),
+                      Catch::Contains("'" + checkpoint + "'") &&
+                          Catch::Contains("no 'body0_start_z_m'"));
+    // A checkpoint of another setup: one grain, no wall, no body where the scenario has a wheel.
+    DemSystem loose(hertzRestitution(0.3, 0.5), {soil(3e6, 0.2, 2400)}, quietSettings(1e-5));
+    loose.particles().add(sphere(Vec3::Zero(), 0.004, 2400));
+    writeCheckpoint(loose, checkpoint,
+                    {{"run_start_s", 0.0}, {"snapshots", 0.0}, {"body0_start_z_m", 0.05}});
+    CHECK_THROWS_WITH(runScenario(smallScenario(dir, 0.3), resume),
+                      "'" + checkpoint +
+                          "': checkpoint has 0 mesh bodies, the scenario defines 1 "
+                          "(a checkpoint of another scenario?)");
+    // Grains of a material the scenario does not define (a crusted bed has two).
+    auto crusted = busySystem(1);
+    crusted->particles().material[0] = 1;
+    writeCheckpoint(*crusted, checkpoint,
+                    {{"run_start_s", 0.0}, {"snapshots", 0.0}, {"body0_start_z_m", 0.05}});
+    CHECK_THROWS_WITH(runScenario(smallScenario(dir, 0.3), resume),
+                      "'" + checkpoint +
+                          "': checkpoint has grains of material 1, the scenario "
+                          "defines 1 (a checkpoint of another scenario?)");
+}
+
 TEST_CASE("a failing run reports step, particle and quantity and keeps its results",
           "[dem][checkpoint][scenario]") {
     const Scratch scratch("failure");
