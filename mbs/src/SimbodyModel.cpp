@@ -1,6 +1,8 @@
 #include "grainlink/mbs/SimbodyModel.hpp"
 
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <fstream>
 #include <sstream>
 
@@ -125,32 +127,74 @@ void SimbodyModel::writeCheckpoint(const std::string &path) const {
         throw ModelError("cannot write checkpoint " + path);
 }
 
+namespace {
+
+/// One line of a multibody checkpoint: its tag, then exactly `count` finite numbers; otherwise
+/// an error naming the file, the line and what the line holds.
+std::vector<double> checkpointLine(std::istream &in, const std::string &path, int number,
+                                   const std::string &tag, std::size_t count,
+                                   const std::string &what) {
+    const std::string where = path + ":" + std::to_string(number) + ": ";
+    std::string line;
+    if (!std::getline(in, line))
+        throw ModelError(where + "missing the line '" + tag + " ...' (" + what +
+                         "): truncated multibody checkpoint");
+    std::istringstream words(line);
+    std::string word;
+    if (!(words >> word) || word != tag)
+        throw ModelError(where + "expected '" + tag + " ...' (" + what + "), got '" +
+                         line.substr(0, 40) + "'" +
+                         (number == 1 ? ": not a multibody checkpoint" : ""));
+    std::vector<double> values;
+    while (words >> word) {
+        char *end = nullptr;
+        const double value = std::strtod(word.c_str(), &end);
+        if (end == word.c_str() || *end != '\0' || !std::isfinite(value))
+            throw ModelError(where + "'" + word.substr(0, 40) + "' in " + what +
+                             " is not a finite number");
+        values.push_back(value);
+    }
+    if (values.size() != count)
+        throw ModelError(where + std::to_string(values.size()) + " values of " + what +
+                         ", this model has " + std::to_string(count) +
+                         " (a checkpoint of another model?)");
+    return values;
+}
+
+} // namespace
+
 void SimbodyModel::readCheckpoint(const std::string &path) {
     std::ifstream in(path);
-    std::string tag;
-    double t = 0.0;
-    if (!(in >> tag >> t) || tag != "t")
-        throw ModelError(path + ": not a multibody checkpoint");
-    SimTK::State s = state_;
-    s.setTime(t);
-    in >> tag;
-    for (int i = 0; i < s.getNQ(); ++i)
-        in >> s.updQ()[i];
-    in >> tag;
-    for (int i = 0; i < s.getNU(); ++i)
-        in >> s.updU()[i];
-    in >> tag;
-    std::vector<Wrench> wrenches(coupled_.size());
-    for (auto &w : wrenches)
-        for (int k = 0; k < 3; ++k)
-            in >> w.force_N[k] >> w.torque_N_m[k];
-    std::string extras;
-    std::getline(in >> std::ws, extras);
     if (!in)
-        throw ModelError(path + ": truncated multibody checkpoint");
+        throw ModelError("cannot open multibody checkpoint " + path);
+    SimTK::State s = state_;
+    s.setTime(checkpointLine(in, path, 1, "t", 1, "the time [s]")[0]);
+    const auto q =
+        checkpointLine(in, path, 2, "q", std::size_t(s.getNQ()), "the generalized coordinates");
+    for (int i = 0; i < s.getNQ(); ++i)
+        s.updQ()[i] = q[std::size_t(i)];
+    const auto u =
+        checkpointLine(in, path, 3, "u", std::size_t(s.getNU()), "the generalized speeds");
+    for (int i = 0; i < s.getNU(); ++i)
+        s.updU()[i] = u[std::size_t(i)];
+    const auto w = checkpointLine(in, path, 4, "wrenches", 6 * coupled_.size(),
+                                  "the force [N] and torque [N m] on each coupled body");
+    std::vector<Wrench> wrenches(coupled_.size());
+    for (std::size_t b = 0; b < wrenches.size(); ++b)
+        for (int k = 0; k < 3; ++k) {
+            wrenches[b].force_N[k] = w[6 * b + 2 * std::size_t(k)];
+            wrenches[b].torque_N_m[k] = w[6 * b + 2 * std::size_t(k) + 1];
+        }
+    std::string extras;
+    if (!std::getline(in, extras))
+        throw ModelError(path + ":5: missing the model's own line: truncated multibody checkpoint");
     state_ = s;
     applyWrenches(wrenches);
-    readCheckpointExtras(extras);
+    try {
+        readCheckpointExtras(extras);
+    } catch (const ModelError &e) {
+        throw ModelError(path + ":5: " + e.what());
+    }
     system_.realize(state_, SimTK::Stage::Velocity);
 }
 

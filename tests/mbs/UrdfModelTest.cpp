@@ -7,8 +7,15 @@
 
 #include <catch2/catch.hpp>
 
+#include <unistd.h>
+
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 using namespace grainlink::mbs;
 using grainlink::config::ConfigError;
@@ -170,6 +177,81 @@ TEST_CASE("URDF model: save/restore and checkpoints keep the drives", "[mbs][urd
     CHECK(a.bodyStates()[0].position_m == b.bodyStates()[0].position_m);
     CHECK(a.bodyStates()[0].angular_velocity_rad_s == b.bodyStates()[0].angular_velocity_rad_s);
     std::remove(path.c_str());
+}
+
+TEST_CASE("URDF model: a damaged checkpoint is refused naming the file and the line",
+          "[mbs][urdf][checkpoint]") {
+    UrdfModel a(parseUrdfModel(kModels + "/single_wheel_rig.yaml"));
+    a.applyWrenches({Wrench{}});
+    a.advanceTo(0.02);
+    const std::string path = (std::filesystem::temp_directory_path() /
+                              ("grainlink-damaged-" + std::to_string(::getpid()) + ".txt"))
+                                 .string();
+    a.writeCheckpoint(path);
+    std::vector<std::string> lines;
+    {
+        std::ifstream in(path);
+        for (std::string line; std::getline(in, line);)
+            lines.push_back(line);
+    }
+    REQUIRE(lines.size() == 5); // t, q, u, wrenches, the drives
+    const auto words = [](const std::string &line) {
+        std::istringstream in(line);
+        std::vector<std::string> out;
+        for (std::string w; in >> w;)
+            out.push_back(w);
+        return out;
+    };
+    const std::size_t nq = words(lines[1]).size() - 1;
+    REQUIRE(nq >= 2);
+    // The error reading `damaged` (the intact lines with some replaced or dropped) gives.
+    const auto error = [&](std::vector<std::string> damaged) {
+        std::ofstream out(path);
+        for (const auto &line : damaged)
+            out << line << '\n';
+        out.close();
+        UrdfModel b(parseUrdfModel(kModels + "/single_wheel_rig.yaml"));
+        return messageOf<ModelError>([&] { b.readCheckpoint(path); });
+    };
+    {
+        UrdfModel b(parseUrdfModel(kModels + "/single_wheel_rig.yaml"));
+        b.readCheckpoint(path); // the intact file reads
+        CHECK(b.time() == a.time());
+    }
+    CHECK(error({lines[0], lines[1], lines[2]}) ==
+          path + ":4: missing the line 'wrenches ...' (the force [N] and torque [N m] on each "
+                 "coupled body): truncated multibody checkpoint");
+    CHECK(error({lines[0], lines[1], lines[2], lines[3]}) ==
+          path + ":5: missing the model's own line: truncated multibody checkpoint");
+    // One coordinate fewer: the checkpoint of a model with another number of coordinates.
+    std::string short_q = "q";
+    for (std::size_t k = 1; k < nq; ++k)
+        short_q += " " + words(lines[1])[k];
+    CHECK(error({lines[0], short_q, lines[2], lines[3], lines[4]}) ==
+          path + ":2: " + std::to_string(nq - 1) + " values of the generalized coordinates, this " +
+              "model has " + std::to_string(nq) + " (a checkpoint of another model?)");
+    CHECK(error({lines[0], lines[1], lines[2] + " 0.5", lines[3], lines[4]}) ==
+          path + ":3: " + std::to_string(words(lines[2]).size()) +
+              " values of the generalized speeds, this model has " +
+              std::to_string(words(lines[2]).size() - 1) + " (a checkpoint of another model?)");
+    CHECK(error({lines[0], lines[1], "u 1 x2", lines[3], lines[4]}) ==
+          path + ":3: 'x2' in the generalized speeds is not a finite number");
+    CHECK(error({lines[0], lines[1], lines[2], "wrenches 0 0 nan 0 0 0", lines[4]}) ==
+          path + ":4: 'nan' in the force [N] and torque [N m] on each coupled body is not a "
+                 "finite number");
+    CHECK(error({"<robot name=\"rig\">", lines[1]}) ==
+          path + ":1: expected 't ...' (the time [s]), got '<robot name=\"rig\">': not a "
+                 "multibody checkpoint");
+    // The URDF model's own line: drives of joints this model does not have.
+    std::string drives = lines[4];
+    REQUIRE(drives.find(" wheel ") != std::string::npos);
+    drives.replace(drives.find(" wheel "), 7, " axle ");
+    CHECK(error({lines[0], lines[1], lines[2], lines[3], drives}) ==
+          path + ":5: URDF model checkpoint: drives do not match the model at joint 'wheel'");
+    std::remove(path.c_str());
+    UrdfModel b(parseUrdfModel(kModels + "/single_wheel_rig.yaml"));
+    CHECK(messageOf<ModelError>([&] { b.readCheckpoint(path); }) ==
+          "cannot open multibody checkpoint " + path);
 }
 
 TEST_CASE("URDF joint springs and a compound pendulum swing at the analytic frequencies",
