@@ -50,7 +50,9 @@ urdf::ModelInterfaceSharedPtr loadUrdf(const std::string &path) {
     console_bridge::useOutputHandler(&errors);
     urdf::ModelInterfaceSharedPtr model = urdf::parseURDF(text.str());
     console_bridge::restorePreviousOutputHandler();
-    if (!model)
+    // liburdfdom returns a model even when it could not parse an element (an <inertia> of
+    // "nan" or "1e999" it logs and then reads as 0): an error logged is a refusal too.
+    if (!model || !errors.messages.empty())
         throw ModelError(path + ": not a valid URDF file: " +
                          (errors.messages.empty() ? "liburdfdom gave no reason" : errors.messages));
     return model;

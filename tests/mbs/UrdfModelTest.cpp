@@ -254,6 +254,115 @@ TEST_CASE("URDF model: a damaged checkpoint is refused naming the file and the l
           "cannot open multibody checkpoint " + path);
 }
 
+namespace {
+
+/// A disc on a revolute joint under a base link, with the parts the importer checks left for
+/// the caller: the disc's <mass> and <inertia>, the joint's type, its <axis> and extra elements.
+std::string discUrdf(const std::string &mass, const std::string &inertia,
+                     const std::string &type = "revolute", const std::string &axis = "0 1 0",
+                     const std::string &extra = "") {
+    return "<?xml version=\"1.0\"?>\n<robot name=\"disc\">\n"
+           "  <link name=\"base\"><inertial><mass value=\"1\"/><inertia ixx=\"0.1\" ixy=\"0\" "
+           "ixz=\"0\" iyy=\"0.1\" iyz=\"0\" izz=\"0.1\"/></inertial></link>\n"
+           "  <link name=\"disc\"><inertial><mass value=\"" +
+           mass + "\"/><inertia " + inertia +
+           "/></inertial></link>\n"
+           "  <link name=\"tip\"/>\n"
+           "  <joint name=\"spin\" type=\"" +
+           type +
+           "\"><parent link=\"base\"/><child link=\"disc\"/>"
+           "<axis xyz=\"" +
+           axis + "\"/><limit lower=\"-1\" upper=\"1\" effort=\"1\" velocity=\"1\"/>" + extra +
+           "</joint>\n"
+           "  <joint name=\"tip_weld\" type=\"fixed\"><parent link=\"disc\"/><child "
+           "link=\"tip\"/></joint>\n"
+           "</robot>\n";
+}
+
+const std::string kDiscInertia =
+    "ixx=\"0.01\" ixy=\"0\" ixz=\"0\" iyy=\"0.02\" iyz=\"0\" izz=\"0.01\"";
+
+/// The ModelError building a model from `urdf` (written to a file named `name`) gives, with the
+/// file's path replaced by `name`; "(built)" when it builds.
+std::string urdfError(const std::string &name, const std::string &urdf) {
+    const std::string path =
+        (std::filesystem::temp_directory_path() / (std::to_string(::getpid()) + "-" + name))
+            .string();
+    std::ofstream(path) << urdf;
+    UrdfModelSettings s;
+    s.urdf_path = path;
+    std::string message = "(built)";
+    try {
+        UrdfModel model(s);
+    } catch (const ModelError &e) {
+        message = e.what();
+    }
+    std::remove(path.c_str());
+    for (std::size_t at; (at = message.find(path)) != std::string::npos;)
+        message.replace(at, path.size(), name);
+    return message;
+}
+
+} // namespace
+
+TEST_CASE("URDF importer: each malformed file is refused naming the file, link or joint",
+          "[mbs][urdf]") {
+    CHECK(urdfError("disc.urdf", discUrdf("2", kDiscInertia)) == "(built)");
+    SECTION("a missing file") {
+        UrdfModelSettings s;
+        s.urdf_path = kData + "/no_such_model.urdf";
+        CHECK(messageOf<ModelError>([&] { UrdfModel m(s); }) ==
+              kData + "/no_such_model.urdf: cannot open the URDF file");
+    }
+    SECTION("a negative or non-finite mass") {
+        CHECK(urdfError("negative.urdf", discUrdf("-2", kDiscInertia)) ==
+              "negative.urdf: link 'disc': mass must be >= 0, got -2.000000");
+    }
+    SECTION("a non-finite inertia") {
+        // liburdfdom logs these and reads them as 0: iyy = 0 would pass as a physical disc.
+        for (const std::string value : {"1e999", "nan", "inf", "heavy"}) {
+            std::string inertia = kDiscInertia;
+            inertia.replace(inertia.find("0.02"), 4, value);
+            CHECK(urdfError("infinite.urdf", discUrdf("2", inertia)) ==
+                  "infinite.urdf: not a valid URDF file: Inertial: inertia element iyy is not a "
+                  "valid double; Could not parse inertial element for Link [disc]");
+        }
+        CHECK(urdfError("infinite.urdf", discUrdf("nan", kDiscInertia)) ==
+              "infinite.urdf: not a valid URDF file: Inertial: mass [nan] is not a float; "
+              "Could not parse inertial element for Link [disc]");
+    }
+    SECTION("a zero axis") {
+        CHECK(urdfError("zero_axis.urdf", discUrdf("2", kDiscInertia, "revolute", "0 0 0")) ==
+              "zero_axis.urdf: joint 'spin' has a zero axis");
+        CHECK(urdfError("zero_slide.urdf", discUrdf("2", kDiscInertia, "prismatic", "0 0 0")) ==
+              "zero_slide.urdf: joint 'spin' has a zero axis");
+    }
+    SECTION("no root: two links that no joint connects") {
+        CHECK_THAT(urdfError("two_roots.urdf",
+                             "<robot name=\"x\"><link name=\"a\"/><link name=\"b\"/></robot>"),
+                   Catch::StartsWith("two_roots.urdf: not a valid URDF file: ") &&
+                       Catch::Contains("root"));
+        CHECK_THAT(urdfError("no_links.urdf", "<robot name=\"x\"></robot>"),
+                   Catch::StartsWith("no_links.urdf: not a valid URDF file: ") &&
+                       Catch::Contains("link"));
+    }
+    SECTION("a joint type, mimic or friction the importer does not model") {
+        CHECK_THAT(urdfError("ball.urdf", discUrdf("2", kDiscInertia, "ball")),
+                   Catch::StartsWith("ball.urdf: not a valid URDF file: ") &&
+                       Catch::Contains("spin") && Catch::Contains("ball"));
+        CHECK(urdfError("mimic.urdf", discUrdf("2", kDiscInertia, "revolute", "0 1 0",
+                                               "<mimic joint=\"spin\"/>")) ==
+              "mimic.urdf: joint 'spin' mimics another joint: mimic joints are not supported");
+        CHECK(urdfError("friction.urdf", discUrdf("2", kDiscInertia, "revolute", "0 1 0",
+                                                  "<dynamics friction=\"0.1\"/>")) ==
+              "friction.urdf: joint 'spin' has dynamics friction: joint friction is not "
+              "modelled; remove it or set it to 0");
+        CHECK(urdfError("damping.urdf", discUrdf("2", kDiscInertia, "revolute", "0 1 0",
+                                                 "<dynamics damping=\"-0.1\"/>")) ==
+              "damping.urdf: joint 'spin': dynamics damping must be >= 0");
+    }
+}
+
 TEST_CASE("URDF joint springs and a compound pendulum swing at the analytic frequencies",
           "[mbs][urdf]") {
     UrdfModel m(parseUrdfModel(kData + "/oscillators.yaml"));
