@@ -1,5 +1,6 @@
 #include "RunBodies.hpp"
 
+#include "OutputCheck.hpp"
 #include "RunState.hpp"
 
 #include <algorithm>
@@ -27,6 +28,8 @@ RunBodies collectBodies(const std::vector<Declaration> &participants, const RunN
             provider[body.name] = p.name;
             if (b >= p.initial_states.size() || p.initial_states[b].body != body.name)
                 throw PeerError(who(p), "gave no initial state for body '" + body.name + "'");
+            if (const auto problem = checkOutputs(std::vector{p.initial_states[b]}, {body.name}))
+                throw PeerError(who(p), "gave a " + problem->text + " in its Hello");
             run.bodies.push_back(body);
             run.names.push_back(body.name);
             run.initial_states.push_back(p.initial_states[b]);

@@ -191,6 +191,22 @@ TEST_CASE("Codec: a mesh's triangles index its vertices, three at a time", "[cou
     }
 }
 
+TEST_CASE("Codec: a Hello needs its role and a Welcome its scheme", "[coupling][codec]") {
+    for (const auto scheme :
+         {SchemeKind::ExplicitSerial, SchemeKind::ExplicitParallel, SchemeKind::Implicit})
+        CHECK(codec::fromWire(codec::toWire(scheme)) == scheme);
+    CHECK(codec::fromWire(pb::ROLE_SOIL, "participant 'soil'") == Role::Soil);
+    CHECK(codec::fromWire(pb::ROLE_MULTIBODY, "participant 'mbs'") == Role::Multibody);
+    const auto no_scheme = protocolError([] { codec::fromWire(pb::SCHEME_UNSPECIFIED); });
+    CHECK(no_scheme.code == pb::Error::CODE_MALFORMED);
+    CHECK(std::string(no_scheme.what()) == "Welcome names no coupling scheme");
+    const auto no_role =
+        protocolError([] { codec::fromWire(pb::ROLE_UNSPECIFIED, "participant 'soil'"); });
+    CHECK(no_role.code == pb::Error::CODE_MALFORMED);
+    CHECK(std::string(no_role.what()) ==
+          "participant 'soil': Hello has no role (expected multibody or soil)");
+}
+
 TEST_CASE("Codec: text from a peer is printable and short in messages", "[coupling][codec]") {
     CHECK(codec::printable("mass1") == "mass1");
     CHECK(codec::printable("a\nb\\c") == "a\\x0ab\\x5cc"); // no new log line, no fake escapes

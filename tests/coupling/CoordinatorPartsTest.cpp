@@ -10,6 +10,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <cmath>
+
 using namespace grainlink::coupling;
 namespace pb = grainlink::v1;
 using State = Coordinator::State;
@@ -95,6 +97,14 @@ TEST_CASE("Body collection: every body provided once, consumed once, and its inp
     no_state.initial_states.clear();
     CHECK(collectError({no_state, soil("s", {"w"})}) ==
           "participant 'a': gave no initial state for body 'w'");
+    auto nan_state = multibody("a", {"w"});
+    nan_state.initial_states[0].linear_velocity_m_s.z() = NAN;
+    CHECK(collectError({nan_state, soil("s", {"w"})}) ==
+          "participant 'a': gave a non-finite state of body 'w' in its Hello");
+    nan_state.initial_states[0].linear_velocity_m_s.z() = 0.0;
+    nan_state.initial_states[0].position_m.x() = -INFINITY;
+    CHECK(collectError({nan_state, soil("s", {"w"})}) ==
+          "participant 'a': gave a non-finite state of body 'w' in its Hello");
     CHECK(collectError({multibody("a", {"w"}), soil("s", {"x"})}) ==
           "participant 's': consumes body 'x', which no multibody participant provides");
     CHECK(collectError({multibody("a", {"w"}), soil("s", {"w"}), soil("t", {"w"})}) ==
