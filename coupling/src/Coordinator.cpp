@@ -544,7 +544,7 @@ struct Coordinator::Impl {
             try {
                 scheme->restore(resumed->states, resumed->wrenches);
             } catch (const CouplingError &error) {
-                fail("the checkpoint", error.what());
+                fail("the checkpoint " + *restore_directory, error.what());
             }
         }
         if (!c.output_directory.empty())

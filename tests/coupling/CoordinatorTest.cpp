@@ -1,4 +1,5 @@
 // Coordinator and participants in one test binary, talking over inproc:// and tcp://127.0.0.1:*.
+#include "CheckpointFiles.hpp"
 #include "CouplingFixtures.hpp"
 #include "TwoMassDriver.hpp"
 
@@ -183,6 +184,62 @@ TEST_CASE("A failed run resumes from its last checkpoint and ends as if never st
     CHECK(straight.size() == 51);
     CHECK(resumed == straight); // bit-identical: same numbers printed with 17 digits
     std::filesystem::remove_all(base);
+}
+
+TEST_CASE("Resume: no checkpoint, an unreadable one or one of other bodies is named",
+          "[coupling][coordinator][checkpoint]") {
+    namespace fs = std::filesystem;
+    const std::string base =
+        (fs::temp_directory_path() / ("grainlink-resume-refused-" + std::to_string(::getpid())))
+            .string();
+    fs::remove_all(base);
+    int runs = 0;
+    const auto config = [&] {
+        auto c = twoMassRun(SchemeKind::ExplicitSerial,
+                            "inproc://resume-refused-" + std::to_string(++runs), 0.01, 0.5);
+        c.output_directory = base;
+        c.checkpoint_every_windows = 10;
+        c.resume = true;
+        return c;
+    };
+    const std::string latest = base + "/checkpoints/latest";
+    // Refused before anyone joins: no participant is started.
+    const auto refusal = [&] {
+        Coordinator coordinator(config());
+        try {
+            coordinator.run();
+        } catch (const CouplingError &e) {
+            return std::string(e.what());
+        }
+        return std::string("(ran)");
+    };
+    CHECK(refusal() == "cannot resume: no complete checkpoint (" + latest + " is missing)");
+    const std::string folder = checkpointDirectory(base, 30);
+    fs::create_directories(folder);
+    std::ofstream(latest) << "window_000000030\n";
+    CHECK(refusal() == "cannot resume: " + folder + "/coordinator.pb is unreadable");
+    std::ofstream(folder + "/coordinator.pb") << "\xff\xff\xff not protobuf";
+    CHECK(refusal() == "cannot resume: " + folder + "/coordinator.pb is unreadable");
+
+    // A complete checkpoint of another run, whose body is not this run's: the participants
+    // join, are stopped, and the line names the checkpoint and the body.
+    BodyState rock;
+    rock.body = "rock";
+    commitCheckpoint(base, folder, {"other-run", 30, 300'000'000, 10'000'000, {rock}, {}, 0.0});
+    Coordinator coordinator(config());
+    auto mbs = startSide(Role::Multibody, coordinator.boundEndpoint());
+    auto soil = startSide(Role::Soil, coordinator.boundEndpoint());
+    std::string failure = "(ran)";
+    try {
+        coordinator.run();
+    } catch (const CouplingError &e) {
+        failure = e.what();
+    }
+    CHECK(failure == "the checkpoint " + folder +
+                         " failed during the handshake: state for unknown body 'rock'");
+    for (auto *side : {&mbs, &soil})
+        CHECK_THROWS_AS(side->get(), CouplingError); // told to stop, not left waiting
+    fs::remove_all(base);
 }
 
 TEST_CASE("A participant that declares its experiment complete ends the run normally",
