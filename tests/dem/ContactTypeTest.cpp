@@ -149,6 +149,73 @@ TEST_CASE("a grain slides on a wall at the wall's friction, not the grains'",
     CHECK(deceleration(0.4, 0.4) == Approx(0.4 * kG).epsilon(0.01));
 }
 
+TEST_CASE("a friction track brakes a sliding grain at its own friction, beside it none",
+          "[dem][contact][contact_type][friction]") {
+    // The seed's bin floor: a frictionless plane carrying a rough track (mu = 0.4) for x < 0.05.
+    // A grain launched inside the track slides at a = mu_track g, as on a wall of that friction
+    // (docs/physics.md §2.10: a track's coefficient takes precedence over the wall's); one
+    // launched beside it keeps its speed to round-off. The track's box reaches just above the
+    // floor: it holds the contact points, which lie on the floor surface.
+    DemSettings settings = quietSettings(1e-5);
+    settings.gravity_m_s2 = Vec3(0, 0, -kG);
+    DemSystem sys(ContactLaws(hertzRestitution(0.3, 0.6)), {kMaterial}, settings);
+    PlaneWall floor;
+    floor.name = "floor";
+    floor.friction_coefficient = 0.0;
+    floor.track = FrictionTrack{Vec3(-1, -1, -0.001), Vec3(0.05, 1, 0.001), 0.4};
+    sys.addPlane(floor);
+    const double m = sphereMass(kRadius, 2500.0);
+    const double rest = std::pow(
+        m * kG / (4.0 / 3.0 * effectiveModulus(kMaterial) * std::sqrt(kRadius)), 2.0 / 3.0);
+    const double v0 = 0.2;
+    sys.particles().add(sphere(Vec3(0, 0, kRadius - rest), kRadius, 2500.0, {v0, 0, 0}));
+    sys.particles().add(sphere(Vec3(0.2, 0.1, kRadius - rest), kRadius, 2500.0, {v0, 0, 0}));
+    const double t = 0.5 * 2.0 * v0 / (7.0 * 0.4 * kG); // half the sliding time on the track
+    sys.run(std::uint64_t(std::llround(t / 1e-5)));
+    const auto &v = sys.particles().velocity;
+    REQUIRE(sys.particles().position[0].x() < 0.05); // still on the track
+    CHECK((v0 - v[0].x()) / sys.time() == Approx(0.4 * kG).epsilon(0.01));
+    CHECK(v[1].x() == Approx(v0).epsilon(1e-9));
+    CHECK(sys.particles().angular_velocity[1].norm() < 1e-9);
+}
+
+TEST_CASE("cohesion: a grain snaps into a wall to (5/4)^2 of its resting overlap, at any step",
+          "[dem][contact][contact_type][cohesion]") {
+    // Soft grains (E = 5.4 MPa, r = 1.8 mm) and strong linear cohesion at a wall: released at rest
+    // at first touch, without damping and gravity, the grain falls into the wall until the
+    // potential of f(d) = a d - b d^1.5 is back to zero: a d^2 / 2 = 2/5 b d^2.5, at
+    // d1 = (5 a / 4 b)^2 = (5/4)^2 d0. k_c = 0.331 E* puts d0 at 0.61 r and d1 at 0.95 r, the
+    // overlap once seen beside a wall. The law alone takes it there: the same at the stability
+    // estimate's step and at a tenth of it (docs/physics.md §2.7).
+    const Material soft = soil(5.4e6, 0.2, 2400.0);
+    const double r = 0.0018, e_star = 5.4e6 / (2.0 * (1.0 - 0.04));
+    const double k_c = 0.331 * e_star;
+    const double a = k_c * M_PI * r, b = 4.0 / 3.0 * e_star * std::sqrt(r);
+    const double d0 = std::pow(a / b, 2), d1 = std::pow(1.25 * a / b, 2);
+    REQUIRE(d1 / r == Approx(0.95).epsilon(0.01));
+    ContactLaw law = hertzRestitution(1.0, 0.5); // e = 1: no dashpot
+    law.cohesion = CohesionLinear{k_c};
+    const auto deepest = [&](double step_fraction) {
+        DemSettings settings = quietSettings(1e-5);
+        settings.max_overlap_ratio = 2.0; // let the grain go where the law takes it
+        DemSystem sys(ContactLaws(law), {soft}, settings);
+        PlaneWall floor;
+        floor.name = "floor";
+        sys.addPlane(floor);
+        sys.particles().add(sphere(Vec3(0, 0, r * (1.0 - 1e-6)), r, 2400.0));
+        sys.setTimeStep(step_fraction * sys.stableTimeStepEstimate());
+        double deepest = 0.0;
+        for (int k = 0; k < 200000 && sys.time() < 0.01; ++k) {
+            sys.step();
+            deepest = std::max(deepest, r - sys.particles().position[0].z());
+        }
+        return deepest;
+    };
+    CHECK(deepest(0.1) == Approx(d1).epsilon(0.01));
+    CHECK(deepest(0.99) == Approx(d1).epsilon(0.03));
+    CHECK(d0 / r == Approx(0.608).epsilon(0.01));
+}
+
 TEST_CASE("grain-tool rolling resistance decelerates a spinning grain at 5 mu_r g / 2 r",
           "[dem][contact][contact_type][rolling]") {
     // A sphere spinning about a horizontal axis on a flat mesh (a tool), without tangential
