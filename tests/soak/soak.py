@@ -224,6 +224,8 @@ class Fault:
     def __str__(self):
         where = self.injected_at if self.injected_at is not None else f"({self.window})"
         text = f"{self.name} {self.target}@{where}"
+        if self.detail.get("at_checkpoint"):
+            text += " in checkpoint"
         if "seconds" in self.detail:
             text += f" {self.detail['seconds']:.2f}s"
         if "cycles" in self.detail:
@@ -244,6 +246,8 @@ def plan_faults(rng, scenario):
     else:
         windows = windows[:1]
     faults = []
+    if rng.random() < 0.2:  # strangers while the participants join
+        faults.append(Fault("garbage", "coordinator", 0, seed=rng.getrandbits(32)))
     for window in windows:
         kind = rng.choices(KINDS, weights=(3, 3, 2, 2))[0]
         peers = [name for name, _ in scenario.participants]
@@ -261,8 +265,8 @@ def plan_faults(rng, scenario):
                                 seed=rng.getrandbits(32)))
         elif kind == "garbage":
             faults.append(Fault(kind, "coordinator", window, seed=rng.getrandbits(32)))
-        else:
-            faults.append(Fault(kind, target, window))
+        else:  # a third of the kills while a checkpoint is being written
+            faults.append(Fault(kind, target, window, at_checkpoint=rng.random() < 0.33))
     return faults
 
 
@@ -287,7 +291,9 @@ class Stranger:
         h = self.pb.Hello(protocol_major=major, protocol_minor=1, participant=name, role=role)
         return self.envelope(sender or name, hello=h)
 
-    def batch(self, rng):
+    def batch(self, rng, handshake):
+        """Messages to send: (what, frames()) pairs. In the handshake, no valid Hello for an
+        expected name: the first one takes the name (docs/protocol.md, without CURVE)."""
         pb, (name, role) = self.pb, rng.choice(self.participants)
         noise = lambda n: noise_bytes(rng, n)
         menu = [
@@ -298,6 +304,7 @@ class Stranger:
             ("no body", lambda: [self.envelope(name)]),
             ("Hello of major 2", lambda: [self.hello(name, role, major=2)]),
             ("Hello for a joined name", lambda: [self.hello(name, role)]),
+            ("Hello in another role", lambda: [self.hello(name, 3 - role)]),
             ("Hello for an unknown name", lambda: [self.hello("stranger", role)]),
             ("Hello naming another", lambda: [self.hello(name, role, sender="stranger")]),
             ("Hello with control bytes", lambda: [self.hello(name + "\n\x00", role)]),
@@ -311,11 +318,21 @@ class Stranger:
             ("Heartbeat", lambda: [self.envelope(name, sequence=0, heartbeat=pb.Heartbeat())]),
             ("large frame", lambda: [noise(rng.randint(1 << 20, 3 << 20))]),
         ]
+        if handshake:
+            menu = [m for m in menu if m[0] != "Hello for a joined name"]
         return [rng.choice(menu) for _ in range(rng.randint(6, 14))]
 
-    def send(self, endpoint, seed, context):
+    def send(self, endpoint, seed, context, handshake=False):
+        """Sends a batch from one connection, sometimes a flood (more than the coordinator's
+        limits.max_stranger_messages_per_s) or a frame over limits.max_message_bytes from
+        another, and bytes that are not ZeroMQ from a plain TCP connection. Returns the count
+        of messages sent, of answers, and the answers' error codes."""
         rng = random.Random(seed)
-        sent = self.batch(rng)
+        sent = self.batch(rng, handshake)
+        if rng.random() < 0.3:
+            sent += [("flood", lambda: [noise_bytes(rng, 8)])] * 150
+        if rng.random() < 0.2:
+            self.once(context, endpoint, [noise_bytes(rng, (16 << 20) + 1)])
         socket_ = context.socket(zmq.DEALER)
         socket_.setsockopt(zmq.LINGER, 0)
         socket_.connect(endpoint)
@@ -345,6 +362,14 @@ class Stranger:
         except OSError:
             pass
         return len(sent) + 1, answers, codes
+
+    @staticmethod
+    def once(context, endpoint, frames):
+        socket_ = context.socket(zmq.DEALER)
+        socket_.setsockopt(zmq.LINGER, 2000)
+        socket_.connect(endpoint)
+        socket_.send_multipart(frames)
+        socket_.close()  # lingers until the frame has gone (or 2 s)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -428,6 +453,20 @@ class Attempt:
             self.size = size
         return max(self.lines - 1, 0)
 
+    def writing_checkpoint(self):
+        """Whether a checkpoint folder newer than checkpoints/latest exists: one being written."""
+        folder = os.path.join(self.run.out, "checkpoints")
+        try:
+            names = os.listdir(folder)
+        except OSError:
+            return False
+        try:
+            with open(os.path.join(folder, "latest")) as f:
+                latest = f.read().strip()
+        except OSError:
+            latest = ""
+        return any(n.startswith("window_") and n > latest for n in names)
+
     def ours(self, pid):
         return self.run.endpoint in proc_argv(pid)
 
@@ -477,7 +516,8 @@ class Attempt:
         elif fault.kind == "garbage":
             sent, answers, codes = self.soak.stranger.send(self.run.endpoint,
                                                            fault.detail["seed"],
-                                                           self.soak.context)
+                                                           self.soak.context,
+                                                           handshake=fault.window == 0)
             fault.note = f"{sent} sent, {answers} answered"
             if codes:
                 fault.note += ": " + " ".join(sorted(codes))
@@ -499,8 +539,14 @@ class Attempt:
                 self.ready = rows <= self.start_rows
             if len(self.pids) < len(self.run.scenario.participants):
                 self.discover()
-            due = pending and self.ready and rows >= pending[0].window and len(self.pids) == len(
-                self.run.scenario.participants) and not any(f.fatal for f in self.injected)
+            if pending and pending[0].window == 0:  # strangers while the participants join
+                due = True
+            else:
+                due = pending and self.ready and rows >= pending[0].window and len(
+                    self.pids) == len(self.run.scenario.participants) and not any(
+                    f.fatal for f in self.injected)
+                if due and pending[0].detail.get("at_checkpoint"):
+                    due = self.writing_checkpoint()
             if due:
                 self.inject(pending.pop(0))
             else:
@@ -520,13 +566,17 @@ class Run:
         self.out = os.path.join(self.folder, "out")
         self.endpoint = f"tcp://127.0.0.1:{free_port()}"
         self.config = scenario.copy_to(self.folder, self.endpoint.rsplit(":", 1)[1])
-        self.attempts, self.problems, self.kept = [], [], []
+        self.attempts, self.problems, self.kept, self.unreadable = [], [], [], []
+        self.recovery_problems = 0
         self.finished = self.identical = False
         self.lost = []
         self.wall_s = 0.0
 
-    def problem(self, text):
+    def problem(self, text, recovery=True):
+        """Notes what went wrong; recovery: it means the run did not recover (a fault not
+        detected as it must be, a hang, a process left over, unreadable results)."""
         self.problems.append(text)
+        self.recovery_problems += recovery
 
     def checkpoint(self):
         """Windows before the last complete checkpoint (None: there is none)."""
@@ -600,8 +650,8 @@ class Run:
                 break
             self.judge_failure(attempt)
             kept = Results(self.out)
-            self.problems += [f"after attempt {len(self.attempts)}: unreadable: {u}"
-                              for u in kept.unreadable]
+            self.unreadable += [f"after attempt {len(self.attempts)}: {u}"
+                                for u in kept.unreadable]
             self.kept.append(kept)
             start_rows = self.checkpoint()
             resume = start_rows is not None
@@ -609,25 +659,28 @@ class Run:
         else:
             self.problem(f"not finished after {len(self.attempts)} attempts")
         final = Results(self.out)
-        self.problems += [f"unreadable: {u}" for u in final.unreadable]
+        self.unreadable += [f"at the end: {u}" for u in final.unreadable]
+        self.problems += [f"unreadable {u}" for u in self.unreadable]
         if self.finished:
             diff = differences(self.scenario.reference, final)
             self.identical = not diff
             if diff:
-                self.problem("results differ from the uninterrupted run: " + "; ".join(diff[:4]))
+                self.problem("results differ from the uninterrupted run: " + "; ".join(diff[:4]),
+                             recovery=False)
                 self.soak.check_determinism(self.scenario, self)
         for kept in self.kept:
             self.lost += lost_records(kept, final)
         if self.lost:
             self.problem(f"lost records: {', '.join(self.lost[:5])}"
-                         + (f" and {len(self.lost) - 5} more" if len(self.lost) > 5 else ""))
+                         + (f" and {len(self.lost) - 5} more" if len(self.lost) > 5 else ""),
+                         recovery=False)
         self.wall_s = time.monotonic() - began
         if self.recovered and self.identical and not self.lost:
             shutil.rmtree(self.out, ignore_errors=True)  # keep the logs, not the results
 
     @property
     def recovered(self):
-        return self.finished and not self.problems
+        return self.finished and not self.recovery_problems
 
 
 class Soak:
@@ -711,7 +764,7 @@ class Soak:
         diff = differences(scenario.reference, again)
         run.problem("a second uninterrupted run " + ("differs too (the scenario is not "
                                                      "deterministic)" if diff else
-                                                     "is identical to the first"))
+                                                     "is identical to the first"), recovery=False)
 
     def execute(self):
         for scenario in self.scenarios:
@@ -755,12 +808,13 @@ def report(runs):
           f"stop {count['stop']}, garbage {count['garbage']}, slow {count['slow']}), "
           f"recovered {recovered}, results identical {identical}/{len(runs)}, "
           f"lost records {lost}")
-    print(f"{'run':>3}  {'scenario':<8}  {'attempts':>8}  {'recovered':<9}  {'identical':<9}  "
-          f"{'lost':>4}  {'wall_s':>6}  faults (kind target@window)")
+    print(f"{'run':>3}  {'scenario':<8}  {'attempts':>8}  {'recovered':<9}  {'readable':<8}  "
+          f"{'identical':<9}  {'lost':>4}  {'wall_s':>6}  faults (kind target@window [outcome])")
     for run in runs:
         faults = "; ".join(str(f) for f in run.faults if f.injected_at is not None) or "none"
         print(f"{run.index:>3}  {run.scenario.name:<8}  {len(run.attempts):>8}  "
-              f"{'yes' if run.recovered else 'NO':<9}  {'yes' if run.identical else 'NO':<9}  "
+              f"{'yes' if run.recovered else 'NO':<9}  {'NO' if run.unreadable else 'yes':<8}  "
+              f"{'yes' if run.identical else 'NO':<9}  "
               f"{len(run.lost):>4}  {run.wall_s:>6.1f}  {faults}")
     for run in runs:
         for text in run.problems:
