@@ -484,6 +484,46 @@ void DemSystem::meshContacts() {
     meshes_.sumLoads(dt, settings_.threads);
 }
 
+std::string DemSystem::overlapHint(const WorstOverlap &worst) const {
+    const std::string usual = "time step too large or stiffness too low";
+    const auto index = [&](ParticleId id) {
+        return std::size_t(std::find(particles_.id.begin(), particles_.id.end(), id) -
+                           particles_.id.begin());
+    };
+    const std::size_t i = index(worst.i), j = index(worst.j);
+    if (i >= particles_.size() || j >= particles_.size())
+        return usual;
+    const ContactType type = worst.i != worst.j ? ContactType::GrainGrain
+                             : worst.plane >= 0 ? ContactType::GrainWall
+                                                : ContactType::GrainTool;
+    const auto *cohesion = std::get_if<CohesionLinear>(&laws_.of(type).cohesion);
+    if (!cohesion || !(cohesion->energy_density_J_m3 > 0.0))
+        return usual;
+    const Material &grain = materials_[std::size_t(particles_.material[i])];
+    const Material &other =
+        type == ContactType::GrainGrain  ? materials_[std::size_t(particles_.material[j])]
+        : type == ContactType::GrainWall ? planes_.planes()[std::size_t(worst.plane)].material
+                                         : meshes_.body(worst.body).material;
+    const double e_star = pairProperties(grain, other, laws_.of(type)).effective_modulus_Pa;
+    const double ri = particles_.radius[i], rj = type == ContactType::GrainGrain
+                                                     ? particles_.radius[j]
+                                                     : std::numeric_limits<double>::infinity();
+    const double radius_eff = std::isfinite(rj) ? ri * rj / (ri + rj) : ri;
+    // Where cohesion balances Hertz: d0 = R* (3 pi k_c / 4 E*)^2, docs/physics.md §2.7.
+    const double resting = radius_eff / std::min(ri, rj) *
+                           std::pow(3.0 * M_PI * cohesion->energy_density_J_m3 / (4.0 * e_star), 2);
+    // Released at first touch, a grain falls in to (5/4)^2 d0 undamped: from half the limit on,
+    // cohesion is the likely cause.
+    if (resting < 0.5 * settings_.max_overlap_ratio)
+        return usual;
+    std::ostringstream hint;
+    hint << "cohesion alone holds this contact at " << resting
+         << " of the radius: energy_density_J_m3 = " << cohesion->energy_density_J_m3
+         << " against E* = " << e_star
+         << " Pa, docs/physics.md §2.7; lower the cohesion or stiffen the grains";
+    return hint.str();
+}
+
 void DemSystem::checkOverlaps() {
     PhaseTimer::Scope scope(timer_, phase_.check);
     max_overlap_ratio_ = 0.0;
@@ -509,8 +549,8 @@ void DemSystem::checkOverlaps() {
             against = "a wall";
         std::ostringstream msg;
         msg << "= " << max_overlap_ratio_ << " of the radius against " << against
-            << " exceeds max_overlap_ratio " << settings_.max_overlap_ratio
-            << " (time step too large or stiffness too low)";
+            << " exceeds max_overlap_ratio " << settings_.max_overlap_ratio << " ("
+            << overlapHint(worst) << ")";
         throw SimulationError(step_ + 1, worst.i, "overlap", msg.str());
     }
 }

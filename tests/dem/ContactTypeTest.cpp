@@ -214,6 +214,21 @@ TEST_CASE("cohesion: a grain snaps into a wall to (5/4)^2 of its resting overlap
     CHECK(deepest(0.1) == Approx(d1).epsilon(0.01));
     CHECK(deepest(0.99) == Approx(d1).epsilon(0.03));
     CHECK(d0 / r == Approx(0.608).epsilon(0.01));
+    // Under the default max_overlap_ratio (0.4) the run stops, blaming cohesion, not the step.
+    DemSystem sys(ContactLaws(law), {soft}, quietSettings(1e-5));
+    PlaneWall floor;
+    floor.name = "floor";
+    sys.addPlane(floor);
+    sys.particles().add(sphere(Vec3(0, 0, r * (1.0 - 1e-6)), r, 2400.0));
+    CHECK_THROWS_WITH(sys.run(2000), Catch::Contains("against plane 'floor'") &&
+                                         Catch::Contains("(cohesion alone holds this contact "
+                                                         "at 0.608") &&
+                                         Catch::Contains("lower the cohesion or stiffen"));
+    law.cohesion = CohesionLinear{0.2 * k_c}; // resting at 0.024 r: the usual hint
+    DemSystem weak(ContactLaws(law), {soft}, quietSettings(1e-5));
+    weak.addPlane(floor);
+    weak.particles().add(sphere(Vec3(0, 0, 0.5 * r), r, 2400.0));
+    CHECK_THROWS_WITH(weak.run(1), Catch::EndsWith("(time step too large or stiffness too low)"));
 }
 
 TEST_CASE("grain-tool rolling resistance decelerates a spinning grain at 5 mu_r g / 2 r",

@@ -142,6 +142,9 @@ public:
 
 private:
     void initialize();
+    /// Why a contact may overlap too far: cohesion when its own resting overlap is deep
+    /// (docs/physics.md §2.7), else the time step or the stiffness.
+    std::string overlapHint(const WorstOverlap &worst) const;
     void validateTimeStep() const;
     // The phases of a step, in order; each is timed (PhaseIds).
     void advanceAndClear();
