@@ -186,20 +186,41 @@ def differences(reference, results):
 
 
 def lost_records(before, after):
-    """Records present after a crash that are missing or changed once the run has finished."""
+    """Records present after a crash that are missing or changed once the run has finished:
+    (file, 'missing' or 'changed', line) triples. A CSV row is kept when the finished file has
+    it among the rows of the same time (first cell), so one row lost does not shift the rest."""
     lost = []
     for name, rows in before.rows.items():
         final = after.rows.get(name, [])
-        for i, row in enumerate(rows):
-            if i >= len(final) or final[i] != row:
-                lost.append(f"{name} line {i + 1}")
+        if final[:1] != rows[:1]:
+            lost.append((name, "changed", 1))
+        by_time = {}
+        for row in final[1:]:
+            by_time.setdefault(row[0], []).append(row)
+        for line, row in enumerate(rows[1:], start=2):
+            if row not in by_time.get(row[0], []):
+                lost.append((name, "changed" if row[0] in by_time else "missing", line))
     for name, entries in before.entries.items():
         final = set(after.entries.get(name, []))
-        lost += [f"{name}: {dict(e).get('file', e)}" for e in entries if e not in final]
+        lost += [(name, "missing", i + 1) for i, e in enumerate(entries) if e not in final]
     for name, data in before.blobs.items():
         if after.blobs.get(name) != data:
-            lost.append(name)
+            lost.append((name, "changed" if name in after.blobs else "missing", 0))
     return lost
+
+
+def describe_lost(lost):
+    """'rig.csv: 28 missing (from line 124), 31 changed (from line 152); ...'"""
+    parts = []
+    for name in sorted({n for n, _, _ in lost}):
+        kinds = []
+        for kind in ("missing", "changed"):
+            lines = [line for n, k, line in lost if n == name and k == kind]
+            if lines:
+                kinds.append(f"{len(lines)} {kind}" + (f" (from line {min(lines)})"
+                                                       if min(lines) else ""))
+        parts.append(f"{name}: {', '.join(kinds)}")
+    return "; ".join(parts)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -223,6 +244,8 @@ class Fault:
 
     def __str__(self):
         where = self.injected_at if self.injected_at is not None else f"({self.window})"
+        if "after_resume" in self.detail:
+            where = f"resume+{self.detail['after_resume']:.2f}s"
         text = f"{self.name} {self.target}@{where}"
         if self.detail.get("at_checkpoint"):
             text += " in checkpoint"
@@ -267,6 +290,11 @@ def plan_faults(rng, scenario):
             faults.append(Fault(kind, "coordinator", window, seed=rng.getrandbits(32)))
         else:  # a third of the kills while a checkpoint is being written
             faults.append(Fault(kind, target, window, at_checkpoint=rng.random() < 0.33))
+        if faults[-1].fatal and rng.random() < 0.35:
+            # A crash again soon after the restart: what the resumed processes do first (cut
+            # their files back to the checkpoint) must survive it.
+            target = "coordinator" if rng.random() < 0.25 else rng.choice(peers)
+            faults.append(Fault("kill", target, window, after_resume=rng.uniform(0.05, 0.6)))
     return faults
 
 
@@ -385,6 +413,9 @@ class Scenario:
         self.windows = round(coupling["end_time_s"] / coupling["macro_step_s"])
         self.checkpoint_every = coupling["checkpoint_every_windows"]
         self.peer_timeout = coupling["peer_timeout_s"]
+        # How long a participant may outlive its coordinator: until its peer timeout, or before
+        # the Welcome (which tells it the timeout) until its handshake timeout.
+        self.orphan_s = max(self.peer_timeout, coupling["handshake_timeout_s"]) + 10
         roles = {"multibody": 1, "soil": 2}  # grainlink.v1.Role
         self.participants = [(p["name"], roles[p["role"]]) for p in config["participants"]]
         self.reference = None       # Results of an uninterrupted run
@@ -422,6 +453,7 @@ class Attempt:
             self.coordinator = subprocess.Popen(argv, cwd=soak.work, stdout=log,
                                                 stderr=subprocess.STDOUT, env=env)
         self.pids = {}              # participant name -> pid
+        self.discovered_at = None   # when all were found
         self.start_rows = start_rows
         self.ready = False          # coupling.csv cut back to where this attempt starts
         self.csv = os.path.join(run.out, "coupling.csv")
@@ -494,19 +526,24 @@ class Attempt:
             time.sleep(min(0.02, max(end - time.monotonic(), 0)))
 
     def inject(self, fault):
-        fault.injected_at = self.rows()
+        """Injects the fault; one whose target has already ended is dropped (not counted)."""
+        rows = self.rows()
         if fault.kind == "kill":
-            self.signal(fault.target, signal.SIGKILL)
+            if not self.signal(fault.target, signal.SIGKILL):
+                return
         elif fault.kind == "stop":
-            if self.signal(fault.target, signal.SIGSTOP):
-                try:
-                    self.pause(fault.detail["seconds"], until_exit=fault.target != "coordinator")
-                finally:
-                    self.signal(fault.target, signal.SIGCONT)
+            if not self.signal(fault.target, signal.SIGSTOP):
+                return
+            try:
+                self.pause(fault.detail["seconds"], until_exit=fault.target != "coordinator")
+            finally:
+                self.signal(fault.target, signal.SIGCONT)
         elif fault.kind == "slow":
             rng = random.Random(fault.detail["seed"])
-            for _ in range(fault.detail["cycles"]):
+            for cycle in range(fault.detail["cycles"]):
                 if not self.signal(fault.target, signal.SIGSTOP):
+                    if cycle == 0:
+                        return
                     break
                 try:
                     self.pause(rng.uniform(0.05, 0.2))
@@ -524,6 +561,7 @@ class Attempt:
             if answers == 0 and self.coordinator.poll() is None:
                 self.run.problem(f"{fault.name}: the coordinator answered none of the "
                                  f"stranger's {sent} messages")
+        fault.injected_at = rows
         self.injected.append(fault)
 
     def execute(self, pending, limit_s):
@@ -539,12 +577,17 @@ class Attempt:
                 self.ready = rows <= self.start_rows
             if len(self.pids) < len(self.run.scenario.participants):
                 self.discover()
-            if pending and pending[0].window == 0:  # strangers while the participants join
-                due = True
-            else:
-                due = pending and self.ready and rows >= pending[0].window and len(
-                    self.pids) == len(self.run.scenario.participants) and not any(
-                    f.fatal for f in self.injected)
+                if len(self.pids) == len(self.run.scenario.participants):
+                    self.discovered_at = time.monotonic()
+            # After a fault that ends the run, nothing more until the next attempt.
+            due = bool(pending) and not any(f.fatal for f in self.injected)
+            if due and pending[0].window == 0:  # strangers while the participants join
+                pass
+            elif due and "after_resume" in pending[0].detail:
+                due = len(self.run.attempts) > 1 and self.discovered_at is not None and \
+                    time.monotonic() - self.discovered_at >= pending[0].detail["after_resume"]
+            elif due:
+                due = self.ready and rows >= pending[0].window and self.discovered_at is not None
                 if due and pending[0].detail.get("at_checkpoint"):
                     due = self.writing_checkpoint()
             if due:
@@ -553,7 +596,10 @@ class Attempt:
                 time.sleep(0.01)
         self.rc = self.coordinator.wait()
         with open(self.log, errors="replace") as f:
-            lines = [line.strip() for line in f if "error:" in line]
+            # grainlink's one error line, or (a participant that ended badly after the last
+            # window) "run: participant soil was killed by signal 9 (Killed)"
+            lines = [line.strip() for line in f if "error:" in line
+                     or line.startswith("run: participant ")]
         self.error = lines[-1] if lines else ""
 
 
@@ -612,6 +658,9 @@ class Run:
             fault.note += f": {cause}"
         if fault.target == "coordinator":
             expected = attempt.rc != 0
+        elif attempt.error.startswith(f"run: participant {fault.target} "):
+            fault.note = "after its last window: " + attempt.error[5:]
+            expected = fault.kind == "kill" and cause == "signal 9"
         else:
             named = f"participant '{fault.target}'" in attempt.error
             expected = named and cause in (("signal 9", "disconnected") if fault.kind == "kill"
@@ -622,14 +671,14 @@ class Run:
 
     def leftovers(self, attempt):
         """Waits for the attempt's participants to end; stops and reports any that stay."""
-        limit = time.monotonic() + self.scenario.peer_timeout + 10
+        limit = time.monotonic() + self.scenario.orphan_s
         while time.monotonic() < limit:
             if not any(alive(pid) for pid in attempt.pids.values()):
                 return
             time.sleep(0.05)
         names = [n for n, pid in attempt.pids.items() if alive(pid)]
         self.problem(f"participant(s) {', '.join(names)} still running "
-                     f"{self.scenario.peer_timeout + 10:.0f} s after the run ended: killed")
+                     f"{self.scenario.orphan_s:.0f} s after the run ended: killed")
         self.soak.stop_all(attempt)
 
     def execute(self):
@@ -645,8 +694,14 @@ class Run:
             if attempt.rc == 0:
                 self.finished = True
                 for fault in attempt.injected:
-                    if fault.fatal:
+                    # coupling.csv is written at least at every checkpoint: a fault this early
+                    # came before the participants' last window.
+                    early = fault.injected_at < self.scenario.windows - 2 * \
+                        self.scenario.checkpoint_every
+                    if fault.fatal and early:
                         self.problem(f"{fault}: the run finished as if nothing had happened")
+                    elif fault.fatal:
+                        fault.note = "came after the last window: the run finished"
                 break
             self.judge_failure(attempt)
             kept = Results(self.out)
@@ -660,7 +715,8 @@ class Run:
             self.problem(f"not finished after {len(self.attempts)} attempts")
         final = Results(self.out)
         self.unreadable += [f"at the end: {u}" for u in final.unreadable]
-        self.problems += [f"unreadable {u}" for u in self.unreadable]
+        for text in self.unreadable:
+            self.problem(f"unreadable {text}")
         if self.finished:
             diff = differences(self.scenario.reference, final)
             self.identical = not diff
@@ -671,9 +727,7 @@ class Run:
         for kept in self.kept:
             self.lost += lost_records(kept, final)
         if self.lost:
-            self.problem(f"lost records: {', '.join(self.lost[:5])}"
-                         + (f" and {len(self.lost) - 5} more" if len(self.lost) > 5 else ""),
-                         recovery=False)
+            self.problem(f"lost records: {describe_lost(self.lost)}", recovery=False)
         self.wall_s = time.monotonic() - began
         if self.recovered and self.identical and not self.lost:
             shutil.rmtree(self.out, ignore_errors=True)  # keep the logs, not the results
