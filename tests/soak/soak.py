@@ -13,6 +13,10 @@ wheel.yaml: Simbody rig + DEM soil) again and again while injecting faults at ra
            a large frame, a raw TCP connection that does not speak ZeroMQ): the run must carry on
   slow     a peer stopped and continued many times in a row: the run must carry on
 
+A third of the kills wait for a checkpoint being written; a third of the runs that fail are
+killed again (a participant or the coordinator) within a fraction of a second of their restart,
+while the resumed processes cut their files back to the checkpoint.
+
 A run that fails is resumed (`grainlink run --resume`, or started afresh when no checkpoint is
 complete yet) until it finishes. After every failure, the results written so far must be
 readable (CSV rows complete, snapshots well-formed XML) and are kept; once the run has finished,
@@ -46,7 +50,6 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 REPOSITORY = os.path.dirname(os.path.dirname(HERE))
 SCENARIOS = (("two-mass", "two_mass.yaml"), ("wheel", "wheel.yaml"))
 KINDS = ("kill", "stop", "garbage", "slow")
-FATAL = ("kill", "stop-long")  # faults after which the run must fail and be resumed
 
 
 # ---------------------------------------------------------------------------------------------
@@ -568,7 +571,7 @@ class Attempt:
         deadline = time.monotonic() + limit_s
         while self.coordinator.poll() is None:
             if time.monotonic() > deadline:
-                self.run.problem(f"attempt {len(self.run.attempts) + 1} still running after "
+                self.run.problem(f"attempt {len(self.run.attempts)} still running after "
                                  f"{limit_s:.0f} s (hung): stopped by soak")
                 self.soak.stop_all(self)
                 break
@@ -831,12 +834,11 @@ class Soak:
         runs = []
         while True:
             scenario = self.scenarios[len(runs) % len(self.scenarios)]
-            # A run with a long stop and two resumes takes about this long.
-            needed = 3 * scenario.reference_s + 3 * scenario.peer_timeout + 5
-            if time.monotonic() + needed > self.deadline:
+            faults = plan_faults(self.rng, scenario)
+            if time.monotonic() + expected_s(scenario, faults) > self.deadline:
                 break
             self.stranger.participants = scenario.participants
-            run = Run(self, len(runs) + 1, scenario, plan_faults(self.rng, scenario))
+            run = Run(self, len(runs) + 1, scenario, faults)
             runs.append(run)
             try:
                 run.execute()
@@ -850,6 +852,14 @@ class Soak:
             for text in run.problems:
                 print(f"  {text}", flush=True)
         return runs
+
+
+def expected_s(scenario, faults):
+    """About how long a run with these faults takes: the run, a share of it again per restart,
+    the stops, and a peer timeout per failure (participants that outlive a killed coordinator)."""
+    fatal = sum(f.fatal for f in faults)
+    return (scenario.reference_s * (1 + 0.5 * fatal) + fatal * (scenario.peer_timeout + 1) + 2
+            + sum(f.detail.get("seconds", 0) + 0.2 * f.detail.get("cycles", 0) for f in faults))
 
 
 def report(runs):
