@@ -481,7 +481,7 @@ class Attempt:
                     grown = f.read(len(self.tail)) == self.tail
                 if not grown:
                     f.seek(0)
-                    self.lines = 0
+                    self.lines, self.tail = 0, b""
                 data = f.read(size - f.tell())
             self.lines += data.count(b"\n")
             self.tail = (self.tail + data)[-64:]
