@@ -120,6 +120,7 @@ class Results:
         self.entries = {}   # .pvd path -> list of DataSet entries
         self.blobs = {}     # other path -> bytes
         self.unreadable = []
+        self.torn = set()   # files that could not be read whole
         for folder, dirs, files in os.walk(out):
             dirs[:] = [d for d in dirs if os.path.relpath(os.path.join(folder, d), out)
                        != "checkpoints"]
@@ -135,6 +136,7 @@ class Results:
                         root = ElementTree.fromstring(data)
                     except ElementTree.ParseError as e:
                         self.unreadable.append(f"{rel}: not well-formed XML ({e})")
+                        self.torn.add(rel)
                         root = None
                     if name.endswith(".pvd"):
                         self.entries[rel] = [] if root is None else [
@@ -195,7 +197,7 @@ def lost_records(before, after):
     lost = []
     for name, rows in before.rows.items():
         final = after.rows.get(name, [])
-        if final[:1] != rows[:1]:
+        if rows and final[:1] != rows[:1]:
             lost.append((name, "changed", 1))
         by_time = {}
         for row in final[1:]:
@@ -207,6 +209,8 @@ def lost_records(before, after):
         final = set(after.entries.get(name, []))
         lost += [(name, "missing", i + 1) for i, e in enumerate(entries) if e not in final]
     for name, data in before.blobs.items():
+        if name in before.torn:
+            continue  # unreadable then (reported as such), not a record yet
         if after.blobs.get(name) != data:
             lost.append((name, "changed" if name in after.blobs else "missing", 0))
     return lost
