@@ -18,16 +18,26 @@ killed again (a participant or the coordinator) within a fraction of a second of
 while the resumed processes cut their files back to the checkpoint.
 
 A run that fails is resumed (`grainlink run --resume`, or started afresh when no checkpoint is
-complete yet) until it finishes. After every failure, the results written so far must be
-readable (CSV rows complete, snapshots well-formed XML) and are kept; once the run has finished,
-a row or file kept then that is missing or changed is a lost record. Every finished run's
-results (coupling.csv without wall_s, each participant's CSVs, the snapshots) must equal those of
-an uninterrupted run of the same scenario, row for row and byte for byte.
+complete yet) until it finishes. A run has
+  recovered  when it finished, every kill and long stop ended its attempt with the cause named
+             (the participant and "killed by signal 9", "disconnected" or "silent"; a killed
+             coordinator exits by the signal), no short stop, slow peer or stranger ended one,
+             no attempt hung, no participant outlived its coordinator by more than its timeouts,
+             and the results were readable after every crash (CSV rows whole, snapshots
+             well-formed XML);
+  identical  when its results (coupling.csv without wall_s, each participant's CSVs, the
+             snapshots) equal those of an uninterrupted run of the scenario, row for row and
+             byte for byte (on a difference, a second uninterrupted run tells a resume that
+             differs from a scenario that is not deterministic);
+  lost records: the rows (and snapshots) there after a crash that are missing or changed once
+             the run has finished, a row matched by its time (first cell).
 
 Usage: soak.py GRAINLINK [--minutes M] [--work DIR] [--seed S]
 Prints one summary line and a table per run; exits non-zero unless every run recovered, every
-run's results are identical and no record was lost. Replay a soak with the --seed it printed
-(the windows hit vary a little with the machine's load).
+run's results are identical and no record was lost. Each run's logs stay in WORK/runs/, and the
+outputs of those that failed. Replay a soak with the --seed it printed (the windows hit vary a
+little with the machine's load). soak.py signals only processes it started: the coordinator
+(its child) and the participants that coordinator started, checked by their command line.
 """
 import argparse
 import csv
