@@ -32,7 +32,7 @@ complete yet) until it finishes. A run has
   lost records: the rows (and snapshots) there after a crash that are missing or changed once
              the run has finished, a row matched by its time (first cell).
 
-Usage: soak.py GRAINLINK [--minutes M] [--work DIR] [--seed S]
+Usage: soak.py GRAINLINK [--minutes M] [--work DIR] [--seed S] [--scenario two-mass|wheel]
 Prints one summary line and a table per run; exits non-zero unless every run recovered, every
 run's results are identical and no record was lost. Each run's logs stay in WORK/runs/, and the
 outputs of those that failed. Replay a soak with the --seed it printed (the windows hit vary a
@@ -575,7 +575,10 @@ class Attempt:
             fault.note = f"{sent} sent, {answers} answered"
             if codes:
                 fault.note += ": " + " ".join(sorted(codes))
-            if answers == 0 and self.coordinator.poll() is None:
+            if answers == 0 and self.coordinator.poll() is not None:
+                fault.note = ""
+                return  # the run ended first: nothing reached it
+            if answers == 0:
                 self.run.problem(f"{fault.name}: the coordinator answered none of the "
                                  f"stranger's {sent} messages")
         fault.injected_at = rows
@@ -765,7 +768,8 @@ class Soak:
         self.rng = random.Random(args.seed)
         self.context = zmq.Context()
         self.stranger = Stranger(self.protobuf(), None)
-        self.scenarios = [Scenario(name, file) for name, file in SCENARIOS]
+        self.scenarios = [Scenario(name, file) for name, file in SCENARIOS
+                          if name in args.scenario]
 
     def install(self, grainlink):
         """A copy of grainlink and the programs built beside it (the participants it starts)
@@ -905,9 +909,12 @@ def main():
     parser.add_argument("grainlink", help="the grainlink executable (BUILD/apps/grainlink)")
     parser.add_argument("--minutes", type=float, default=5.0, help="bound on the whole soak")
     parser.add_argument("--work", default="soak", help="work folder (its runs/ are replaced)")
+    parser.add_argument("--scenario", action="append", choices=[n for n, _ in SCENARIOS],
+                        help="only this scenario (repeatable; default: all, in turn)")
     parser.add_argument("--seed", type=int, default=None,
                         help="seed of the random choices (default: from the clock, printed)")
     args = parser.parse_args()
+    args.scenario = args.scenario or [n for n, _ in SCENARIOS]
     if args.seed is None:
         args.seed = int(time.time()) % 100000
     if not os.access(args.grainlink, os.X_OK):
