@@ -90,7 +90,7 @@ std::string DepositionReport::preparationSummary() const {
         s << "struck off " << struck_off << " grains; ";
     if (compaction)
         s << "compacted: plate " << compaction->hold_force_N << " N at hold (target "
-          << compaction->target_force_N << " N); ";
+          << compaction->target_force_N << " N, press step " << compaction->time_step_s << " s); ";
     if (crust_grains > 0)
         s << "crust of " << crust_grains << " grains; ";
     if (s.tellp() == 0)

@@ -44,7 +44,7 @@ std::string mm(double m) {
 BevameterScenario parseBevameter(const config::ConfigNode &root) {
     BevameterScenario s;
     s.name = root["name"].text();
-    s.soil = parseLabSoil(root, {"the bevameter adds its own plate", {}, {}});
+    s.soil = parseLabSoil(root, {"the bevameter adds its own plate", {}, {}, {}});
     const auto b = root["bevameter"];
     BevameterSpec &t = s.test;
     t.plate_radii_m = b["plate_radii_m"].positives();

@@ -119,6 +119,7 @@ DirectShearScenario parseDirectShear(const config::ConfigNode &root) {
     s.name = root["name"].text();
     s.soil = parseLabSoil(root, {"the direct shear test adds its own frames",
                                  "the direct shear test builds its own box",
+                                 {},
                                  {}});
     const auto b = root["direct_shear"];
     DirectShearSpec &t = s.test;

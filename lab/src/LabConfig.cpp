@@ -13,6 +13,10 @@ dem::DemScenario parseLabSoil(const config::ConfigNode &root, const LabSoilRules
         refuse("walls", *rules.builds_walls);
     if (rules.never_cached)
         refuse("packing_cache_directory", *rules.never_cached);
+    if (const auto deposition = soil.optional("deposition");
+        rules.no_compaction && deposition && deposition->has("compaction"))
+        (*deposition)["compaction"].fail(*rules.no_compaction +
+                                         "; remove soil.deposition.compaction");
     // Keys of a DEM run that a lab test would read and then ignore.
     refuse("name", "a lab scenario is named by its top-level 'name'");
     refuse("output", "a lab test writes its own outputs (docs/lab.md)");

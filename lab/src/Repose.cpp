@@ -58,7 +58,9 @@ ReposeScenario parseRepose(const config::ConfigNode &root) {
     s.name = root["name"].text();
     s.soil = parseLabSoil(root, {"the repose test adds its own tube",
                                  {},
-                                 "the fill is never cached (the tube stands in it)"});
+                                 "the fill is never cached (the tube stands in it)",
+                                 "the fill is poured into the standing tube, which a "
+                                 "compaction plate cannot enter"});
     const auto r = root["repose"];
     ReposeSpec &t = s.test;
     t.tube_radius_m = r["tube_radius_m"].positive();

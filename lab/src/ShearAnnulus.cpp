@@ -263,7 +263,7 @@ std::string JanosiFit::describe() const {
 ShearAnnulusScenario parseShearAnnulus(const config::ConfigNode &root) {
     ShearAnnulusScenario s;
     s.name = root["name"].text();
-    s.soil = parseLabSoil(root, {"the shear test adds its own annulus", {}, {}});
+    s.soil = parseLabSoil(root, {"the shear test adds its own annulus", {}, {}, {}});
     const auto b = root["bevameter_shear"];
     ShearAnnulusSpec &t = s.test;
     AnnulusGeometry &g = t.annulus;

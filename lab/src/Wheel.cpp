@@ -28,7 +28,7 @@ double rimSpeed(double carriage_speed_m_s, double slip) {
 WheelScenario parseWheel(const config::ConfigNode &root) {
     WheelScenario s;
     s.name = root["name"].text();
-    s.soil = parseLabSoil(root, {"the wheel test adds its own wheel", {}, {}});
+    s.soil = parseLabSoil(root, {"the wheel test adds its own wheel", {}, {}, {}});
     const auto w = root["wheel"];
     WheelSpec &t = s.test;
     t.shape = body::parseWheelShape(w["shape"]);

@@ -129,6 +129,14 @@ TEST_CASE("Lab soil: keys a lab test would read and ignore are errors with their
             "repose.yaml")),
         Contains("repose.yaml:18:") && Contains("soil.packing_cache_directory") &&
             Contains("never cached"));
+    // The fill is poured into the standing tube: a compaction plate cannot enter it (it failed
+    // after settling, "the bed must have no mesh bodies yet").
+    CHECK_THROWS_WITH(
+        lab::parseRepose(config::ConfigNode::loadString(
+            replacedOnce(kTinyRepose, cache, cache + "    compaction: {pressure_Pa: 4000}\n"),
+            "repose.yaml")),
+        Contains("repose.yaml:18:") && Contains("soil.deposition.compaction") &&
+            Contains("poured into the standing tube"));
     CHECK_THROWS_WITH(parseBox(replacedOnce(kTinyShearBox, "soil:\n", "soil:\n  name: other\n")),
                       Contains("box.yaml:3:") && Contains("soil.name") &&
                           Contains("top-level 'name'"));

@@ -45,6 +45,7 @@ struct CompactionReport {
     double target_force_N = 0.0; ///< [N] pressure x footprint area
     double hold_force_N = 0.0;   ///< [N] plate's mean reaction over the second half of the hold
     double time_s = 0.0;         ///< [s] simulated from the plate's approach to its lift-off
+    double time_step_s = 0.0;    ///< [s] the press's step: the bed's, or shorter under load
 };
 
 /// Compacts the bed under a plate spanning the x-y footprint [lower_m, upper_m] (docs/physics.md

@@ -19,6 +19,7 @@ struct LabSoilRules {
     std::string adds_bodies;                 ///< e.g. "the bevameter adds its own plate"
     std::optional<std::string> builds_walls; ///< set: `soil.walls` is refused, this says why
     std::optional<std::string> never_cached; ///< set: `soil.packing_cache_directory` refused
+    std::optional<std::string> no_compaction; ///< set: `soil.deposition.compaction` refused
 };
 
 /// Reads `root["soil"]`: the DEM soil keys of docs/scenario.md, refusing what the lab does not
