@@ -98,4 +98,21 @@ ColumnStats columnStats(const Eigen::MatrixXd &rows) {
     return s;
 }
 
+void PooledScatter::add(const Eigen::MatrixXd &group) {
+    const ColumnStats s = columnStats(group);
+    for (Eigen::Index c = 0; c < group.cols() && c < squares_.size(); ++c)
+        if (s.count[c] >= 2) {
+            squares_[c] += s.sd[c] * s.sd[c] * (s.count[c] - 1);
+            dof_[c] += s.count[c] - 1;
+        }
+}
+
+Eigen::VectorXd PooledScatter::sd(const Eigen::VectorXd &fallback) const {
+    Eigen::VectorXd out = fallback;
+    for (Eigen::Index c = 0; c < squares_.size(); ++c)
+        if (dof_[c] > 0)
+            out[c] = std::sqrt(squares_[c] / dof_[c]);
+    return out;
+}
+
 } // namespace grainlink::gap

@@ -3,6 +3,7 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <limits>
 
 using namespace grainlink::gap;
 
@@ -61,4 +62,23 @@ TEST_CASE("feature rows and their column statistics skip what a curve does not r
     CHECK(s.count[1] == 1);
     CHECK(s.mean[1] == Approx(1.5));
     CHECK(std::isnan(s.sd[1]));
+}
+
+TEST_CASE("pooled scatter: squared deviations from each group's mean over their degrees of freedom",
+          "[gap][features]") {
+    // Two groups of one column: {1, 3} (mean 2, squares 2, 1 dof) and {10, 13, 16} (mean 13,
+    // squares 18, 2 dof): pooled variance 20 / 3. A second column with one value per group has no
+    // degrees of freedom and keeps the fallback.
+    Eigen::MatrixXd a(2, 2), b(3, 2);
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    a << 1, 5, 3, nan;
+    b << 10, 7, 13, nan, 16, nan;
+    PooledScatter pool(2);
+    pool.add(a);
+    pool.add(b);
+    const Eigen::VectorXd sd = pool.sd(Eigen::Vector2d(-1.0, -2.0));
+    CHECK(sd[0] == Approx(std::sqrt(20.0 / 3.0)));
+    CHECK(pool.dof()[0] == 3);
+    CHECK(sd[1] == -2.0);
+    CHECK(pool.dof()[1] == 0);
 }

@@ -50,4 +50,23 @@ struct ColumnStats {
 };
 ColumnStats columnStats(const Eigen::MatrixXd &rows);
 
+/// The scatter of one simulated bed, per column, pooled over groups of rows that each share one
+/// model (the base's seeds, each variant's seeds): sqrt(sum of squared deviations from each
+/// group's own mean / sum of (n_g - 1)). Two or three seeds give a sample sd that swings by
+/// factors of ten; pooled over many variants it is a steady estimate (docs/gap.md, step 6).
+class PooledScatter {
+public:
+    explicit PooledScatter(Eigen::Index columns)
+        : squares_(Eigen::VectorXd::Zero(columns)), dof_(Eigen::VectorXi::Zero(columns)) {}
+    void add(const Eigen::MatrixXd &group);
+    /// The pooled sd; `fallback` where no group had two values.
+    Eigen::VectorXd sd(const Eigen::VectorXd &fallback) const;
+    /// Degrees of freedom of each column's estimate.
+    const Eigen::VectorXi &dof() const { return dof_; }
+
+private:
+    Eigen::VectorXd squares_;
+    Eigen::VectorXi dof_;
+};
+
 } // namespace grainlink::gap
