@@ -690,15 +690,22 @@ class Run:
                          f"{attempt.error or f'exit status {attempt.rc}'}")
 
     def leftovers(self, attempt):
-        """Waits for the attempt's participants to end; stops and reports any that stay."""
-        limit = time.monotonic() + self.scenario.orphan_s
+        """Waits for the attempt's participants to end; stops and reports any that stay. Once
+        welcomed, a participant must notice a vanished coordinator within its peer timeout.
+        Before, one that never heard the coordinator waits for its Welcome as long as its
+        handshake timeout (the two-mass node's is the library's 120 s): noted, not a failure."""
+        with open(attempt.log, errors="replace") as f:
+            welcomed = "coordinator: run " in f.read()
+        wait_s = self.scenario.peer_timeout + 10 if welcomed else self.scenario.orphan_s
+        limit = time.monotonic() + wait_s
         while time.monotonic() < limit:
             if not any(alive(pid) for pid in attempt.pids.values()):
                 return
             time.sleep(0.05)
         names = [n for n, pid in attempt.pids.items() if alive(pid)]
-        self.problem(f"participant(s) {', '.join(names)} still running "
-                     f"{self.scenario.orphan_s:.0f} s after the run ended: killed")
+        self.problem(f"participant(s) {', '.join(names)} still running {wait_s:.0f} s after the "
+                     f"run ended {'' if welcomed else 'during the handshake '}(killed by soak)",
+                     recovery=welcomed)
         self.soak.stop_all(attempt)
 
     def execute(self):
