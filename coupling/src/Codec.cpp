@@ -49,6 +49,18 @@ void toWire(const BodyDescription &body, pb::BodyDescription *out) {
     }
 }
 
+namespace {
+
+/// Throws the protocol error for body `name` unless `ok`.
+void require(bool ok, const std::string &name, const std::string &what) {
+    if (!ok)
+        throw ProtocolError(pb::Error::CODE_MALFORMED, "body '" + printable(name) + "': " + what);
+}
+
+bool finite(const Vec3 &v) { return v.allFinite(); }
+
+} // namespace
+
 BodyDescription fromWire(const pb::BodyDescription &body) {
     BodyDescription out;
     out.name = body.name();
@@ -56,11 +68,19 @@ BodyDescription fromWire(const pb::BodyDescription &body) {
     out.mass.center_of_mass_m = fromWire(body.mass().center_of_mass_m());
     out.mass.inertia_diagonal_kg_m2 = fromWire(body.mass().inertia_diagonal_kg_m2());
     out.mass.inertia_off_diagonal_kg_m2 = fromWire(body.mass().inertia_off_diagonal_kg_m2());
+    // Numbers that would reach the soil's mesh and integrator: finite, and sizes in range.
+    require(std::isfinite(out.mass.mass_kg) && out.mass.mass_kg >= 0.0, body.name(),
+            "mass_kg must be finite and not negative");
+    require(finite(out.mass.center_of_mass_m) && finite(out.mass.inertia_diagonal_kg_m2) &&
+                finite(out.mass.inertia_off_diagonal_kg_m2),
+            body.name(), "non-finite centre of mass or inertia");
     if (body.has_mesh()) {
         const auto &indices = body.mesh().triangle_indices();
         MeshShape mesh;
-        for (const auto &v : body.mesh().vertices_m())
+        for (const auto &v : body.mesh().vertices_m()) {
             mesh.vertices_m.push_back(fromWire(v));
+            require(finite(mesh.vertices_m.back()), body.name(), "non-finite mesh vertex");
+        }
         if (indices.size() % 3 != 0)
             throw ProtocolError(pb::Error::CODE_MALFORMED,
                                 "body '" + printable(body.name()) + "': triangle index count " +
@@ -88,6 +108,20 @@ BodyDescription fromWire(const pb::BodyDescription &body) {
                                   : GrouserShape::Straight;
         wheel.chevron_angle_deg = w.chevron_angle_deg();
         wheel.closed_sides = w.closed_sides();
+        const auto positive = [](double x) { return std::isfinite(x) && x > 0.0; };
+        const auto size = [](double x) { return std::isfinite(x) && x >= 0.0; };
+        require(positive(wheel.diameter_m) && positive(wheel.width_m), body.name(),
+                "wheel diameter_m and width_m must be finite and positive");
+        require(size(wheel.rim_thickness_m) && wheel.rim_thickness_m < 0.5 * wheel.diameter_m,
+                body.name(), "wheel rim_thickness_m must lie in [0, the rim radius)");
+        require(wheel.grouser_count <= unsigned(body::kMaxGrousers), body.name(),
+                "wheel grouser_count " + std::to_string(wheel.grouser_count) + " above " +
+                    std::to_string(body::kMaxGrousers));
+        require(size(wheel.grouser_height_m) && size(wheel.grouser_thickness_m) &&
+                    std::isfinite(wheel.chevron_angle_deg) &&
+                    std::abs(wheel.chevron_angle_deg) < 80.0,
+                body.name(), "wheel grouser sizes must be finite and not negative, the chevron "
+                             "angle within (-80, 80) deg");
         out.geometry = wheel;
     }
     return out;

@@ -3,6 +3,8 @@
 #include "OutputCheck.hpp"
 #include "RunState.hpp"
 
+#include <cmath>
+
 namespace grainlink::coupling {
 
 WindowReplies::WindowReplies(std::vector<From> participants) : from_(std::move(participants)) {}
@@ -55,8 +57,13 @@ WindowReplies::Reply WindowReplies::read(std::size_t p, const codec::pb::Envelop
         throw PeerError(from.who, error.what());
     }
     Reply reply;
-    for (const auto &w : done.work())
+    for (const auto &w : done.work()) {
+        // The coupling's energy balance sums it: one NaN would blind the mismatch guard.
+        if (!std::isfinite(w.work_j()))
+            throw PeerError(from.who, "sent a non-finite work for body '" +
+                                          codec::printable(w.body()) + "'");
         reply.work_J += w.work_j();
+    }
     reply.suggested_step_ticks = done.suggested_macro_step_ticks();
     reply.run_complete = done.run_complete();
     return reply;

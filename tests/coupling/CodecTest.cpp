@@ -9,6 +9,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <limits>
+
 #include <array>
 #include <cmath>
 
@@ -191,6 +193,60 @@ TEST_CASE("Codec: a mesh's triangles index its vertices, three at a time", "[cou
     }
 }
 
+TEST_CASE("Codec: a body's mass, mesh and wheel numbers must be finite and in range",
+          "[coupling][codec]") {
+    // Every one of these reached the soil's mesh builder or integrator before: a NaN vertex, a
+    // negative mass, four billion grousers (a mesh that exhausts memory).
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    pb::BodyDescription plate;
+    plate.set_name("plate");
+    plate.mutable_mass()->set_mass_kg(1.0);
+    for (int v = 0; v < 3; ++v)
+        plate.mutable_mesh()->add_vertices_m()->set_x(v);
+    for (std::uint32_t i : {0u, 1u, 2u})
+        plate.mutable_mesh()->add_triangle_indices(i);
+    CHECK_NOTHROW(codec::fromWire(plate));
+    SECTION("a non-finite vertex") {
+        plate.mutable_mesh()->mutable_vertices_m(1)->set_z(nan);
+        CHECK_THROWS_WITH(codec::fromWire(plate), "body 'plate': non-finite mesh vertex");
+    }
+    SECTION("a negative or non-finite mass, a non-finite inertia") {
+        plate.mutable_mass()->set_mass_kg(-1.0);
+        CHECK_THROWS_WITH(codec::fromWire(plate),
+                          "body 'plate': mass_kg must be finite and not negative");
+        plate.mutable_mass()->set_mass_kg(nan);
+        CHECK_THROWS_WITH(codec::fromWire(plate),
+                          "body 'plate': mass_kg must be finite and not negative");
+        plate.mutable_mass()->set_mass_kg(1.0);
+        plate.mutable_mass()->mutable_inertia_diagonal_kg_m2()->set_y(nan);
+        CHECK_THROWS_WITH(codec::fromWire(plate),
+                          "body 'plate': non-finite centre of mass or inertia");
+    }
+    pb::BodyDescription wheel;
+    wheel.set_name("wheel");
+    auto *w = wheel.mutable_wheel();
+    w->set_diameter_m(0.25);
+    w->set_width_m(0.1);
+    w->set_grouser_count(12);
+    w->set_grouser_height_m(0.01);
+    w->set_grouser_thickness_m(0.002);
+    CHECK_NOTHROW(codec::fromWire(wheel));
+    SECTION("wheel sizes") {
+        w->set_grouser_count(4000000000u);
+        CHECK_THROWS_WITH(codec::fromWire(wheel),
+                          "body 'wheel': wheel grouser_count 4000000000 above 1000");
+        w->set_grouser_count(12);
+        w->set_width_m(0.0);
+        CHECK_THROWS_WITH(codec::fromWire(wheel), Catch::Contains("must be finite and positive"));
+        w->set_width_m(0.1);
+        w->set_rim_thickness_m(0.2);
+        CHECK_THROWS_WITH(codec::fromWire(wheel), Catch::Contains("rim_thickness_m"));
+        w->set_rim_thickness_m(0.0);
+        w->set_grouser_height_m(-0.01);
+        CHECK_THROWS_WITH(codec::fromWire(wheel), Catch::Contains("grouser sizes"));
+    }
+}
+
 TEST_CASE("Codec: a Hello needs its role and a Welcome its scheme", "[coupling][codec]") {
     for (const auto scheme :
          {SchemeKind::ExplicitSerial, SchemeKind::ExplicitParallel, SchemeKind::Implicit})
@@ -330,6 +386,11 @@ TEST_CASE("WindowDone: checked against its window, in the words the run stops wi
         CHECK(line(0, mbs) == mbs_at + "sent a non-finite state of body 'wheel'");
         s->mutable_wrenches()->mutable_wrenches(0)->mutable_force_n()->set_y(-INFINITY);
         CHECK(line(1, soil) == soil_at + "sent a non-finite wrench on body 'wheel'");
+        // The work enters the coupling's energy balance: a NaN would hide every mismatch.
+        m->mutable_states()->mutable_states(0)->mutable_linear_velocity_m_s()->set_x(0.0);
+        m->mutable_work(1)->set_body("wheel");
+        m->mutable_work(1)->set_work_j(NAN);
+        CHECK(line(0, mbs) == mbs_at + "sent a non-finite work for body 'wheel'");
     }
     SECTION("a non-unit quaternion and a wrong frame inside the reply") {
         m->mutable_states()->mutable_states(0)->mutable_orientation()->set_w(0.5);
