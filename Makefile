@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: deps configure build demo test bench gap-selftest clean
+.PHONY: deps configure build demo test bench gap-selftest asan-build asan fuzz tsan soak clean
 
 deps:
 	@scripts/install-deps
@@ -27,6 +27,43 @@ bench: build
 # two cores; prints the score line and the confusion matrix.
 gap-selftest: build
 	OMP_WAIT_POLICY=PASSIVE $(BUILD)/apps/grainlink gap selftest --scale full --jobs 2
+
+# Hardening (docs/hardening.md). One clang build with AddressSanitizer + UndefinedBehaviorSanitizer,
+# for the portable instruction set (x86-64), holds the fuzz targets too: `make asan` runs the test
+# suite in it (all but the tests that only repeat simulations: ASAN_SKIP), `make fuzz` a fuzzing
+# campaign of FUZZ_SECONDS per target. `make tsan` runs the coupling's tests (the coordinator's
+# threads) under ThreadSanitizer.
+ASAN_BUILD ?= build-asan
+TSAN_BUILD ?= build-tsan
+FUZZ_SECONDS ?= 300
+ASAN_SKIP ?= selftest|slurm
+CLANG_FLAGS = -DCMAKE_CXX_COMPILER=clang++ -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+              "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" -DGRAINLINK_BUILD_BENCH=OFF
+
+asan-build:
+	@scripts/install-deps hardening
+	@cmake -S . -B $(ASAN_BUILD) $(CLANG_FLAGS) -DGRAINLINK_SANITIZE=address -DGRAINLINK_FUZZ=ON \
+	       -DGRAINLINK_ARCH=x86-64 >/dev/null
+	@cmake --build $(ASAN_BUILD) -j $(JOBS)
+
+asan: asan-build
+	@cd $(ASAN_BUILD) && ctest --output-on-failure -j $(JOBS) -E '$(ASAN_SKIP)'
+
+fuzz: asan-build
+	@fuzz/run-campaign $(ASAN_BUILD) $(FUZZ_SECONDS)
+
+tsan:
+	@scripts/install-deps hardening
+	@cmake -S . -B $(TSAN_BUILD) $(CLANG_FLAGS) -DGRAINLINK_SANITIZE=thread >/dev/null
+	@cmake --build $(TSAN_BUILD) -j $(JOBS) --target test_coupling
+	@cd $(TSAN_BUILD) && ctest --output-on-failure -j $(JOBS) -R '^coupling:'
+
+# The fault soak (docs/hardening.md): coupled runs with faults injected at random windows,
+# each resumed and compared with an uninterrupted run; SOAK_MINUTES bounds it.
+SOAK_MINUTES ?= 5
+soak: build
+	@OMP_WAIT_POLICY=PASSIVE /usr/bin/python3 tests/soak/soak.py $(BUILD)/apps/grainlink \
+	    --minutes $(SOAK_MINUTES) --work $(BUILD)/soak
 
 clean:
 	rm -rf $(BUILD)
