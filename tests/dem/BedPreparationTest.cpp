@@ -135,7 +135,7 @@ TEST_CASE("strike-off above the bed removes nothing and leaves the bed as it was
 
 TEST_CASE("compaction: the plate holds pressure x area, and the packing fraction rises with the "
           "pressure",
-          "[dem][preparation]") {
+          "[dem][preparation][slow]") {
     const double settled = packingFraction(settledBed().particles(), footprintArea());
     std::printf("compaction of %zu grains in a %.0f mm square bin (E = 3 MPa, mu = 0.3, dt = "
                 "%.0e s): packing fraction at 0 kPa %.4f\n",

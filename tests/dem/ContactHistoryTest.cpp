@@ -90,7 +90,7 @@ double maxForceDifference(const DemSystem& a, const DemSystem& b) {
 } // namespace
 
 TEST_CASE("Contact history survives neighbour-list rebuilds and spatial re-sorts",
-          "[dem][history]") {
+          "[dem][history][slow]") {
     const DemSystem& packing = settledPacking();
     const double weight = sphereMass(0.0025, kMaterial.density_kg_m3) * 9.81; // smallest grain
     // The packing is loaded and its contacts carry history, or the test proves nothing.

@@ -88,7 +88,7 @@ double largestStableStep(Integrator integrator, double lo, double hi, int steps,
 } // namespace
 
 TEST_CASE("Largest stable step: velocity Verlet vs Newmark (beta 1/4, gamma 1/2) on a bed",
-          "[dem][integrator]") {
+          "[dem][integrator][slow]") {
     // The same settled bed (Table 1 soil, 500 grains of r = 2.5 mm, restitution 0.5, mu 0.5) is
     // run 2000 steps from rest at a trial step, check_time_step off. Two criteria:
     //  - blow-up: SimulationError (overlap > 0.4 r, non-finite) or kinetic energy above

@@ -39,7 +39,7 @@ std::string edited(const std::string &from, const std::string &to) {
 } // namespace
 
 TEST_CASE("Bevameter on a tiny bed: pressure grows with sinkage for both plates, Bekker fits",
-          "[lab][bevameter]") {
+          "[lab][bevameter][slow]") {
     const auto result = lab::runBevameter(parse(kTiny), {});
     INFO(result.report());
     REQUIRE(result.runs.size() == 2);

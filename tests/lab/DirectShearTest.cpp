@@ -95,7 +95,7 @@ TEST_CASE("Direct shear input errors name the key", "[lab][direct_shear]") {
 }
 
 TEST_CASE("Direct shear on a tiny box: the servo holds sigma and strength grows with it",
-          "[lab][direct_shear][dem]") {
+          "[lab][direct_shear][dem][slow]") {
     const auto scenario = parse(kTinyShearBox);
     const auto result = lab::runDirectShear(scenario, {});
     REQUIRE(result.runs.size() == 2);
@@ -138,7 +138,7 @@ TEST_CASE("Direct shear on a tiny box: the servo holds sigma and strength grows 
 }
 
 TEST_CASE("Direct shear: the servo's integral term removes the dilation lag",
-          "[lab][direct_shear][dem]") {
+          "[lab][direct_shear][dem][slow]") {
     // A proportional servo (u = g e) moves the plate at g times the load error, so over the
     // shearing its mean error is exactly the plate's rise / (T g): the lag behind the dilating
     // bed (physics.md §12.11). With the integral term the mean error is instead the integral's
@@ -192,7 +192,7 @@ TEST_CASE("Direct shear: the servo's integral term removes the dilation lag",
 }
 
 TEST_CASE("Direct shear: frictionless spheres are much weaker than phi = 30 deg grains",
-          "[lab][direct_shear][dem]") {
+          "[lab][direct_shear][dem][slow]") {
     // Same box and packing procedure at 4 kPa; phi = 0 with no rolling resistance against
     // phi = 30 deg with grain-shape rolling resistance (gamma = 20 deg). Strength as the
     // residual (critical-state) friction angle atan(tau / sigma), tau and sigma averaged over the

@@ -85,7 +85,7 @@ bool hasMatplotlib() {
 
 } // namespace
 
-TEST_CASE("Lab plot: every test's summary.json becomes <dir>/<test>.png", "[lab][plot]") {
+TEST_CASE("Lab plot: every test's summary.json becomes <dir>/<test>.png", "[lab][plot][slow]") {
     if (!hasMatplotlib()) {
         WARN("skipped: no /usr/bin/python3 with matplotlib");
         return;

@@ -140,7 +140,7 @@ TEST_CASE("Bed summary: a simple cubic packing has packing fraction pi / 6", "[l
     CHECK(bed.seed == 7);
 }
 
-TEST_CASE("A lab run's summary.json holds what its CSV and report hold", "[lab][summary][dem]") {
+TEST_CASE("A lab run's summary.json holds what its CSV and report hold", "[lab][summary][dem][slow]") {
     // The tiny repose test through runLabTest, written to disk: summary.json's profile against
     // heap_profile.csv (10 significant digits there), its angle against the result's.
     const auto dir = std::filesystem::temp_directory_path() /

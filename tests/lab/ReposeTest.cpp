@@ -75,7 +75,7 @@ TEST_CASE("Grains spread flat are no heap: a result with its profile, not an err
     CHECK_THAT(result.report(), Contains("no heap"));
 }
 
-TEST_CASE("Angle of repose: more rolling resistance builds a steeper heap", "[lab][repose]") {
+TEST_CASE("Angle of repose: more rolling resistance builds a steeper heap", "[lab][repose][slow]") {
     // The same 600 grains with rolling resistance 0.3 and 0.1, each filled from three deposition
     // seeds. Grain shape (here its stand-in) is what holds a heap of spheres up, so the 0.3 heaps
     // must be steeper on average by more than the two 95 % intervals of the means together

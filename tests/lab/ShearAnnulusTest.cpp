@@ -164,7 +164,7 @@ TEST_CASE("Janosi fit recovers c, phi and K from synthetic curves", "[lab][shear
 
 TEST_CASE("Shear annulus on a tiny bed: load held, tau(j) rises and saturates, higher sigma "
           "gives higher tau_max",
-          "[lab][shear_annulus]") {
+          "[lab][shear_annulus][slow]") {
     const auto scenario = parse(kTiny);
     const auto result = lab::runShearAnnulus(scenario, {});
     INFO(result.report());
@@ -202,7 +202,7 @@ TEST_CASE("Shear annulus on a tiny bed: load held, tau(j) rises and saturates, h
 }
 
 TEST_CASE("Shear annulus: frictionless grains carry a much smaller tau_max than 30 degree ones",
-          "[lab][shear_annulus]") {
+          "[lab][shear_annulus][slow]") {
     // Same bed and load (1 kPa); frictionless grains without rolling resistance (the annulus
     // takes the grains' friction, so it is frictionless too) resist only through the grousers
     // pushing grains aside. Written: 195 Pa against 735 Pa (ratio 0.26); required below 0.6,

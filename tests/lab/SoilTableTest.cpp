@@ -150,7 +150,7 @@ TEST_CASE("Grain parameters of a table point: stick = slip = phi, gamma 0 is the
     CHECK(dem::packingKey(shaped) != dem::packingKey(base));
 }
 
-TEST_CASE("Soil table generated on the tiny box reads back and inverts", "[lab][soil_table][dem]") {
+TEST_CASE("Soil table generated on the tiny box reads back and inverts", "[lab][soil_table][dem][slow]") {
     // Two friction angles (0 and 30 deg) at gamma 20 deg on the tiny direct-shear box, no
     // repose test. The run writes the table; it must read back with the regenerate command in
     // its header. psi must rise with phi by more than 5 deg: measured 17.5 deg at phi 0 (the same

@@ -57,7 +57,7 @@ TEST_CASE("wheel: the rim speed of a slip, driven, braked and locked, by hand", 
 
 TEST_CASE("wheel: a braked wheel is pushed back, a driven one pulls, the servo holds the load and "
           "the motor's power covers the drawbar's",
-          "[lab][wheel]") {
+          "[lab][wheel][slow]") {
     const lab::WheelScenario s = parse(kTiny);
     const lab::WheelResult r = lab::runWheel(s, {});
     REQUIRE(r.runs.size() == 3);

@@ -268,7 +268,7 @@ TEST_CASE("Mole: the hammer's rebound from the anvil follows Hunt-Crossley", "[m
     CHECK(v_out == Approx(v_exact).epsilon(1e-4));
 }
 
-TEST_CASE("Mole: strokes repeat with the configured period", "[mbs][mole]") {
+TEST_CASE("Mole: strokes repeat with the configured period", "[mbs][mole][slow]") {
     MoleSettings s = quickMole();
     s.hull_fixed = true; // Mars gravity, losses on: the mechanism settles between strokes
     Mole mole(s);
@@ -368,7 +368,7 @@ TEST_CASE("Mole hull mesh: closed, outward, volume of cylinder plus cone", "[mbs
     CHECK(hull->triangles.size() == mesh.triangles.size());
 }
 
-TEST_CASE("Mole: save/restore and a checkpoint continue identically", "[mbs][mole]") {
+TEST_CASE("Mole: save/restore and a checkpoint continue identically", "[mbs][mole][slow]") {
     MoleSettings s = quickMole(); // Mars gravity, free hull, a constant soil force
     Wrench soil;
     soil.force_N = Vec3(0.1, 0.0, 2.0);

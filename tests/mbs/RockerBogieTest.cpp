@@ -198,7 +198,7 @@ std::vector<double> flatten(const RockerBogie &rover) {
 } // namespace
 
 TEST_CASE("Rocker-bogie: static wheel loads on flat ground match the hand calculation",
-          "[mbs][rover]") {
+          "[mbs][rover][slow]") {
     auto settings = resting();
     SECTION("default rover") {}
     SECTION("chassis centre of mass forward and to the left") {
@@ -239,7 +239,7 @@ TEST_CASE("Rocker-bogie: static wheel loads on flat ground match the hand calcul
 }
 
 TEST_CASE("Rocker-bogie: the differential splits a raised front wheel between the rockers",
-          "[mbs][rover]") {
+          "[mbs][rover][slow]") {
     RockerBogie rover(resting());
     PenaltyGround ground;
     // The ground under the left front wheel rises to a 60 mm step over 0.4 s, then holds.
@@ -290,7 +290,7 @@ TEST_CASE("Rocker-bogie: the differential splits a raised front wheel between th
     CHECK(sum == Approx(rover.totalMass_kg() * 3.71).epsilon(1e-5));
 }
 
-TEST_CASE("Rocker-bogie: driven wheels hold their speed and climb a slope", "[mbs][rover]") {
+TEST_CASE("Rocker-bogie: driven wheels hold their speed and climb a slope", "[mbs][rover][slow]") {
     // A 10° slope: the ground stays z = 0 and gravity tilts backwards, g (-sin α, 0, -cos α).
     const double alpha = 10.0 * SimTK::Pi / 180.0, g = 3.71;
     auto settings = resting();
@@ -323,7 +323,7 @@ TEST_CASE("Rocker-bogie: driven wheels hold their speed and climb a slope", "[mb
     CHECK(rover.chassisState().linear_velocity_m_s.x() == Approx(r - creep).epsilon(1e-3));
 }
 
-TEST_CASE("Rocker-bogie: torque-driven wheels accelerate the rover up the slope", "[mbs][rover]") {
+TEST_CASE("Rocker-bogie: torque-driven wheels accelerate the rover up the slope", "[mbs][rover][slow]") {
     // The slope of the test above, reached at steady speed with the speed drive; then torque
     // drive with each wheel's steady motor torque plus 10 % of the total shared equally.
     const double alpha = 10.0 * SimTK::Pi / 180.0, g = 3.71;
@@ -358,7 +358,7 @@ TEST_CASE("Rocker-bogie: torque-driven wheels accelerate the rover up the slope"
           Approx(a / r).epsilon(1e-3));
 }
 
-TEST_CASE("Rocker-bogie: save/restore and checkpoints continue identically", "[mbs][rover]") {
+TEST_CASE("Rocker-bogie: save/restore and checkpoints continue identically", "[mbs][rover][slow]") {
     auto settings = resting();
     RockerBogie rover(settings);
     PenaltyGround ground;
