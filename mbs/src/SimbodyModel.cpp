@@ -1,5 +1,7 @@
 #include "grainlink/mbs/SimbodyModel.hpp"
 
+#include "CheckpointText.hpp"
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -129,36 +131,11 @@ void SimbodyModel::writeCheckpoint(const std::string &path) const {
 
 namespace {
 
-/// One line of a multibody checkpoint: its tag, then exactly `count` finite numbers; otherwise
-/// an error naming the file, the line and what the line holds.
+/// One line of a multibody checkpoint: its tag, then exactly `count` finite numbers.
 std::vector<double> checkpointLine(std::istream &in, const std::string &path, int number,
                                    const std::string &tag, std::size_t count,
                                    const std::string &what) {
-    const std::string where = path + ":" + std::to_string(number) + ": ";
-    std::string line;
-    if (!std::getline(in, line))
-        throw ModelError(where + "missing the line '" + tag + " ...' (" + what +
-                         "): truncated multibody checkpoint");
-    std::istringstream words(line);
-    std::string word;
-    if (!(words >> word) || word != tag)
-        throw ModelError(where + "expected '" + tag + " ...' (" + what + "), got '" +
-                         line.substr(0, 40) + "'" +
-                         (number == 1 ? ": not a multibody checkpoint" : ""));
-    std::vector<double> values;
-    while (words >> word) {
-        char *end = nullptr;
-        const double value = std::strtod(word.c_str(), &end);
-        if (end == word.c_str() || *end != '\0' || !std::isfinite(value))
-            throw ModelError(where + "'" + word.substr(0, 40) + "' in " + what +
-                             " is not a finite number");
-        values.push_back(value);
-    }
-    if (values.size() != count)
-        throw ModelError(where + std::to_string(values.size()) + " values of " + what +
-                         ", this model has " + std::to_string(count) +
-                         " (a checkpoint of another model?)");
-    return values;
+    return checkpointNumbers(in, path, number, "multibody", tag, count, what);
 }
 
 } // namespace

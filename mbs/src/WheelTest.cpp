@@ -1,7 +1,11 @@
 #include "grainlink/mbs/WheelTest.hpp"
 
+#include "CheckpointText.hpp"
+
 #include <cmath>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 
 namespace grainlink::mbs {
 
@@ -122,6 +126,75 @@ std::string WheelTest::summary() const {
                   steady_.slip_std, steady_.drawbar_pull_mean_N, steady_.drawbar_pull_std_N,
                   steady_.torque_mean_N_m, steady_.torque_std_N_m);
     return text;
+}
+
+void WheelTest::writeCheckpoint(const std::string &path) const {
+    std::ostringstream os;
+    os.precision(17); // round trip: the resumed criteria see the very same numbers
+    os << "phase " << phaseName() << "\ndrive_start_s " << drive_start_s_ << "\ndrop_heights";
+    for (const auto &[t, z] : drop_heights_)
+        os << ' ' << t << ' ' << z;
+    os << "\ndrive_samples";
+    for (const auto &w : drive_samples_)
+        os << ' ' << w.time_s << ' ' << w.slip << ' ' << w.motor_torque_N_m << ' '
+           << w.soil_force_x_N << ' ' << w.soil_force_z_N << ' ' << w.wheel_z_m;
+    const auto &r = steady_;
+    os << "\nsteady " << (r.reached ? 1 : 0) << ' ' << r.time_s << ' ' << r.slip_mean << ' '
+       << r.slip_std << ' ' << r.torque_mean_N_m << ' ' << r.torque_std_N_m << ' '
+       << r.drawbar_pull_mean_N << ' ' << r.drawbar_pull_std_N << ' ' << r.revolutions << '\n';
+    std::ofstream out(path);
+    out << os.str();
+    if (!out)
+        throw ModelError("cannot write the wheel test's checkpoint " + path);
+}
+
+void WheelTest::readCheckpoint(const std::string &path) {
+    std::ifstream in(path);
+    if (!in)
+        throw ModelError("cannot open the wheel test's checkpoint " + path +
+                         " (a checkpoint written before the wheel test's state was saved cannot "
+                         "be resumed: start the run again)");
+    const std::string kind = "wheel test";
+    std::string line, tag, name;
+    std::getline(in, line);
+    std::istringstream words(line);
+    words >> tag >> name;
+    Phase phase = Phase::Drop;
+    if (tag != "phase")
+        throw ModelError(path + ":1: expected 'phase drop|drive|steady', got '" +
+                         line.substr(0, 40) + "': not a wheel test checkpoint");
+    if (name == "drive")
+        phase = Phase::Drive;
+    else if (name == "steady")
+        phase = Phase::Steady;
+    else if (name != "drop")
+        throw ModelError(path + ":1: unknown phase '" + name.substr(0, 40) +
+                         "' (drop, drive or steady)");
+    const double drive_start_s =
+        checkpointNumbers(in, path, 2, kind, "drive_start_s", 1, "when driving began [s]")[0];
+    const auto heights =
+        checkpointNumbers(in, path, 3, kind, "drop_heights", "the drop's (time [s], height [m])");
+    const auto samples = checkpointNumbers(in, path, 4, kind, "drive_samples",
+                                           "the drive's samples (time [s], slip, torque [N m], "
+                                           "force x [N], force z [N], height [m])");
+    const auto report = checkpointNumbers(in, path, 5, kind, "steady", 9, "the steady report");
+    if (heights.size() % 2 != 0)
+        throw ModelError(path + ":3: " + std::to_string(heights.size()) +
+                         " values of the drop's (time, height) pairs: an odd number");
+    if (samples.size() % 6 != 0)
+        throw ModelError(path + ":4: " + std::to_string(samples.size()) +
+                         " values of the drive's samples: not 6 per sample");
+    phase_ = phase;
+    drive_start_s_ = drive_start_s;
+    drop_heights_.clear();
+    for (std::size_t k = 0; k < heights.size(); k += 2)
+        drop_heights_.emplace_back(heights[k], heights[k + 1]);
+    drive_samples_.clear();
+    for (std::size_t k = 0; k < samples.size(); k += 6)
+        drive_samples_.push_back({samples[k], samples[k + 1], samples[k + 2], samples[k + 3],
+                                  samples[k + 4], samples[k + 5]});
+    steady_ = {report[0] != 0.0, report[1], report[2], report[3], report[4],
+               report[5],        report[6], report[7], report[8]};
 }
 
 WheelTestSettings parseWheelTest(const config::ConfigNode &node) {

@@ -52,12 +52,19 @@ public:
     std::string phaseName() const;
     std::string summary() const;
 
+    /// The procedure's own state beyond the rig's (the phase, when driving began, the heights
+    /// and samples its criteria look back on, the steady report) as text, for the run's
+    /// checkpoints: a run resumed from one continues the procedure as if it never stopped.
+    void writeCheckpoint(const std::string &path) const;
+    /// Reads what writeCheckpoint wrote; a missing, truncated or damaged file is a ModelError
+    /// naming the file and the line.
+    void readCheckpoint(const std::string &path);
+
 private:
     WheelTestSettings settings_;
     Phase phase_ = Phase::Drop;
     std::deque<std::pair<double, double>> drop_heights_; ///< (t, z) over the last settle time
     double drive_start_s_ = 0.0;
-    double drive_start_angle_rad_ = 0.0;
     std::deque<WheelSample> drive_samples_;
     SteadyState steady_;
 };
