@@ -107,9 +107,9 @@ public:
 
     void start(const coupling::RunInfo &run) override {
         std::filesystem::create_directories(options_.output_directory);
-        series_ = openSeries(options_.output_directory + "/" + report_.series_file, report_.header,
-                             run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
-                                         : std::nullopt);
+        series_.emplace(options_.output_directory + "/" + report_.series_file, report_.header,
+                        run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
+                                    : std::nullopt);
     }
 
     coupling::WindowOutputs advance(const coupling::WindowInputs &in) override {
@@ -118,7 +118,8 @@ public:
         model_.applyWrenches(soil_);
         const auto work = model_.advanceTo(in.end_s);
         coupling::WindowOutputs out;
-        out.run_complete = report_.after_window(series_, soil_);
+        out.run_complete = report_.after_window(series_->rows(), soil_);
+        series_->write();
         const auto states = model_.bodyStates();
         for (std::size_t b = 0; b < bodies_.size(); ++b) {
             out.states.push_back(toCoupling(bodies_[b].name, states[b]));
@@ -133,16 +134,12 @@ public:
 
     void writeCheckpoint(const std::string &directory) override {
         model_.writeCheckpoint(directory + "/" + report_.checkpoint_file);
-        series_.flush();
     }
     void readCheckpoint(const std::string &directory) override {
         model_.readCheckpoint(directory + "/" + report_.checkpoint_file);
     }
 
-    void finish() override {
-        series_.flush();
-        report_.finish();
-    }
+    void finish() override { report_.finish(); }
 
 private:
     mbs::MultibodyModel &model_;
@@ -150,7 +147,7 @@ private:
     NodeOptions options_;
     std::vector<mbs::BodyDescription> bodies_;
     std::vector<mbs::Wrench> soil_; ///< the soil's wrenches of the current window
-    std::ofstream series_;
+    std::optional<Series> series_;
 };
 
 int runWindows(const config::ConfigNode &root, mbs::MultibodyModel &model, Report report,

@@ -49,10 +49,10 @@ public:
         resumed_ = run.restore.has_value();
         end_s_ = run.end_tick * run.tick_s;
         std::filesystem::create_directories(options_.output_directory);
-        series_ = openSeries(options_.output_directory + "/" + options_.section + ".csv",
-                             "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts",
-                             run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
-                                         : std::nullopt);
+        series_.emplace(options_.output_directory + "/" + options_.section + ".csv",
+                        "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts",
+                        run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
+                                    : std::nullopt);
         first_step_ = sys_->stepCount();
     }
 
@@ -91,11 +91,12 @@ public:
                 MirrorSymmetry::complete(w.force_N, w.torque_N_m);
                 out.work[b].work_J *= 2.0;
             }
-            series_ << in.end_s << ',' << w.body << ',' << surface_ - lowestPoint(b) << ','
-                    << w.force_N.x() << ',' << w.force_N.y() << ',' << w.force_N.z() << ','
-                    << w.torque_N_m.x() << ',' << w.torque_N_m.y() << ',' << w.torque_N_m.z() << ','
-                    << sys_->wallContactCount() << '\n';
+            series_->rows() << in.end_s << ',' << w.body << ',' << surface_ - lowestPoint(b) << ','
+                            << w.force_N.x() << ',' << w.force_N.y() << ',' << w.force_N.z() << ','
+                            << w.torque_N_m.x() << ',' << w.torque_N_m.y() << ','
+                            << w.torque_N_m.z() << ',' << sys_->wallContactCount() << '\n';
         }
+        series_->write();
         // Particle and wheel snapshots for ParaView (soil.output.snapshot_interval_s), at the
         // first window end past each multiple of the interval.
         const double interval_s = scenario_.output.snapshot_interval_s;
@@ -115,7 +116,6 @@ public:
         for (int k = 0; k < vtk_.count(); ++k)
             extras["snapshot" + std::to_string(k) + "_s"] = vtk_.times()[std::size_t(k)];
         dem::writeCheckpoint(*sys_, directory + "/soil.bin", extras);
-        series_.flush();
     }
 
     void readCheckpoint(const std::string &directory) override {
@@ -127,8 +127,6 @@ public:
         vtk_.resumeAt(int(times.size()), times);
         first_step_ = sys_->stepCount();
     }
-
-    void finish() override { series_.flush(); }
 
 private:
     std::size_t bodyCount() const { return options_.bodies.size(); }
@@ -149,7 +147,7 @@ private:
     bool resumed_ = false;
     double end_s_ = 0.0; ///< [s] the run's end, for the progress line
     dem::VtkWriter vtk_;
-    std::ofstream series_;
+    std::optional<Series> series_;
     dem::Progress progress_;
     std::uint64_t first_step_ = 0;
 };

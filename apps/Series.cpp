@@ -1,0 +1,104 @@
+#include "Series.hpp"
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <fcntl.h>
+#include <fstream>
+#include <stdexcept>
+#include <unistd.h>
+
+namespace grainlink::apps {
+
+namespace {
+
+std::runtime_error systemError(const std::string &what, const std::string &path) {
+    return std::runtime_error(what + " " + path + ": " + std::strerror(errno));
+}
+
+/// Writes all of `text` to `fd` (a write may take only part of it).
+void writeAll(int fd, const std::string &text, const std::string &path) {
+    std::size_t done = 0;
+    while (done < text.size()) {
+        const ssize_t n = ::write(fd, text.data() + done, text.size() - done);
+        if (n < 0 && errno == EINTR)
+            continue;
+        if (n < 0)
+            throw systemError("cannot write", path);
+        done += std::size_t(n);
+    }
+}
+
+std::size_t cells(const std::string &line) {
+    std::size_t n = 1;
+    for (const char c : line)
+        n += c == ',';
+    return n;
+}
+
+/// The header and the whole rows of the series at `path` up to `restart_s`, as a file's text.
+std::string keptPrefix(const std::string &path, const std::string &header, double restart_s) {
+    std::string kept = header + '\n';
+    std::ifstream in(path);
+    std::string line;
+    if (!std::getline(in, line))
+        return kept; // no series yet, or an empty one: nothing to keep
+    if (line != header)
+        throw std::runtime_error(path + ": its columns differ from this run's (" +
+                                 line.substr(0, 60) + "...): cannot resume");
+    const std::size_t columns = cells(header);
+    while (std::getline(in, line)) {
+        if (in.eof())
+            break; // no line end: a row cut by the crash
+        const std::string first = line.substr(0, line.find(','));
+        char *end = nullptr;
+        const double time_s = std::strtod(first.c_str(), &end);
+        const bool whole =
+            !first.empty() && *end == '\0' && std::isfinite(time_s) && cells(line) == columns;
+        if (whole && time_s <= restart_s + 1e-12)
+            kept += line + '\n';
+    }
+    return kept;
+}
+
+} // namespace
+
+Series::Series(std::string path, const std::string &header, std::optional<double> restart_s)
+    : path_(std::move(path)) {
+    const std::string prefix = restart_s ? keptPrefix(path_, header, *restart_s) : header + '\n';
+    const std::string partial = path_ + ".partial";
+    const int fd = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0)
+        throw systemError("cannot create", partial);
+    try {
+        writeAll(fd, prefix, partial);
+        if (::fsync(fd) != 0)
+            throw systemError("cannot sync", partial);
+    } catch (...) {
+        ::close(fd);
+        throw;
+    }
+    ::close(fd);
+    if (std::rename(partial.c_str(), path_.c_str()) != 0)
+        throw systemError("cannot rename " + partial + " to", path_);
+    fd_ = ::open(path_.c_str(), O_WRONLY | O_APPEND | O_CLOEXEC);
+    if (fd_ < 0)
+        throw systemError("cannot open", path_);
+    rows_.precision(10);
+}
+
+Series::~Series() {
+    if (fd_ >= 0)
+        ::close(fd_);
+}
+
+void Series::write() {
+    const std::string text = rows_.str();
+    if (text.empty())
+        return;
+    writeAll(fd_, text, path_);
+    rows_.str(std::string());
+}
+
+} // namespace grainlink::apps
