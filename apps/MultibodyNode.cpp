@@ -26,6 +26,10 @@ struct Report {
     /// Writes the window's row and says whether the experiment is complete.
     std::function<bool(std::ostream &, const std::vector<mbs::Wrench> &)> after_window;
     std::function<void()> finish;
+    /// The procedure's own state in a checkpoint directory, beside the model's; none for a
+    /// model run to its end time.
+    std::function<void(const std::string &directory)> write_checkpoint = [](const auto &) {};
+    std::function<void(const std::string &directory)> read_checkpoint = [](const auto &) {};
 };
 
 /// The seed's single-wheel procedure (mbs/WheelTest): rig.csv, the steady-state report, and the
@@ -52,6 +56,14 @@ Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
                << ',' << w.force_N.z() << ',' << w.torque_N_m.y() << ','
                << o.at("carriage_x_m") - x0 << '\n';
         return done;
+    };
+    // The procedure's phase, drive start and samples: without them a run resumed while
+    // driving would drop the wheel again and judge its steady state from the resume on.
+    r.write_checkpoint = [test](const std::string &directory) {
+        test->writeCheckpoint(directory + "/wheel_test.txt");
+    };
+    r.read_checkpoint = [test](const std::string &directory) {
+        test->readCheckpoint(directory + "/wheel_test.txt");
     };
     r.finish = [test, options] {
         const std::string summary = test->summary();
@@ -134,9 +146,11 @@ public:
 
     void writeCheckpoint(const std::string &directory) override {
         model_.writeCheckpoint(directory + "/" + report_.checkpoint_file);
+        report_.write_checkpoint(directory);
     }
     void readCheckpoint(const std::string &directory) override {
         model_.readCheckpoint(directory + "/" + report_.checkpoint_file);
+        report_.read_checkpoint(directory);
     }
 
     void finish() override { report_.finish(); }
