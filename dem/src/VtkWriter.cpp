@@ -21,6 +21,16 @@ void openOrThrow(std::ofstream &out, const std::string &path) {
     out.precision(9);
 }
 
+/// Completes a snapshot written to `path`.partial: renamed over `path` in one step, so a crash
+/// while writing leaves the previous file (or none), never a cut one.
+void commit(std::ofstream &out, const std::string &path) {
+    out.close();
+    if (!out)
+        throw std::runtime_error("failed writing snapshot '" + path + "'");
+    if (std::rename((path + ".partial").c_str(), path.c_str()) != 0)
+        throw std::runtime_error("cannot rename '" + path + ".partial' to '" + path + "'");
+}
+
 template <class Get>
 void vectorArray(std::ofstream &out, const char *name, std::size_t n, Get get) {
     out << "<DataArray type=\"Float64\" Name=\"" << name
@@ -34,7 +44,7 @@ void vectorArray(std::ofstream &out, const char *name, std::size_t n, Get get) {
 
 void writeMesh(const MeshBody &body, const std::string &path) {
     std::ofstream out;
-    openOrThrow(out, path);
+    openOrThrow(out, path + ".partial");
     const auto &v = body.worldVertices();
     const auto &t = body.mesh().triangles;
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
@@ -59,6 +69,7 @@ void writeMesh(const MeshBody &body, const std::string &path) {
         out << "</CellData>\n";
     }
     out << "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+    commit(out, path);
 }
 
 } // namespace
@@ -67,7 +78,7 @@ VtkWriter::VtkWriter(std::string directory) : directory_(std::move(directory)) {
 
 void VtkWriter::writeParticles(const ParticleStore &p, const std::string &path) {
     std::ofstream out;
-    openOrThrow(out, path);
+    openOrThrow(out, path + ".partial");
     const std::size_t n = p.size();
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
         << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"0\">\n"
@@ -90,8 +101,7 @@ void VtkWriter::writeParticles(const ParticleStore &p, const std::string &path) 
         << "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\"></DataArray>\n"
         << "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\"></DataArray>\n"
         << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-    if (!out)
-        throw std::runtime_error("failed writing snapshot '" + path + "'");
+    commit(out, path);
 }
 
 void VtkWriter::write(const DemSystem &system, double time_s) {
@@ -125,8 +135,7 @@ void VtkWriter::writeCollection(const std::string &name, const std::string &pref
         out << "<DataSet timestep=\"" << times_[k] << "\" file=\"" << numbered(prefix, int(k))
             << "\"/>\n";
     out << "</Collection>\n</VTKFile>\n";
-    out.close();
-    std::rename((path + ".partial").c_str(), path.c_str());
+    commit(out, path);
 }
 
 } // namespace grainlink::dem

@@ -1,5 +1,7 @@
 #pragma once
 // Particle and mesh snapshots as VTK XML unstructured grids, collected in a ParaView .pvd file.
+// Every file is written to `<name>.partial` and renamed over `<name>` when complete: a crash
+// while writing never leaves a cut snapshot or collection.
 #include "grainlink/dem/DemSystem.hpp"
 
 #include <string>
