@@ -507,6 +507,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         for (const CandidateResult &R : D.candidates)
             if (&R != winner && R.explains)
                 D.indistinguishable.push_back(R.name);
+        D.best_model = winner->name;
+        D.best_model_mean = winner->confirmed_mean;
     } else {
         const PairResult *pair = nullptr;
         for (const PairResult &P : D.pairs)
@@ -518,6 +520,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                   << fmt(pair->fit.a.strength) << ", " << pair->b << " " << fmt(pair->fit.b.strength)
                   << "; held-out gap " << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
                   << fmt(100.0 * pair->held_out.gap, 2) << " % (p = " << fmt(pair->p_value, 2) << ")";
+            D.best_model = pair->a + " + " + pair->b;
+            D.best_model_mean = pair->confirmed_mean;
         } else {
             D.outcome = Diagnosis::Outcome::Unexplained;
             if (D.held_out.empty())
@@ -531,6 +535,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             for (const CandidateResult &R : D.candidates)
                 if (R.confirmed && (!best || R.held_out.gap < best->held_out.gap))
                     best = &R;
+            if (best) {
+                D.best_model = best->name;
+                D.best_model_mean = best->confirmed_mean;
+            }
             if (best)
                 claim << "; closest: " << best->name << " at " << strengthText(best->effect, best->fit.strength)
                       << " (held-out gap " << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
@@ -540,19 +548,13 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         }
     }
     D.claim = claim.str() + notCompared();
+    if (D.outcome == Diagnosis::Outcome::Explained ||
+        D.outcome == Diagnosis::Outcome::ExplainedByPair)
+        D.explained_by = D.best_model;
 
     // What remains after the chosen (or closest) model, in words.
     {
-        const Eigen::VectorXd *mean = nullptr;
-        if (winner)
-            mean = &winner->confirmed_mean;
-        for (const PairResult &P : D.pairs)
-            if (!mean && P.explains)
-                mean = &P.confirmed_mean;
-        if (!mean)
-            for (const CandidateResult &R : D.candidates)
-                if (!mean && R.confirmed)
-                    mean = &R.confirmed_mean;
+        const Eigen::VectorXd *mean = D.best_model.empty() ? nullptr : &D.best_model_mean;
         if (mean) {
             ValidationResult after = V;
             after.simulated = *mean;

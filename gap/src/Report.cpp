@@ -69,6 +69,8 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     j["measurements"] = set.name;
     j["outcome"] = outcomeName(d.outcome);
     j["claim"] = d.claim;
+    j["explained_by"] = d.explained_by;
+    j["best_model"] = d.best_model;
     j["where"] = Json::array();
     for (const RegimeFinding &f : d.findings)
         j["where"].push_back({{"kind", f.kind},
@@ -190,18 +192,9 @@ std::vector<std::string> writeDiagnosis(const Diagnosis &d, const ExperimentSet 
     writeAtomically(dir / "diagnosis.json", toJson(d, set).dump(2) + "\n");
     files.push_back("diagnosis.json");
 
-    // The best model's prediction, for the plots: the winner, the explaining pair, the closest.
-    const Eigen::VectorXd *best = nullptr;
-    std::string best_name;
-    for (const CandidateResult &c : d.candidates)
-        if (c.explains && !best)
-            best = &c.confirmed_mean, best_name = c.name;
-    for (const PairResult &p : d.pairs)
-        if (p.explains && !best)
-            best = &p.confirmed_mean, best_name = p.a + "+" + p.b;
-    for (const CandidateResult &c : d.candidates)
-        if (c.confirmed && !best)
-            best = &c.confirmed_mean, best_name = c.name;
+    // The best model's prediction, for the plots: the one the claim names.
+    const Eigen::VectorXd *best = d.best_model.empty() ? nullptr : &d.best_model_mean;
+    const std::string &best_name = d.best_model;
     std::ostringstream csv;
     csv.precision(10);
     csv << "experiment,observable,kind,x_lo,x_hi,held_out,measured,u_D,simulated,u_seed,u_bed,"

@@ -62,15 +62,8 @@ std::string outcomeWord(const Diagnosis &d) {
     case Diagnosis::Outcome::Unexplained:
         return "unexplained";
     case Diagnosis::Outcome::Explained:
-        for (const auto &c : d.candidates)
-            if (c.explains)
-                return c.name;
-        break;
     case Diagnosis::Outcome::ExplainedByPair:
-        for (const auto &p : d.pairs)
-            if (p.explains)
-                return p.a + " + " + p.b;
-        break;
+        return d.explained_by; // the model the claim names, not the first that explains
     }
     return "?";
 }

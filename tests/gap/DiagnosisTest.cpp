@@ -184,6 +184,11 @@ TEST_CASE("diagnosis on an analytic soil names the hidden effect and its strengt
                 winner = &c;
         REQUIRE(winner);
         CHECK(winner->name == t.effect);
+        // The named model is the best held-out density among those that explain, not the first
+        // by calibration chi^2 (the self-test scored the first, and the report plotted it).
+        CHECK(d.explained_by == winner->name);
+        CHECK(d.best_model == winner->name);
+        CHECK(d.best_model_mean.size() == winner->confirmed_mean.size());
         CHECK(winner->fit.strength == Approx(t.strength).epsilon(0.25));
         CHECK(winner->held_out.gap < 0.3 * d.held_out_base.gap);
     }

@@ -121,6 +121,11 @@ struct Diagnosis {
     std::string separating_experiment;         ///< the probe that would separate them best
     enum class Outcome { NoGap, Explained, ExplainedByPair, Unexplained };
     Outcome outcome = Outcome::NoGap;
+    /// The model the claim names: the winning effect, the explaining pair ("a + b"), or the
+    /// closest confirmed candidate when unexplained (empty when nothing was confirmed).
+    std::string best_model;
+    Eigen::VectorXd best_model_mean; ///< its confirming runs' features (empty with no model)
+    std::string explained_by; ///< best_model when the outcome is an explanation, else empty
     std::string claim;        ///< one sentence: the result (and what was not compared)
     std::string unexplained;  ///< what remains (features still flagged after the best model)
     int simulations = 0;      ///< variant x seed runs requested
