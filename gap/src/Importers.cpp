@@ -158,15 +158,23 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
             for (const fs::path &f : files) {
                 const fs::path json = fs::path(f).replace_extension(".json");
                 if (fs::exists(json)) {
-                    std::ifstream in(json);
-                    const nlohmann::json j = nlohmann::json::parse(in);
-                    const auto &p = j["processing"];
-                    for (auto it = p.begin(); it != p.end(); ++it)
-                        if (it.key().rfind("descent_speed_in_window_mm_per_s", 0) == 0 &&
-                            it->is_array() && it->size() == 3) {
-                            speed += (*it)[1].get<double>() / 1000.0;
-                            ++speeds;
-                        }
+                    // The trial's metadata: its descent speed, if it gives one.
+                    try {
+                        std::ifstream in(json);
+                        const nlohmann::json j = nlohmann::json::parse(in);
+                        if (j.is_object() && j.contains("processing") &&
+                            j["processing"].is_object())
+                            for (const auto &[key, value] : j["processing"].items())
+                                if (key.rfind("descent_speed_in_window_mm_per_s", 0) == 0 &&
+                                    value.is_array() && value.size() == 3 &&
+                                    value[1].is_number()) {
+                                    speed += value[1].get<double>() / 1000.0;
+                                    ++speeds;
+                                }
+                    } catch (const nlohmann::json::exception &e) {
+                        throw std::runtime_error(json.string() + ": not readable JSON (" +
+                                                 e.what() + ")");
+                    }
                 }
                 const std::string copy = "data/" + f.filename().string();
                 writeColumns(readCsv(f), {zcol, "pressure_synced_kPa", "force_N"}, f, dst / copy,
