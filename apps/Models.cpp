@@ -6,6 +6,7 @@
 #include "grainlink/mbs/UrdfModel.hpp"
 
 #include <filesystem>
+#include <memory>
 
 namespace grainlink::apps {
 
@@ -21,10 +22,22 @@ std::string besideScenario(const std::string &path, const std::string &scenario_
 
 std::unique_ptr<mbs::MultibodyModel> makeModel(const config::ConfigNode &root,
                                                const std::string &scenario_path) {
+    // A model checks the relations between its keys when it is built ("need 0 <
+    // cocking_duration_s < stroke_period_s"): its section's file and line go with the message.
+    const auto built = [](const config::ConfigNode &section, auto make) {
+        try {
+            return std::unique_ptr<mbs::MultibodyModel>(make()); // built, or refused whole
+        } catch (const mbs::ModelError &e) {
+            section.fail(e.what());
+        }
+    };
     if (root.has("rover"))
-        return std::make_unique<mbs::RockerBogie>(mbs::parseRockerBogie(root["rover"]));
+        return built(root["rover"], [&] {
+            return std::make_unique<mbs::RockerBogie>(mbs::parseRockerBogie(root["rover"]));
+        });
     if (root.has("mole"))
-        return std::make_unique<mbs::Mole>(mbs::parseMole(root["mole"]));
+        return built(root["mole"],
+                     [&] { return std::make_unique<mbs::Mole>(mbs::parseMole(root["mole"])); });
     if (root.has("model"))
         return std::make_unique<mbs::UrdfModel>(
             mbs::parseUrdfModel(besideScenario(root["model"].text(), scenario_path)));

@@ -69,10 +69,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
         restored = true;
     });
     if (restored) {
-        // An accepted state must step, or stop with the step and the grain that went wrong.
+        // An accepted state must step, or stop with the step and the grain that went wrong, or
+        // refuse the step it would need (std::invalid_argument, naming time_step_s).
         try {
             sys->run(2);
         } catch (const SimulationError &) {
+        } catch (const std::invalid_argument &e) {
+            if (std::string_view(e.what()).find("time_step_s") == std::string_view::npos)
+                fz::finding(std::string("a restored state refused without naming the step: ") +
+                            e.what());
         }
     }
     return 0;

@@ -87,7 +87,7 @@ ConfigNode ConfigNode::operator[](const std::string &key) const {
     if (!child || child.IsNull()) {
         // A key with the same stem but another unit suffix is a wrong unit, not a missing key.
         for (const auto &entry : node_) {
-            const std::string other = entry.first.as<std::string>();
+            const std::string other = keyText(entry.first);
             if (other != key && stem(other) == stem(key)) {
                 std::ostringstream out;
                 out << *file_ << ":" << entry.first.Mark().line + 1 << ": unknown key '"
@@ -103,12 +103,24 @@ ConfigNode ConfigNode::operator[](const std::string &key) const {
     return ConfigNode(child, file_, child_path);
 }
 
+std::string ConfigNode::keyText(const YAML::Node &key) const {
+    // YAML allows a list or a mapping as a key ({[1, 2]: x}); no grainlink key is one.
+    if (!key.IsScalar()) {
+        std::ostringstream out;
+        out << *file_ << ":" << key.Mark().line + 1 << ": a key of '"
+            << (path_.empty() ? std::string("the file") : path_)
+            << "' is a list or a mapping; keys are plain words";
+        throw ConfigError(out.str());
+    }
+    return key.Scalar();
+}
+
 std::vector<std::string> ConfigNode::keys() const {
     if (!node_.IsMap())
         fail("expected a mapping");
     std::vector<std::string> out;
     for (const auto &entry : node_)
-        out.push_back(entry.first.as<std::string>());
+        out.push_back(keyText(entry.first));
     return out;
 }
 
@@ -271,7 +283,7 @@ void ConfigNode::finish() const {
     if (!node_.IsMap())
         return;
     for (const auto &entry : node_) {
-        const std::string key = entry.first.as<std::string>();
+        const std::string key = keyText(entry.first);
         if (used_->count(key))
             continue;
         std::string hint;

@@ -1,5 +1,7 @@
 #include "grainlink/dem/Checkpoint.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -71,7 +73,13 @@ private:
 
 class Reader {
 public:
-    Reader(std::ifstream &in, std::string path) : in_(in), path_(std::move(path)) {}
+    /// Reads from where `in` stands (after the magic).
+    Reader(std::ifstream &in, std::string path) : in_(in), path_(std::move(path)) {
+        const std::streampos here = in_.tellg();
+        in_.seekg(0, std::ios::end);
+        size_ = std::uint64_t(std::max<std::streamoff>(0, in_.tellg()));
+        in_.seekg(here);
+    }
     template <class T> T pod() {
         T value;
         in_.read(reinterpret_cast<char *>(&value), sizeof(T));
@@ -81,8 +89,12 @@ public:
     }
     template <class T> void vec(std::vector<T> &values) {
         const auto n = pod<std::uint64_t>();
-        if (n > (std::uint64_t(1) << 40))
-            throw std::runtime_error("checkpoint '" + path_ + "' is corrupt");
+        // Every item takes at least a byte: a count beyond the bytes left is a damaged file,
+        // refused before it allocates (a flipped bit asked for 2^43 bytes).
+        const auto at = std::uint64_t(std::max<std::streamoff>(0, in_.tellg()));
+        if (n > size_ - std::min(size_, at))
+            throw std::runtime_error("checkpoint '" + path_ + "' is corrupt (a count of " +
+                                     std::to_string(n) + " beyond the file's end)");
         values.resize(n);
         for (T &v : values)
             item(v);
@@ -133,6 +145,7 @@ public:
 private:
     std::ifstream &in_;
     std::string path_;
+    std::uint64_t size_ = 0; ///< [bytes] of the file
 };
 
 } // namespace
@@ -224,8 +237,25 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
     for (std::size_t i = 0; i < p.mass.size(); ++i)
         p.inv_mass[i] = 1.0 / p.mass[i];
     const std::size_t n = p.id.size();
-    if (p.position.size() != n || p.radius.size() != n || p.material.size() != n)
-        throw std::runtime_error("checkpoint '" + path + "' has inconsistent particle arrays");
+    for (std::size_t size : {p.position.size(), p.velocity.size(), p.angular_velocity.size(),
+                             p.orientation.size(), p.force.size(), p.torque.size(),
+                             p.radius.size(), p.mass.size(), p.inertia.size(), p.material.size()})
+        if (size != n)
+            throw std::runtime_error("checkpoint '" + path + "' has inconsistent particle arrays");
+    // A damaged state would reach the neighbour grid and the stability estimate as NaN or a
+    // radius of 1e-300: refused here, naming the grain.
+    for (std::size_t i = 0; i < n; ++i) {
+        const bool sound = p.position[i].allFinite() && p.velocity[i].allFinite() &&
+                           p.angular_velocity[i].allFinite() &&
+                           std::abs(p.orientation[i].norm() - 1.0) < 1e-3 &&
+                           std::isfinite(p.radius[i]) && p.radius[i] > 1e-9 &&
+                           std::isfinite(p.mass[i]) && p.mass[i] > 0.0 &&
+                           p.inertia[i].allFinite() && (p.inertia[i].array() > 0.0).all();
+        if (!sound)
+            throw std::runtime_error("checkpoint '" + path + "' is corrupt: grain " +
+                                     std::to_string(p.id[i]) + " has a non-finite or impossible "
+                                     "position, velocity, orientation, radius, mass or inertia");
+    }
     s.step = r.pod<std::uint64_t>();
     r.vec(s.contacts);
     r.vec(s.plane_history);

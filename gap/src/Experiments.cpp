@@ -405,7 +405,8 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     }
                 }
                 if (!e.scatter) {
-                    if (whole.curves.begin()->second.empty())
+                    // No row passed the filter: no curve was started at all.
+                    if (whole.curves.empty() || whole.curves.begin()->second.empty())
                         f.fail("no rows of " + path.string() + " pass the filter");
                     e.trials.push_back(std::move(whole));
                 }

@@ -6,6 +6,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -19,10 +20,24 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The CSV's header and rows (comment lines dropped).
+/// The CSV's header and rows (comment lines dropped), each row with as many cells as the header.
 struct Csv {
+    fs::path path;
     std::vector<std::string> header;
     std::vector<std::vector<std::string>> rows;
+    std::vector<int> lines; ///< each row's line in the file, for messages
+
+    /// Row r's cell in column c as a number; an error names the file, line and column.
+    double number(std::size_t r, std::size_t c) const {
+        const std::string &cell = rows[r][c];
+        char *end = nullptr;
+        const double v = std::strtod(cell.c_str(), &end);
+        if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v))
+            throw std::runtime_error(path.string() + ":" + std::to_string(lines[r]) +
+                                     ": column '" + header[c] + "': '" + cell +
+                                     "' is not a finite number");
+        return v;
+    }
 };
 
 std::vector<std::string> split(const std::string &line) {
@@ -39,16 +54,23 @@ Csv readCsv(const fs::path &path) {
     if (!in)
         throw std::runtime_error(path.string() + ": cannot read");
     Csv c;
+    c.path = path;
     std::string line;
-    while (std::getline(in, line)) {
+    for (int number = 1; std::getline(in, line); ++number) {
         if (!line.empty() && line.back() == '\r')
             line.pop_back();
         if (line.empty() || line[0] == '#')
             continue;
-        if (c.header.empty())
+        if (c.header.empty()) {
             c.header = split(line);
-        else
-            c.rows.push_back(split(line));
+            continue;
+        }
+        c.rows.push_back(split(line));
+        c.lines.push_back(number);
+        if (c.rows.back().size() != c.header.size())
+            throw std::runtime_error(path.string() + ":" + std::to_string(number) + ": " +
+                                     std::to_string(c.rows.back().size()) + " cells, the header has " +
+                                     std::to_string(c.header.size()));
     }
     if (c.header.empty())
         throw std::runtime_error(path.string() + ": no header line");
@@ -221,9 +243,12 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
                 continue;
             const Csv c = readCsv(f);
             const std::size_t beta_col = column(c, "beta_deg", f);
+            const auto beta_of = [&](std::size_t r) {
+                return int(std::lround(c.number(r, beta_col)));
+            };
             std::vector<int> betas;
-            for (const auto &row : c.rows)
-                betas.push_back(std::stoi(row[beta_col]));
+            for (std::size_t r = 0; r < c.rows.size(); ++r)
+                betas.push_back(beta_of(r));
             std::sort(betas.begin(), betas.end());
             betas.erase(std::unique(betas.begin(), betas.end()), betas.end());
             const std::string copy = "data/wheel_" + wheel + ".csv";
@@ -239,9 +264,9 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
                 // lab's wheel test holds it with a servo).
                 double load = 0.0;
                 int runs = 0;
-                for (const auto &row : c.rows)
-                    if (std::stoi(row[beta_col]) == beta) {
-                        load += std::stod(row[load_col]);
+                for (std::size_t r = 0; r < c.rows.size(); ++r)
+                    if (beta_of(r) == beta) {
+                        load += c.number(r, load_col);
                         ++runs;
                     }
                 YAML::Node e;

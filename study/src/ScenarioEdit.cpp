@@ -30,7 +30,8 @@ bool isIndex(const std::string &step) {
 std::string keysOf(const YAML::Node &map) {
     std::string list;
     for (const auto &entry : map)
-        list += (list.empty() ? "" : ", ") + entry.first.as<std::string>();
+        if (entry.first.IsScalar()) // the strict reader refuses other keys, naming the line
+            list += (list.empty() ? "" : ", ") + entry.first.Scalar();
     return list;
 }
 
@@ -103,7 +104,7 @@ void absolutizeFilePaths(YAML::Node &root, const std::string &folder) {
     if (!root.IsMap())
         return;
     for (auto entry : root) {
-        const std::string key = entry.first.as<std::string>();
+        const std::string key = entry.first.IsScalar() ? entry.first.Scalar() : std::string();
         YAML::Node value = entry.second;
         if (value.IsScalar() && (key == "file" || key == "model" || key == "keys")) {
             const std::filesystem::path path = value.Scalar();

@@ -37,6 +37,18 @@ TEST_CASE("a key given twice is refused with both lines, whichever way it is rea
     CHECK(load(text)["b"].number() == 2.0);
 }
 
+TEST_CASE("a list or a mapping as a key is refused with its line, not a bare yaml-cpp error",
+          "[config]") {
+    // YAML allows {[1, 2]: x}; the fuzzer found it escaping as "yaml-cpp: bad conversion".
+    const std::string text = "contact:\n  tangential: {model: linear, [0.06, 0.3]}\n";
+    const ConfigNode tangential = load(text)["contact"]["tangential"];
+    const auto refused = Contains("s.yaml:2: a key of 'contact.tangential' is a list or a mapping");
+    CHECK_THROWS_WITH(tangential.keys(), refused);
+    CHECK_THROWS_WITH(tangential["stiffness_N_m"], refused); // missing: the unit hint scans keys
+    (void)tangential["model"].text();
+    CHECK_THROWS_WITH(tangential.finish(), refused);
+}
+
 TEST_CASE("range rules refuse out-of-range values naming the key, line and range",
           "[config]") {
     const ConfigNode n = load("zero: 0\nneg: -0.5\nfrac: 1.5\ncount: -5\nhuge: 1e9\nhalf: 2.5\n"

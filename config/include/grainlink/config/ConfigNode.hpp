@@ -72,6 +72,8 @@ public:
 private:
     /// Throws when `key` appears twice in this mapping, naming both lines.
     void refuseDuplicate(const std::string &key) const;
+    /// A mapping key's text; throws with the file and line unless it is a scalar.
+    std::string keyText(const YAML::Node &key) const;
     ConfigNode(YAML::Node node, std::shared_ptr<const std::string> file, std::string path);
     YAML::Node node_;
     std::shared_ptr<const std::string> file_;
