@@ -205,6 +205,28 @@ void writeCheckpoint(const DemSystem &system, const std::string &path,
 
 namespace {
 
+// Every number a checkpoint holds must be finite: a NaN body position or skin reached the
+// neighbour grid's cell index (undefined behaviour) before it reached any check.
+bool finite(const Vec3 &v) { return v.allFinite(); }
+bool finite(const ContactHistory &h) { return finite(h.tangential_m) && finite(h.rolling_N_m); }
+bool finite(const MeshContactSlot &m) { return finite(m.normal) && finite(m.history); }
+bool finite(const NeighbourList::StoredContact &c) { return finite(c.history); }
+bool finite(const RigidBodyState &b) {
+    return finite(b.position_m) && finite(b.linear_velocity_m_s) &&
+           finite(b.angular_velocity_rad_s) && b.orientation.coeffs().allFinite() &&
+           std::abs(b.orientation.norm() - 1.0) < 1e-3;
+}
+bool finite(const BodyLoads &l) {
+    return finite(l.force_N) && finite(l.torque_N_m) && finite(l.impulse_N_s) &&
+           finite(l.angular_impulse_N_m_s) && std::isfinite(l.accumulated_time_s);
+}
+template <class T> void requireFinite(const std::vector<T> &items, const char *what,
+                                      const std::string &path) {
+    for (const T &item : items)
+        if (!finite(item))
+            throw std::runtime_error("checkpoint '" + path + "' is corrupt: a non-finite " + what);
+}
+
 CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Internals &s) {
     std::ifstream in(path, std::ios::binary);
     if (!in)
@@ -289,6 +311,21 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
         if (c.i >= n || c.j >= n)
             throw std::runtime_error("checkpoint '" + path +
                                      "' has a contact beyond the particles");
+    requireFinite(s.contacts, "contact history", path);
+    requireFinite(s.plane_history, "wall contact history", path);
+    requireFinite(s.mesh_slots, "mesh contact", path);
+    requireFinite(s.reference_position, "neighbour reference position", path);
+    requireFinite(s.mesh_reference_position, "mesh reference position", path);
+    requireFinite(s.body_states, "body state (or a non-unit orientation)", path);
+    requireFinite(s.body_reference, "body reference state", path);
+    requireFinite(s.body_loads, "body load", path);
+    requireFinite(s.plane_force, "wall force", path);
+    // The clock offset, the neighbour skin and the deepest overlap seen so far.
+    for (double x : {s.time_offset_s, s.skin_m, s.max_overlap_ratio})
+        if (!std::isfinite(x) || x < 0.0)
+            throw std::runtime_error("checkpoint '" + path +
+                                     "' is corrupt: a clock, skin or overlap of " +
+                                     std::to_string(x));
     return extras;
 }
 

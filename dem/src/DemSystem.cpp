@@ -614,6 +614,13 @@ void DemSystem::restoreInternals(const Internals &s) {
     if (s.plane_history.size() != particles_.size() * planes_.size())
         throw std::runtime_error("checkpoint has plane histories for another number of planes (" +
                                  std::to_string(planes_.size()) + " in the scenario)");
+    for (const MeshContactSlot &slot : s.mesh_slots)
+        if (slot.body >= 0 && (slot.body >= meshes_.size() || slot.triangle < 0 ||
+                               std::size_t(slot.triangle) >=
+                                   meshes_.body(slot.body).mesh().triangles.size()))
+            throw std::runtime_error("checkpoint has a mesh contact on body " +
+                                     std::to_string(slot.body) + ", triangle " +
+                                     std::to_string(slot.triangle) + ", which the scenario lacks");
     step_ = s.step;
     step_offset_ = s.step_offset;
     time_offset_s_ = s.time_offset_s;
