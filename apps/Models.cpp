@@ -26,7 +26,7 @@ std::unique_ptr<mbs::MultibodyModel> makeModel(const config::ConfigNode &root,
     // cocking_duration_s < stroke_period_s"): its section's file and line go with the message.
     const auto built = [](const config::ConfigNode &section, auto make) {
         try {
-            return std::unique_ptr<mbs::MultibodyModel>(make()); // built, or refused whole
+            return std::unique_ptr<mbs::MultibodyModel>(make());
         } catch (const mbs::ModelError &e) {
             section.fail(e.what());
         }

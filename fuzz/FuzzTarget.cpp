@@ -35,6 +35,11 @@ std::string writeFile(const std::string &folder, const std::string &name, std::s
     return path.string();
 }
 
+std::string inputFile(const std::uint8_t *data, std::size_t size, const std::string &name) {
+    return writeFile(freshFolder(), name,
+                     std::string_view(reinterpret_cast<const char *>(data), size));
+}
+
 std::vector<std::string_view> splitParts(const std::uint8_t *data, std::size_t size,
                                          std::size_t n) {
     constexpr std::string_view cut = "\n%%%%\n";

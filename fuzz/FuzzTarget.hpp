@@ -18,6 +18,9 @@ std::string freshFolder();
 /// Writes `bytes` to `folder/name` (creating the folders in `name`) and returns the path.
 std::string writeFile(const std::string &folder, const std::string &name, std::string_view bytes);
 
+/// The whole input as the file `name` in a fresh folder; returns its path.
+std::string inputFile(const std::uint8_t *data, std::size_t size, const std::string &name);
+
 /// The input cut at each line "%%%%" into `n` parts (missing ones empty, extra ones joined to the
 /// last), so that one input carries the files a reader needs together, e.g. experiments.yaml
 /// and its data file; the seeds in fuzz/corpus/ are written that way.

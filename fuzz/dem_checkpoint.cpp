@@ -58,9 +58,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
         writeCheckpoint(*sys, seed, {{"phase", 2.0}});
         std::exit(0);
     }
-    const std::string path =
-        fz::writeFile(fz::freshFolder(), "state.bin",
-                      std::string_view(reinterpret_cast<const char *>(data), size));
+    const std::string path = fz::inputFile(data, size, "state.bin");
     auto sys = busySystem();
     bool restored = false;
     fz::expectClearError(path, [&] {

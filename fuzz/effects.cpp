@@ -7,9 +7,7 @@ namespace fz = grainlink::fuzz;
 using namespace grainlink;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-    const std::string path =
-        fz::writeFile(fz::freshFolder(), "effects.yaml",
-                      std::string_view(reinterpret_cast<const char *>(data), size));
+    const std::string path = fz::inputFile(data, size, "effects.yaml");
     fz::expectClearError(path, [&] { gap::loadEffects(path); });
     return 0;
 }

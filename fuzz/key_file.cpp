@@ -9,9 +9,7 @@ namespace fz = grainlink::fuzz;
 using namespace grainlink;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-    const std::string path =
-        fz::writeFile(fz::freshFolder(), "soil.key",
-                      std::string_view(reinterpret_cast<const char *>(data), size));
+    const std::string path = fz::inputFile(data, size, "soil.key");
     ::chmod(path.c_str(), 0600); // a secret key's mode: the reader refuses others
     fz::expectClearError(path, [&] { coupling::readKeyFile(path); });
     return 0;

@@ -36,9 +36,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size
         }
         std::exit(0);
     }
-    const std::string path =
-        fz::writeFile(fz::freshFolder(), "model.txt",
-                      std::string_view(reinterpret_cast<const char *>(data), size));
+    const std::string path = fz::inputFile(data, size, "model.txt");
     for (auto &model : models())
         fz::expectClearError(path, [&] { model->readCheckpoint(path); });
     return 0;

@@ -13,9 +13,7 @@ namespace fz = grainlink::fuzz;
 using namespace grainlink;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-    const std::string path = fz::writeFile(
-        fz::freshFolder(), "scenario.yaml",
-        std::string_view(reinterpret_cast<const char *>(data), size));
+    const std::string path = fz::inputFile(data, size, "scenario.yaml");
     const std::string folder = std::filesystem::path(path).parent_path().string();
     fz::expectClearError(folder, [&] { dem::loadScenario(path); });
     for (const auto &test : lab::labTestNames())

@@ -6,9 +6,7 @@ namespace fz = grainlink::fuzz;
 using namespace grainlink;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
-    const std::string path =
-        fz::writeFile(fz::freshFolder(), "body.stl",
-                      std::string_view(reinterpret_cast<const char *>(data), size));
+    const std::string path = fz::inputFile(data, size, "body.stl");
     fz::expectClearError(path, [&] { dem::readStl(path); });
     return 0;
 }

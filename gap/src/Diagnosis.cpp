@@ -20,8 +20,6 @@ std::string fmt(double v, int digits = 3) {
     return s.str();
 }
 
-/// Column mean and the variance of that mean over a variant's seeds; where one seed gives no
-/// scatter, the base's single-bed scatter stands in.
 /// The mean of `rows` (one per seed) and its variance, from one bed's scatter `sd` (pooled over
 /// the diagnosis' simulations, not these few rows' own: PooledScatter).
 std::pair<Eigen::VectorXd, Eigen::VectorXd> meanAndVariance(const Eigen::MatrixXd &rows,
