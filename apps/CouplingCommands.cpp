@@ -6,11 +6,16 @@
 #include "grainlink/coupling/Coordinator.hpp"
 #include "grainlink/dem/RigidFloor.hpp"
 #include "grainlink/dem/Scenario.hpp"
+#include "grainlink/dem/SteadySignal.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace grainlink::apps {
 
@@ -121,6 +126,56 @@ std::string substitute(std::string text, const std::string &key, const std::stri
     return text;
 }
 
+/// The rig's steady report (rig_summary.json, written by the rig) gets the wheel's sinkage, which
+/// only the soil knows (its settled surface): the soil series' sinkage of the wheel over the span
+/// the rig judged, with the same statistics. Run after the participants ended, so both files
+/// are complete.
+void addSoilSinkage(const config::ConfigNode &root, const std::string &directory) {
+    const auto sections = nodesIn(root).soil_sections;
+    const std::string summary_path = directory + "/rig_summary.json";
+    if (!root.has("rig") || sections.size() != 1 || !std::filesystem::exists(summary_path))
+        return;
+    auto summary = nlohmann::json::parse(std::ifstream(summary_path));
+    if (!summary.contains("span_s"))
+        return; // the drop never ended: no span was judged
+    const double from = summary["span_s"][0], to = summary["span_s"][1];
+    const std::string wheel = mbs::parseSingleWheelRig(root["rig"]).wheel_name;
+    std::ifstream series(directory + "/" + sections[0] + ".csv");
+    std::string line;
+    std::getline(series, line); // time_s,body,sinkage_m,...
+    std::vector<double> sinkage;
+    while (std::getline(series, line)) {
+        std::istringstream cells(line);
+        std::string time, body, value;
+        std::getline(cells, time, ',');
+        std::getline(cells, body, ',');
+        std::getline(cells, value, ',');
+        const double t = std::strtod(time.c_str(), nullptr);
+        if (body == wheel && t >= from - 1e-9 && t <= to + 1e-9)
+            sinkage.push_back(std::strtod(value.c_str(), nullptr));
+    }
+    if (sinkage.empty())
+        return;
+    const auto s = dem::summarizeSignal(sinkage);
+    summary["sinkage_m"] = {{"mean", s.mean}, {"sd", s.sd}, {"standard_error", s.standard_error}};
+    const std::string partial = summary_path + ".partial";
+    std::ofstream(partial) << summary.dump(2) << '\n';
+    std::filesystem::rename(partial, summary_path);
+    std::printf("run: steady sinkage %.2f +- %.2f mm (se %.2f) in %s\n", 1e3 * s.mean,
+                1e3 * s.sd, 1e3 * s.standard_error, summary_path.c_str());
+}
+
+/// A rig that ended unsteady says why as the run's last line (a study shows a failed point's
+/// last line as its error).
+void printRigVerdict(const std::string &directory) {
+    const std::string path = directory + "/rig_summary.json";
+    if (!std::filesystem::exists(path))
+        return;
+    const auto summary = nlohmann::json::parse(std::ifstream(path), nullptr, false);
+    if (summary.is_object() && summary.value("steady", true) == false)
+        std::fprintf(stderr, "run: %s\n", summary.value("message", std::string()).c_str());
+}
+
 } // namespace
 
 void checkParticipantSections(const config::ConfigNode &root, const std::string &path) {
@@ -213,8 +268,13 @@ int runCoupled(const CoupledRunOptions &options) {
         const auto summary = coordinator.run();
         const auto failed = children.stopAll(10.0);
         printSummary(summary, config);
+        addSoilSinkage(config::ConfigNode::loadFile(options.config_path),
+                       config.output_directory);
+        std::fflush(stdout); // the failures below are the log's last lines
         for (const auto &f : failed)
             std::fprintf(stderr, "run: participant %s\n", f.c_str());
+        if (!failed.empty())
+            printRigVerdict(config.output_directory);
         return failed.empty() ? 0 : 1;
     } catch (...) {
         children.stopAll(3.0); // a frozen process will not exit by itself

@@ -25,15 +25,17 @@ struct Report {
     std::string header;
     /// Writes the window's row and says whether the experiment is complete.
     std::function<bool(std::ostream &, const std::vector<mbs::Wrench> &)> after_window;
-    std::function<void()> finish;
+    /// The closing report; returns the node's exit status (non-zero: the experiment failed).
+    std::function<int()> finish;
     /// The procedure's own state in a checkpoint directory, beside the model's; none for a
     /// model run to its end time.
     std::function<void(const std::string &directory)> write_checkpoint = [](const auto &) {};
     std::function<void(const std::string &directory)> read_checkpoint = [](const auto &) {};
 };
 
-/// The seed's single-wheel procedure (mbs/WheelTest): rig.csv, the steady-state report, and the
-/// run ends at steady slip.
+/// The seed's single-wheel procedure (mbs/WheelTest): rig.csv, the steady-state report
+/// (rig_summary.txt and .json), and the run ends at steady slip — or, with a phase past its
+/// maximum, as a failure: the node then exits with status 3, and `grainlink run` with it.
 Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
                        const NodeOptions &options) {
     const auto test_node = root.optional("wheel_test");
@@ -65,10 +67,15 @@ Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
     r.read_checkpoint = [test](const std::string &directory) {
         test->readCheckpoint(directory + "/wheel_test.txt");
     };
-    r.finish = [test, options] {
-        const std::string summary = test->summary();
+    r.finish = [test, &rig, options] {
+        const std::string summary = test->summary(rig.time());
         std::printf("%s\n", summary.c_str());
         std::ofstream(options.output_directory + "/rig_summary.txt") << summary << '\n';
+        test->writeSummaryJson(options.output_directory + "/rig_summary.json", rig.time());
+        if (test->succeeded())
+            return 0;
+        std::fprintf(stderr, "%s\n", summary.c_str());
+        return 3;
     };
     return r;
 }
@@ -104,6 +111,7 @@ Report observablesReport(const mbs::MultibodyModel &model, const NodeOptions &op
         for (const auto &[name, value] : model.observables())
             std::printf(" %s %.6g", name.c_str(), value);
         std::printf("\n");
+        return 0;
     };
     return r;
 }
@@ -153,7 +161,8 @@ public:
         report_.read_checkpoint(directory);
     }
 
-    void finish() override { report_.finish(); }
+    void finish() override { exit_status_ = report_.finish(); }
+    int exitStatus() const { return exit_status_; }
 
 private:
     mbs::MultibodyModel &model_;
@@ -162,6 +171,7 @@ private:
     std::vector<mbs::BodyDescription> bodies_;
     std::vector<mbs::Wrench> soil_; ///< the soil's wrenches of the current window
     std::optional<Series> series_;
+    int exit_status_ = 0;
 };
 
 int runWindows(const config::ConfigNode &root, mbs::MultibodyModel &model, Report report,
@@ -169,7 +179,7 @@ int runWindows(const config::ConfigNode &root, mbs::MultibodyModel &model, Repor
     MultibodyNode node(model, std::move(report), options);
     coupling::Participant participant(multibodyParticipantConfig(options, root, model));
     coupling::runParticipant(participant, node);
-    return 0;
+    return node.exitStatus();
 }
 
 } // namespace

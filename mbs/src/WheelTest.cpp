@@ -1,9 +1,13 @@
 #include "grainlink/mbs/WheelTest.hpp"
 
 #include "CheckpointText.hpp"
+#include "grainlink/dem/SteadySignal.hpp"
+
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -11,26 +15,40 @@ namespace grainlink::mbs {
 
 namespace {
 
-struct MeanStd {
-    double mean = 0.0, std = 0.0;
-};
+SteadyValue steadyValue(const std::vector<double> &values) {
+    const auto s = dem::summarizeSignal(values, 10);
+    return {s.mean, s.sd, s.standard_error};
+}
 
-template <typename Get>
-MeanStd meanStd(const std::deque<WheelSample> &samples, std::size_t first, std::size_t end,
-                Get get) {
-    MeanStd m;
-    const double n = double(end - first);
-    if (n <= 0)
-        return m;
-    for (std::size_t i = first; i < end; ++i)
-        m.mean += get(samples[i]) / n;
-    for (std::size_t i = first; i < end; ++i)
-        m.std += (get(samples[i]) - m.mean) * (get(samples[i]) - m.mean) / n;
-    m.std = std::sqrt(m.std);
-    return m;
+Drift drift(const std::vector<double> &times, const std::vector<double> &values, double span_s) {
+    const auto trend = dem::signalTrend(times, values, 20);
+    return {trend.slope_per_s * span_s, trend.slope_se_per_s * span_s,
+            trend.consistentWithZero()};
 }
 
 } // namespace
+
+void WheelTest::judge(double t) {
+    std::vector<double> time, slip, torque, pull, vertical, height;
+    for (const auto &w : drive_samples_) {
+        time.push_back(w.time_s);
+        slip.push_back(w.slip);
+        torque.push_back(w.motor_torque_N_m);
+        pull.push_back(w.soil_force_x_N);
+        vertical.push_back(w.soil_force_z_N);
+        height.push_back(w.wheel_z_m);
+    }
+    const double span = settings_.steady_window_s;
+    steady_.time_s = t;
+    steady_.span_start_s = time.empty() ? t : time.front();
+    steady_.slip = steadyValue(slip);
+    steady_.motor_torque_N_m = steadyValue(torque);
+    steady_.drawbar_pull_N = steadyValue(pull);
+    steady_.vertical_force_N = steadyValue(vertical);
+    steady_.wheel_z_m = steadyValue(height);
+    steady_.slip_drift = drift(time, slip, span);
+    steady_.height_drift_m = drift(time, height, span);
+}
 
 bool WheelTest::afterWindow(SingleWheelRig &rig, const Wrench &soil) {
     const auto o = rig.observables();
@@ -54,11 +72,21 @@ bool WheelTest::afterWindow(SingleWheelRig &rig, const Wrench &soil) {
             std::fprintf(stderr,
                          "wheel test: sinkage steady at t = %.3f s; driving at %.3g rad/s\n", t,
                          rig.settings().angular_velocity_rad_s);
+        } else if (t > settings_.drop_max_s && !settings_.until_end_time) {
+            char text[256];
+            std::snprintf(text, sizeof text,
+                          "the drop phase ran %.3g s (wheel_test.drop_max_s = %.3g s) and the "
+                          "wheel still moved %.3g mm over the last %.3g s (drop_settle_distance_m "
+                          "= %.3g mm)",
+                          t, settings_.drop_max_s, 1e3 * (high - low),
+                          t - drop_heights_.front().first, 1e3 * settings_.drop_settle_distance_m);
+            failure_ = text;
+            return true;
         }
         return false;
     }
     if (phase_ == Phase::Steady)
-        return true;
+        return !settings_.until_end_time;
     WheelSample s;
     s.time_s = t;
     s.slip = o.at("slip");
@@ -70,37 +98,50 @@ bool WheelTest::afterWindow(SingleWheelRig &rig, const Wrench &soil) {
     const double span = settings_.steady_window_s;
     while (!drive_samples_.empty() && drive_samples_.front().time_s < t - 2.0 * span)
         drive_samples_.pop_front();
-    if (t - drive_start_s_ < std::max(settings_.drive_min_s, 2.0 * span))
+    const double driven = t - drive_start_s_;
+    if (driven < std::max(settings_.drive_min_s, 2.0 * span))
         return false;
-    // Two consecutive spans of steady_window_s: steady when their mean slips agree.
-    std::size_t middle = 0;
-    while (middle < drive_samples_.size() && drive_samples_[middle].time_s <= t - span)
-        ++middle;
-    const auto slip = [](const WheelSample &w) { return w.slip; };
-    const MeanStd older = meanStd(drive_samples_, 0, middle, slip);
-    const MeanStd newer = meanStd(drive_samples_, middle, drive_samples_.size(), slip);
-    const auto height = [](const WheelSample &w) { return w.wheel_z_m; };
-    const double sinking = meanStd(drive_samples_, middle, drive_samples_.size(), height).mean -
-                           meanStd(drive_samples_, 0, middle, height).mean;
-    if (std::abs(newer.mean - older.mean) >= settings_.steady_slip_tolerance ||
-        std::abs(sinking) >= settings_.steady_height_tolerance_m)
-        return false;
-    phase_ = Phase::Steady;
-    steady_.reached = true;
-    steady_.time_s = t;
-    steady_.slip_mean = newer.mean;
-    steady_.slip_std = newer.std;
-    const auto torque = meanStd(drive_samples_, middle, drive_samples_.size(),
-                                [](const WheelSample &w) { return w.motor_torque_N_m; });
-    const auto pull = meanStd(drive_samples_, middle, drive_samples_.size(),
-                              [](const WheelSample &w) { return w.soil_force_x_N; });
-    steady_.torque_mean_N_m = torque.mean;
-    steady_.torque_std_N_m = torque.std;
-    steady_.drawbar_pull_mean_N = pull.mean;
-    steady_.drawbar_pull_std_N = pull.std;
-    steady_.revolutions =
-        (t - drive_start_s_) * rig.settings().angular_velocity_rad_s / (2.0 * M_PI);
-    return true;
+    // The trend test over the last two spans: slip and height each change by less than their
+    // tolerance per span, and by an amount consistent with zero. Two spans' means alone missed
+    // a slow drift hidden in the fluctuation and judged a noisy flat signal unsteady.
+    judge(t);
+    steady_.revolutions = driven * rig.settings().angular_velocity_rad_s / (2.0 * M_PI);
+    const auto within = [](const Drift &d, double tolerance) {
+        return std::abs(d.per_span) < tolerance && d.consistent_with_zero;
+    };
+    if (within(steady_.slip_drift, settings_.steady_slip_tolerance) &&
+        within(steady_.height_drift_m, settings_.steady_height_tolerance_m)) {
+        phase_ = Phase::Steady;
+        steady_.reached = true;
+        return !settings_.until_end_time;
+    }
+    if (driven > settings_.drive_max_s && !settings_.until_end_time) {
+        char text[160];
+        std::snprintf(text, sizeof text,
+                      "the drive phase ran %.3g s (wheel_test.drive_max_s = %.3g s) without a "
+                      "steady state",
+                      driven, settings_.drive_max_s);
+        failure_ = text + std::string("; still changing: ") + stillChanging();
+        return true;
+    }
+    return false;
+}
+
+std::string WheelTest::stillChanging() const {
+    const double span = settings_.steady_window_s;
+    const auto describe = [span](const char *name, const Drift &d, double tolerance,
+                                 double scale, const char *unit) {
+        char text[200];
+        std::snprintf(text, sizeof text,
+                      "%s by %+.3g +- %.2g%s per %.3g s (tolerance %.3g%s%s)", name,
+                      scale * d.per_span, scale * d.standard_error, unit, span, scale * tolerance,
+                      unit, d.consistent_with_zero ? "" : ", a trend unlike zero");
+        return std::string(text);
+    };
+    return describe("slip", steady_.slip_drift, settings_.steady_slip_tolerance, 1.0, "") +
+           ", height " +
+           describe("", steady_.height_drift_m, settings_.steady_height_tolerance_m, 1e3, " mm")
+               .substr(1);
 }
 
 std::string WheelTest::phaseName() const {
@@ -115,17 +156,75 @@ std::string WheelTest::phaseName() const {
     return "?";
 }
 
-std::string WheelTest::summary() const {
-    char text[512];
-    if (!steady_.reached)
-        return "wheel test: no steady state reached (phase " + phaseName() + ")";
+std::string WheelTest::summary(double run_end_s) const {
+    char text[640];
+    if (!steady_.reached) {
+        if (!failure_.empty())
+            return "wheel test: no steady state: " + failure_;
+        char ended[200];
+        std::snprintf(ended, sizeof ended,
+                      "wheel test: no steady state: the run ended at t = %.4g s "
+                      "(coupling.end_time_s) after %.3g s of the %s phase",
+                      run_end_s, run_end_s - (phase_ == Phase::Drop ? 0.0 : drive_start_s_),
+                      phaseName().c_str());
+        std::string text = ended;
+        if (phase_ == Phase::Drive && steady_.time_s > 0.0)
+            text += "; still changing: " + stillChanging();
+        else if (phase_ == Phase::Drive)
+            text += " (shorter than the drive_min_s or two steady_window_s it needs)";
+        return text;
+    }
+    const auto &r = steady_;
     std::snprintf(text, sizeof text,
-                  "wheel test: steady after %.3f s of driving (%.2f revolutions): slip %.3f +- "
-                  "%.3f, drawbar pull %.2f +- %.2f N, motor torque %.3f +- %.3f N m",
-                  steady_.time_s - drive_start_s_, steady_.revolutions, steady_.slip_mean,
-                  steady_.slip_std, steady_.drawbar_pull_mean_N, steady_.drawbar_pull_std_N,
-                  steady_.torque_mean_N_m, steady_.torque_std_N_m);
+                  "wheel test: steady after %.3f s of driving (%.2f revolutions): over the last "
+                  "%.3g s slip %.3f +- %.3f (se %.3f), drawbar pull %.2f +- %.2f N (se %.2f), "
+                  "motor torque %.3f +- %.3f N m (se %.3f), vertical force %.2f +- %.2f N; "
+                  "drift per %.3g s: slip %+.3f +- %.3f, height %+.2f +- %.2f mm",
+                  r.time_s - drive_start_s_, r.revolutions, r.time_s - r.span_start_s,
+                  r.slip.mean, r.slip.sd, r.slip.standard_error, r.drawbar_pull_N.mean,
+                  r.drawbar_pull_N.sd, r.drawbar_pull_N.standard_error, r.motor_torque_N_m.mean,
+                  r.motor_torque_N_m.sd, r.motor_torque_N_m.standard_error,
+                  r.vertical_force_N.mean, r.vertical_force_N.sd, settings_.steady_window_s,
+                  r.slip_drift.per_span, r.slip_drift.standard_error,
+                  1e3 * r.height_drift_m.per_span, 1e3 * r.height_drift_m.standard_error);
     return text;
+}
+
+void WheelTest::writeSummaryJson(const std::string &path, double run_end_s) const {
+    using nlohmann::json;
+    const auto value = [](const SteadyValue &v) {
+        return json{{"mean", v.mean}, {"sd", v.sd}, {"standard_error", v.standard_error}};
+    };
+    const auto trend = [](const Drift &d) {
+        return json{{"per_span", d.per_span},
+                    {"standard_error", d.standard_error},
+                    {"consistent_with_zero", d.consistent_with_zero}};
+    };
+    const auto &r = steady_;
+    json j{{"steady", r.reached},
+           {"phase", phaseName()},
+           {"message", summary(run_end_s)},
+           {"run_end_s", run_end_s}};
+    if (phase_ != Phase::Drop) {
+        j["drive_start_s"] = drive_start_s_;
+        j["span_s"] = {r.span_start_s, r.time_s};
+        j["span_length_s"] = settings_.steady_window_s;
+        j["revolutions"] = r.revolutions;
+        j["slip"] = value(r.slip);
+        j["motor_torque_N_m"] = value(r.motor_torque_N_m);
+        j["drawbar_pull_N"] = value(r.drawbar_pull_N);
+        j["vertical_force_N"] = value(r.vertical_force_N);
+        j["wheel_z_m"] = value(r.wheel_z_m);
+        j["drift"] = {{"slip", trend(r.slip_drift)}, {"wheel_z_m", trend(r.height_drift_m)}};
+    }
+    // Written aside and renamed: a reader (a study collecting it) sees the whole file or none.
+    const std::string partial = path + ".partial";
+    std::ofstream(partial) << j.dump(2) << '\n';
+    std::error_code error;
+    std::filesystem::rename(partial, path, error);
+    if (error)
+        throw ModelError("cannot write the wheel test's summary " + path + ": " +
+                         error.message());
 }
 
 void WheelTest::writeCheckpoint(const std::string &path) const {
@@ -138,10 +237,9 @@ void WheelTest::writeCheckpoint(const std::string &path) const {
     for (const auto &w : drive_samples_)
         os << ' ' << w.time_s << ' ' << w.slip << ' ' << w.motor_torque_N_m << ' '
            << w.soil_force_x_N << ' ' << w.soil_force_z_N << ' ' << w.wheel_z_m;
-    const auto &r = steady_;
-    os << "\nsteady " << (r.reached ? 1 : 0) << ' ' << r.time_s << ' ' << r.slip_mean << ' '
-       << r.slip_std << ' ' << r.torque_mean_N_m << ' ' << r.torque_std_N_m << ' '
-       << r.drawbar_pull_mean_N << ' ' << r.drawbar_pull_std_N << ' ' << r.revolutions << '\n';
+    // The steady report is judged again from the samples when read.
+    os << "\nsteady " << (steady_.reached ? 1 : 0) << ' ' << steady_.time_s << ' '
+       << steady_.revolutions << '\n';
     std::ofstream out(path);
     out << os.str();
     if (!out)
@@ -177,7 +275,8 @@ void WheelTest::readCheckpoint(const std::string &path) {
     const auto samples = checkpointNumbers(in, path, 4, kind, "drive_samples",
                                            "the drive's samples (time [s], slip, torque [N m], "
                                            "force x [N], force z [N], height [m])");
-    const auto report = checkpointNumbers(in, path, 5, kind, "steady", 9, "the steady report");
+    const auto report = checkpointNumbers(in, path, 5, kind, "steady", 3,
+                                          "the steady report (reached, time [s], revolutions)");
     if (heights.size() % 2 != 0)
         throw ModelError(path + ":3: " + std::to_string(heights.size()) +
                          " values of the drop's (time, height) pairs: an odd number");
@@ -193,8 +292,11 @@ void WheelTest::readCheckpoint(const std::string &path) {
     for (std::size_t k = 0; k < samples.size(); k += 6)
         drive_samples_.push_back({samples[k], samples[k + 1], samples[k + 2], samples[k + 3],
                                   samples[k + 4], samples[k + 5]});
-    steady_ = {report[0] != 0.0, report[1], report[2], report[3], report[4],
-               report[5],        report[6], report[7], report[8]};
+    steady_ = {};
+    if (report[1] > 0.0)
+        judge(report[1]);
+    steady_.reached = report[0] != 0.0;
+    steady_.revolutions = report[2];
 }
 
 WheelTestSettings parseWheelTest(const config::ConfigNode &node) {
@@ -202,11 +304,31 @@ WheelTestSettings parseWheelTest(const config::ConfigNode &node) {
     s.drop_min_s = node.number("drop_min_s", s.drop_min_s);
     s.drop_settle_distance_m = node.number("drop_settle_distance_m", s.drop_settle_distance_m);
     s.drop_settle_time_s = node.number("drop_settle_time_s", s.drop_settle_time_s);
+    s.drop_max_s = node.number("drop_max_s", s.drop_max_s);
     s.drive_min_s = node.number("drive_min_s", s.drive_min_s);
+    s.drive_max_s = node.number("drive_max_s", s.drive_max_s);
     s.steady_window_s = node.number("steady_window_s", s.steady_window_s);
     s.steady_slip_tolerance = node.number("steady_slip_tolerance", s.steady_slip_tolerance);
     s.steady_height_tolerance_m =
         node.number("steady_height_tolerance_m", s.steady_height_tolerance_m);
+    if (node.has("run_until")) {
+        const std::string until = node["run_until"].text();
+        if (until != "steady" && until != "end_time")
+            node["run_until"].fail("'" + until + "' is not steady or end_time");
+        s.until_end_time = until == "end_time";
+    }
+    // A phase's maximum below its minimum would fail every run for the wrong reason (a run to
+    // its end time has no maximum).
+    const auto ordered = [&node, &s](const char *min_key, double min, const char *max_key,
+                                     double max) {
+        if (s.until_end_time || max > min)
+            return;
+        node[node.has(max_key) ? max_key : min_key].fail(
+            std::string(max_key) + " = " + std::to_string(max) + " s is not above " + min_key +
+            " = " + std::to_string(min) + " s");
+    };
+    ordered("drop_min_s", s.drop_min_s, "drop_max_s", s.drop_max_s);
+    ordered("drive_min_s", s.drive_min_s, "drive_max_s", s.drive_max_s);
     node.finish();
     return s;
 }

@@ -222,3 +222,38 @@ TEST_CASE("a run killed from outside leaves its point unfinished while the study
     REQUIRE(runToEnd(command, folder.path.string(), output) == 0);
     CHECK_THAT(output, Catch::Contains("3 points: 3 done (1 run now), 0 failed, 0 unfinished"));
 }
+
+TEST_CASE("a study of coupled runs collects each rig's steady report", "[study][local]") {
+    // `grainlink study` (whose reader of coupled scenarios is the command's) on two coupled
+    // wheel runs on the rigid floor (rig, floor, coordinator: three processes each): one steady,
+    // whose rig_summary.json the study reads — a torque-driven wheel's motor torque is the set
+    // torque, the floor carries the normal load 3 kg x 9.81 m/s^2 within 1 % —, and one whose
+    // drive is shorter than its judging needs before the run's end time: the run exits non-zero
+    // and its point fails with the rig's message.
+    TempFolder folder("coupled");
+    writeFile(folder / "wheels.yaml",
+              "name: wheels\nbase: {kind: run, scenario: " + kData +
+                  "/wheel_floor.yaml}\n"
+                  "design:\n  combine: zip\n  vary:\n"
+                  "    - {key: rig.drive_torque_N_m, values: [0.1, 0.15]}\n"
+                  "    - {key: wheel_test.drive_min_s, values: [0.6, 5.0]}\n"
+                  "observables: [motor_torque_N_m.mean, vertical_force_N.mean]\n");
+    std::string output;
+    const int code = runToEnd({kGrainlink, "study", folder / "wheels.yaml", "--out",
+                               folder / "study", "--jobs", "1"},
+                              folder.path.string(), output);
+    INFO(output);
+    CHECK(code != 0); // a point failed
+    const auto points = finishedPoints(folder.path / "study");
+    REQUIRE(points.size() == 1);
+    const auto summary = nlohmann::json::parse(
+        readFile(folder.path / "study" / "points" / points[0] / "rig_summary.json"));
+    CHECK(summary["steady"] == true);
+    CHECK(summary["motor_torque_N_m"]["mean"].get<double>() == Approx(0.1).epsilon(1e-6));
+    CHECK(summary["vertical_force_N"]["mean"].get<double>() == Approx(3.0 * 9.81).epsilon(0.01));
+    CHECK(summary["vertical_force_N"]["standard_error"].get<double>() > 0.0);
+    CHECK_THAT(output, Catch::Contains("2 points: 1 done (2 run now), 1 failed"));
+    // The failed point's error is the run's last word: the rig's reason.
+    CHECK_THAT(output, Catch::Contains("exit code 1: run: wheel test: no steady state: the run "
+                                       "ended at t = 1.5 s"));
+}
