@@ -43,6 +43,13 @@ public:
             dem::MeshBody body(options_.bodies[b],
                                meshOf(describedBody(run, options_.bodies[b]), mirror_.has_value()),
                                dem::RigidBodyState{});
+            const auto &d = scenario_.deposition;
+            const std::string implausible = dem::implausibleMeshSize(
+                body.mesh(), 2.0 * d.radius.largest(), (d.region_upper_m - d.region_lower_m).maxCoeff());
+            if (!implausible.empty())
+                throw coupling::CouplingError("body '" + options_.bodies[b] +
+                                              "' as the multibody side describes it: " +
+                                              implausible);
             sys_->addBody(std::move(body));
         }
         dem_offset_s_ = sys_->time() - run.start_tick * run.tick_s; // DEM time - coupling time
@@ -68,6 +75,14 @@ public:
         // state now and follows the motion at every step's end.
         for (std::size_t b = 0; b < bodyCount(); ++b) {
             sys_->setBodyMotion(int(b), windowMotion(in, b, dem_offset_s_));
+            if (in.window == 0 && !resumed_)
+                std::fprintf(stderr, "[%s] %s; lowest point %.2f mm above the bed surface\n",
+                             options_.name.c_str(),
+                             dem::describeMesh(options_.bodies[b], sys_->body(int(b)).mesh(),
+                                               in.start_states.at(b).position_m,
+                                               2.0 * scenario_.deposition.radius.largest())
+                                 .c_str(),
+                             1000.0 * (lowestPoint(b) - surface_));
             if (in.window == 0 && !resumed_ && lowestPoint(b) < surface_)
                 throw coupling::CouplingError("body '" + options_.bodies[b] + "' starts " +
                                               std::to_string(1000.0 * (surface_ - lowestPoint(b))) +

@@ -446,8 +446,15 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
     s.deposition = parseDeposition(root["deposition"]);
     s.packing_cache_directory = root.text("packing_cache_directory", ".cache/packings");
     if (const auto bodies = root.optional("bodies"))
-        for (const ConfigNode &b : bodies->items())
+        for (const ConfigNode &b : bodies->items()) {
             s.bodies.push_back(parseBody(b, dir));
+            const std::string implausible =
+                implausibleMeshSize(s.bodies.back().mesh, 2.0 * s.deposition.radius.largest(),
+                                    (s.deposition.region_upper_m - s.deposition.region_lower_m)
+                                        .maxCoeff());
+            if (!implausible.empty())
+                b["mesh"].fail("body '" + s.bodies.back().name + "': " + implausible);
+        }
     if (!coupled) { // a coupled soil runs as long as the coordinator says
         const ConfigNode run = root["run"];
         s.duration_s = run["duration_s"].positive();

@@ -292,8 +292,14 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
         sys = prepareSoil(scenario, options.progress_interval_s, &summary.packing_from_cache);
         run_start_s = sys->time();
         starts = startPoses(*sys, scenario);
-        for (std::size_t b = 0; b < scenario.bodies.size(); ++b)
+        for (std::size_t b = 0; b < scenario.bodies.size(); ++b) {
             addBody(*sys, scenario.bodies[b], starts[b], run_start_s);
+            std::fprintf(stderr, "[bodies] %s\n",
+                         describeMesh(scenario.bodies[b].name, scenario.bodies[b].mesh,
+                                      starts[b].position_m,
+                                      2.0 * scenario.deposition.radius.largest())
+                             .c_str());
+        }
         if (fs::exists(series_path))
             fs::remove(series_path);
     }

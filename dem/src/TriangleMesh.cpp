@@ -1,5 +1,7 @@
 #include "grainlink/dem/TriangleMesh.hpp"
 
+#include <cstdio>
+
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -15,6 +17,51 @@ double TriangleMesh::boundingRadius() const {
     for (const Vec3 &v : vertices_m)
         r = std::max(r, v.norm());
     return r;
+}
+
+Vec3 TriangleMesh::extent() const {
+    if (vertices_m.empty())
+        return Vec3::Zero();
+    Vec3 low = vertices_m.front(), high = vertices_m.front();
+    for (const Vec3 &v : vertices_m) {
+        low = low.cwiseMin(v);
+        high = high.cwiseMax(v);
+    }
+    return high - low;
+}
+
+std::string describeMesh(const std::string &name, const TriangleMesh &mesh,
+                         const Vec3 &position_m, double grain_diameter_m) {
+    const Vec3 e = mesh.extent();
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "mesh '%s': %zu triangles, %.4g x %.4g x %.4g m (body frame), placed at (%.4g, "
+                  "%.4g, %.4g) m, %.3g grain diameters across",
+                  name.c_str(), mesh.triangleCount(), e.x(), e.y(), e.z(), position_m.x(),
+                  position_m.y(), position_m.z(), e.maxCoeff() / grain_diameter_m);
+    return text;
+}
+
+std::string implausibleMeshSize(const TriangleMesh &mesh, double grain_diameter_m,
+                                double bed_size_m) {
+    const double size = mesh.extent().maxCoeff();
+    char text[320];
+    if (size < grain_diameter_m) {
+        std::snprintf(text, sizeof text,
+                      "the mesh is %.3g m across, less than one grain (%.3g m): a mesh in "
+                      "metres scaled as if in millimetres?",
+                      size, grain_diameter_m);
+        return text;
+    }
+    if (size > 10.0 * bed_size_m || size > 5000.0 * grain_diameter_m) {
+        std::snprintf(text, sizeof text,
+                      "the mesh is %.3g m across, %.3g times the bed's largest side (%.3g m) and "
+                      "%.3g grain diameters: a mesh in millimetres read as metres? (scale it: "
+                      "0.001)",
+                      size, size / bed_size_m, bed_size_m, size / grain_diameter_m);
+        return text;
+    }
+    return "";
 }
 
 void TriangleMesh::transform(double scale, const Vec3 &offset_m) {

@@ -162,3 +162,29 @@ TEST_CASE("the packing key changes with the soil and not with the run", "[dem][s
     d.deposition.seed = 99;
     CHECK(packingKey(a) != packingKey(d));
 }
+
+TEST_CASE("a mesh whose size cannot fit the grains is refused", "[dem][scenario]") {
+    // tiny.yaml: grains of at most 10 mm diameter in a 0.1 m region. A 150 mm wheel given in
+    // millimetres (radius 75 "m") is 150 m across: 1500 times the region and 15,000 grains;
+    // one scaled twice (radius 7.5e-5 m, width 8e-5 m) is 0.15 mm, under one grain. A 150 mm
+    // wheel is fine
+    // and the load report gives its size: 0.15 x 0.08 x 0.15 m (72 facets reach ±r on x and z).
+    const auto withBody = [](const std::string &radius, const std::string &width = "0.08") {
+        return replaced(kValid, "run: {duration_s: 0.1}",
+                        "bodies:\n  - name: wheel\n    position_m: [0.05, 0.05, 0.2]\n"
+                        "    mesh: {type: cylinder, radius_m: " +
+                            radius + ", width_m: " + width + "}\nrun: {duration_s: 0.1}");
+    };
+    CHECK(errorOf(withBody("75")) ==
+          "bad.yaml:18: key 'bodies[0].mesh': body 'wheel': the mesh is 150 m across, 1.5e+03 times "
+          "the bed's largest side (0.1 m) and 1.5e+04 grain diameters: a mesh in millimetres "
+          "read as metres? (scale it: 0.001)");
+    CHECK(errorOf(withBody("7.5e-5", "8e-5")) ==
+          "bad.yaml:18: key 'bodies[0].mesh': body 'wheel': the mesh is 0.00015 m across, less "
+          "than one grain (0.01 m): a mesh in metres scaled as if in millimetres?");
+    const DemScenario ok = parseScenario(ConfigNode::loadString(withBody("0.075"), "ok.yaml"));
+    REQUIRE(ok.bodies.size() == 1);
+    CHECK(describeMesh("wheel", ok.bodies[0].mesh, Vec3(0.05, 0.05, 0.2), 0.01) ==
+          "mesh 'wheel': 288 triangles, 0.15 x 0.08 x 0.15 m (body frame), placed at (0.05, "
+          "0.05, 0.2) m, 15 grain diameters across");
+}

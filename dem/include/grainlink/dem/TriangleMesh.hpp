@@ -19,7 +19,20 @@ struct TriangleMesh {
     void transform(double scale, const Vec3 &offset_m);
     /// Throws if an index is out of range, a triangle is degenerate or a vertex is non-finite.
     void validate(const std::string &what) const;
+    /// The sides of the axis-aligned box around the vertices, in the body frame [m].
+    Vec3 extent() const;
 };
+
+/// One line for the log when a body's mesh is loaded: its name, triangles, size and placement,
+/// and how many grain diameters it spans.
+std::string describeMesh(const std::string &name, const TriangleMesh &mesh,
+                         const Vec3 &position_m, double grain_diameter_m);
+
+/// Why a mesh this size cannot be meant for grains of this diameter in a bed this size, or ""
+/// when it is plausible: under one grain across (a metre STL scaled as millimetres?), or more
+/// than 10 times the bed's largest side or 5000 grains across (a millimetre STL read as metres?).
+std::string implausibleMeshSize(const TriangleMesh &mesh, double grain_diameter_m,
+                                double bed_size_m);
 
 /// Reads ASCII or binary STL (detected from the file); vertices are shared where identical.
 TriangleMesh readStl(const std::string &path);
