@@ -1,5 +1,7 @@
 #include "grainlink/dem/SteadySignal.hpp"
 
+#include <boost/math/distributions/students_t.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -26,13 +28,39 @@ std::vector<double> batchMeans(const std::vector<double> &values, std::size_t ba
 } // namespace
 
 double studentT95(std::size_t dof) {
-    static const double table[] = {12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306,
-                                   2.262,  2.228, 2.201, 2.179, 2.160, 2.145, 2.131, 2.120,
-                                   2.110,  2.101, 2.093, 2.086, 2.080, 2.074, 2.069, 2.064,
-                                   2.060,  2.056, 2.052, 2.048, 2.045, 2.042};
     if (dof == 0)
         throw std::invalid_argument("Student t quantile: zero degrees of freedom");
-    return dof <= 30 ? table[dof - 1] : 1.96;
+    return boost::math::quantile(boost::math::students_t(double(dof)), 0.975);
+}
+
+LineFit fitLine(const std::vector<double> &x, const std::vector<double> &y) {
+    if (x.size() != y.size())
+        throw std::invalid_argument("line fit: " + std::to_string(x.size()) + " x values for " +
+                                    std::to_string(y.size()) + " y values");
+    LineFit fit;
+    const double n = double(x.size());
+    if (x.size() < 3)
+        return fit;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+        fit.x_mean += x[k] / n;
+        fit.intercept += y[k] / n;
+    }
+    double sxx = 0.0, sxy = 0.0;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+        sxx += (x[k] - fit.x_mean) * (x[k] - fit.x_mean);
+        sxy += (x[k] - fit.x_mean) * (y[k] - fit.intercept);
+    }
+    if (sxx <= 0.0)
+        return fit;
+    fit.slope = sxy / sxx;
+    double residuals = 0.0;
+    for (std::size_t k = 0; k < x.size(); ++k) {
+        const double r = y[k] - fit.intercept - fit.slope * (x[k] - fit.x_mean);
+        residuals += r * r;
+    }
+    fit.dof = x.size() - 2;
+    fit.slope_se = std::sqrt(residuals / double(fit.dof) / sxx);
+    return fit;
 }
 
 bool SignalTrend::consistentWithZero() const {
@@ -67,32 +95,8 @@ SignalTrend signalTrend(const std::vector<double> &times, const std::vector<doub
     if (times.size() != values.size())
         throw std::invalid_argument("signal trend: " + std::to_string(times.size()) +
                                     " times for " + std::to_string(values.size()) + " values");
-    SignalTrend trend;
-    const auto t = batchMeans(times, batches), y = batchMeans(values, batches);
-    if (t.size() < 3)
-        return trend;
-    const double n = double(t.size());
-    double t_mean = 0.0, y_mean = 0.0;
-    for (std::size_t k = 0; k < t.size(); ++k) {
-        t_mean += t[k] / n;
-        y_mean += y[k] / n;
-    }
-    double stt = 0.0, sty = 0.0;
-    for (std::size_t k = 0; k < t.size(); ++k) {
-        stt += (t[k] - t_mean) * (t[k] - t_mean);
-        sty += (t[k] - t_mean) * (y[k] - y_mean);
-    }
-    if (stt <= 0.0)
-        return trend;
-    trend.slope_per_s = sty / stt;
-    double residuals = 0.0;
-    for (std::size_t k = 0; k < t.size(); ++k) {
-        const double r = y[k] - y_mean - trend.slope_per_s * (t[k] - t_mean);
-        residuals += r * r;
-    }
-    trend.dof = t.size() - 2;
-    trend.slope_se_per_s = std::sqrt(residuals / double(trend.dof) / stt);
-    return trend;
+    const LineFit line = fitLine(batchMeans(times, batches), batchMeans(values, batches));
+    return {line.slope, line.slope_se, line.dof};
 }
 
 } // namespace grainlink::dem

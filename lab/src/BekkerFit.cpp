@@ -1,5 +1,7 @@
 #include "grainlink/lab/BekkerFit.hpp"
 
+#include "grainlink/dem/SteadySignal.hpp"
+
 #include <Eigen/Dense>
 #include <unsupported/Eigen/LevenbergMarquardt>
 
@@ -21,18 +23,7 @@ double studentT975(int dof) {
     if (dof < 1)
         throw std::invalid_argument("studentT975: degrees of freedom must be >= 1, got " +
                                     std::to_string(dof));
-    // Below 5 the expansion is poor; these are the exact quantiles.
-    static const double kSmall[] = {12.7062047, 4.30265273, 3.18244631, 2.77644511};
-    if (dof <= 4)
-        return kSmall[dof - 1];
-    // Cornish-Fisher expansion about the normal quantile (Abramowitz & Stegun 26.7.5).
-    const double z = 1.959963984540054, v = dof;
-    const double z2 = z * z, z3 = z2 * z, z5 = z3 * z2, z7 = z5 * z2, z9 = z7 * z2;
-    const double g1 = (z3 + z) / 4.0;
-    const double g2 = (5.0 * z5 + 16.0 * z3 + 3.0 * z) / 96.0;
-    const double g3 = (3.0 * z7 + 19.0 * z5 + 17.0 * z3 - 15.0 * z) / 384.0;
-    const double g4 = (79.0 * z9 + 776.0 * z7 + 1482.0 * z5 - 1920.0 * z3 - 945.0 * z) / 92160.0;
-    return z + g1 / v + g2 / (v * v) + g3 / (v * v * v) + g4 / (v * v * v * v);
+    return dem::studentT95(std::size_t(dof)); // one t quantile in the project (Boost.Math)
 }
 
 namespace {

@@ -2,6 +2,7 @@
 
 #include "grainlink/dem/Deposition.hpp"
 #include "grainlink/dem/Progress.hpp"
+#include "grainlink/dem/SteadySignal.hpp"
 #include "grainlink/dem/TriangleMesh.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
 #include "grainlink/lab/LabBed.hpp"
@@ -139,24 +140,8 @@ void measureHeap(const std::vector<Eigen::Vector3d> &positions, const std::vecto
         result.angle_half_width_95_deg = std::numeric_limits<double>::quiet_NaN();
         return;
     }
-    const double n = double(x.size());
-    double mx = 0.0, my = 0.0;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        mx += x[i] / n;
-        my += y[i] / n;
-    }
-    double sxx = 0.0, sxy = 0.0;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        sxx += (x[i] - mx) * (x[i] - mx);
-        sxy += (x[i] - mx) * (y[i] - my);
-    }
-    const double slope = sxy / sxx;
-    double rss = 0.0;
-    for (std::size_t i = 0; i < x.size(); ++i) {
-        const double e = y[i] - (my + slope * (x[i] - mx));
-        rss += e * e;
-    }
-    const double se = std::sqrt(rss / (n - 2.0) / sxx);
+    const dem::LineFit line = dem::fitLine(x, y);
+    const double slope = line.slope, se = line.slope_se;
     result.angle_deg = std::atan(-slope) * 180.0 / kPi;
     // d(atan s)/ds = 1 / (1 + s^2)
     result.angle_half_width_95_deg =

@@ -70,6 +70,15 @@ TEST_CASE("steady signal: batch-means intervals cover", "[dem][statistics]") {
 }
 
 TEST_CASE("steady signal: exact cases", "[dem][statistics]") {
+    // A line through three points (0, 1), (1, 2), (2, 4): slope 1.5, mean 7/3 at x 1, residuals
+    // (1/6, -1/3, 1/6): se = sqrt((1/6) / 1 / 2).
+    const auto fit = fitLine({0, 1, 2}, {1, 2, 4});
+    CHECK(fit.slope == Approx(1.5));
+    CHECK(fit.intercept == Approx(7.0 / 3.0));
+    CHECK(fit.x_mean == Approx(1.0));
+    CHECK(fit.slope_se == Approx(std::sqrt(1.0 / 12.0)));
+    CHECK(fit.dof == 1);
+    CHECK(fitLine({1, 1, 1}, {0, 1, 2}).dof == 0);
     // A constant: no fluctuation, no error, no trend. A line: its slope exactly, zero error.
     const std::vector<double> t = {0, 1, 2, 3, 4, 5, 6, 7, 8, 9};
     std::vector<double> flat(10, 2.5), line(10);
@@ -92,9 +101,9 @@ TEST_CASE("steady signal: exact cases", "[dem][statistics]") {
 }
 
 TEST_CASE("steady signal: t quantiles integrate to 95 %", "[dem][statistics]") {
-    // Student's t density, integrated by Simpson's rule from -q to q, holds 95 % for every
-    // tabulated dof (the table has three decimals: accepted within 2e-4).
-    for (std::size_t dof = 1; dof <= 30; ++dof) {
+    // Student's t density, integrated by Simpson's rule from -q to q, holds 95 % (within 1e-6)
+    // for the dof the steady-state and fit intervals use.
+    for (std::size_t dof : {1, 2, 3, 5, 9, 18, 30, 100}) {
         const double nu = double(dof);
         const double norm = std::exp(std::lgamma((nu + 1) / 2) - std::lgamma(nu / 2)) /
                             std::sqrt(nu * M_PI);
@@ -109,8 +118,7 @@ TEST_CASE("steady signal: t quantiles integrate to 95 %", "[dem][statistics]") {
             integral += (k % 2 ? 4.0 : 2.0) * density(-q + k * h);
         integral *= h / 3.0;
         INFO("dof " << dof);
-        CHECK(integral == Approx(0.95).margin(2e-4));
+        CHECK(integral == Approx(0.95).margin(1e-6));
     }
-    CHECK(studentT95(100) == 1.96);
     CHECK_THROWS(studentT95(0));
 }

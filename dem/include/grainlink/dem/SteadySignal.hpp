@@ -5,11 +5,22 @@
 // §9.5.3): a coupled run's consecutive samples are strongly correlated (one grouser passes in
 // hundreds of windows), so sd/√n understates the uncertainty many times over, while the means of
 // a few long batches are close to independent. Here in dem because both the rig's procedure
-// (mbs) and the lab's wheel test link it.
+// (mbs) and the lab link it; the lab's repose test fits its heap's flank with fitLine too.
 #include <cstddef>
 #include <vector>
 
 namespace grainlink::dem {
+
+/// A least-squares line y = intercept + slope (x - x_mean) with its slope's standard error.
+struct LineFit {
+    double x_mean = 0.0, intercept = 0.0; ///< the line's value at x_mean
+    double slope = 0.0, slope_se = 0.0;
+    std::size_t dof = 0; ///< points - 2; 0 with fewer than 3 points or no spread in x
+};
+
+/// The least-squares line through (x_k, y_k); with fewer than 3 points or all x equal, a zero
+/// slope with zero dof.
+LineFit fitLine(const std::vector<double> &x, const std::vector<double> &y);
 
 struct SignalSummary {
     double mean = 0.0;
@@ -35,7 +46,7 @@ SignalSummary summarizeSignal(const std::vector<double> &values, std::size_t bat
 SignalTrend signalTrend(const std::vector<double> &times, const std::vector<double> &values,
                         std::size_t batches = 20);
 
-/// The two-sided 95 % quantile of Student's t with `dof` degrees of freedom (1.96 beyond 30).
+/// The two-sided 95 % quantile of Student's t with `dof` degrees of freedom (Boost.Math).
 double studentT95(std::size_t dof);
 
 } // namespace grainlink::dem
