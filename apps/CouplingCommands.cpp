@@ -118,6 +118,8 @@ void printSummary(const coupling::CoordinatorSummary &s, const CoordinatorConfig
                     w.force_N.x(), w.force_N.y(), w.force_N.z());
     }
     std::printf("coupling: time series in %s/coupling.csv\n", config.output_directory.c_str());
+    for (const auto &warning : s.guard_warnings)
+        std::printf("coupling guard: %s\n", warning.c_str());
 }
 
 std::string substitute(std::string text, const std::string &key, const std::string &value) {

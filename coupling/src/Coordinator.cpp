@@ -111,6 +111,7 @@ struct Coordinator::Impl {
 
     Ticks end_tick = 0, macro_step_ticks = 0;
     Ticks nominal_step_ticks = 0, min_step_ticks = 0, max_step_ticks = 0;
+    CouplingGuard guard{GuardSettings{}};
     double cumulative_mismatch_J = 0.0;
     Ticks hint_ticks = std::numeric_limits<Ticks>::max(); ///< smallest step hint this window
     std::optional<CoordinatorSnapshot> resumed;           ///< the checkpoint, if resuming
@@ -484,6 +485,36 @@ struct Coordinator::Impl {
 
     /// The next window's length: the nominal step, or with adaptive stepping the smallest hint
     /// (growing back to the nominal step when there is none), clamped; never past the end.
+    /// The coupling guard after a window: a warning is logged once and kept for the summary;
+    /// with coupling.adaptive the coordinator shortens the nominal macro step itself.
+    void watch(double work_multibody, double work_soil, Ticks step, CoordinatorSummary &summary) {
+        const auto warning =
+            guard.afterWindow(work_multibody, work_soil, scheme->wrenches(), step * config.tick_s);
+        if (!warning)
+            return;
+        std::string message = warning->message;
+        if (max_step_ticks > 0) {
+            Ticks shorter = std::max<Ticks>(
+                Ticks(std::llround(warning->suggested_step_s / config.tick_s)), min_step_ticks);
+            shorter -= shorter % min_step_ticks;
+            if (shorter < nominal_step_ticks) {
+                message += "; coupling.adaptive: the macro step goes from " +
+                           formatSeconds(nominal_step_ticks * config.tick_s) + " s to " +
+                           formatSeconds(shorter * config.tick_s) + " s at t = " +
+                           formatSeconds((run.tick + step) * config.tick_s) + " s";
+                nominal_step_ticks = shorter;
+                max_step_ticks = std::min(max_step_ticks, shorter);
+                guard.restart();
+            } else {
+                message += "; coupling.adaptive cannot go lower than its min_macro_step_s";
+            }
+        } else {
+            message += " (with coupling.adaptive the coordinator shortens it itself)";
+        }
+        spdlog::warn("coupling guard: {}", message);
+        summary.guard_warnings.push_back(message);
+    }
+
     Ticks nextStep() {
         Ticks step = nominal_step_ticks;
         if (max_step_ticks > 0) {
@@ -566,6 +597,7 @@ struct Coordinator::Impl {
             const auto [work_multibody, work_soil] = runWindow(run.tick, run.tick + step);
             const double mismatch = work_multibody - work_soil;
             cumulative_mismatch_J += mismatch;
+            watch(work_multibody, work_soil, step, summary);
             ++summary.windows;
             summary.iterations += scheme->iterations();
             if (series) {
@@ -675,6 +707,7 @@ Coordinator::Coordinator(CoordinatorConfig config)
         throw CouplingError("adaptive stepping needs 0 < min_macro_step_s <= max_macro_step_s");
     s.min_step_ticks = ticks(c.min_macro_step_s);
     s.max_step_ticks = ticks(c.max_macro_step_s);
+    s.guard = CouplingGuard(c.guard);
     if ((c.checkpoint_every_windows > 0 || c.resume) && c.output_directory.empty())
         throw CouplingError("checkpoints need an output directory");
     checkLimits(c.limits);

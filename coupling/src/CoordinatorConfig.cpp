@@ -58,6 +58,19 @@ CoordinatorConfig coordinatorConfigFrom(const ConfigNode &root) {
             adaptive->fail("min_macro_step_s must not exceed max_macro_step_s");
         adaptive->finish();
     }
+    if (auto guard = coupling.optional("guard")) {
+        auto &g = c.guard;
+        g.enabled = guard->boolean("enabled", true);
+        if (guard->has("energy_ratio"))
+            g.energy_ratio = (*guard)["energy_ratio"].positive();
+        g.oscillation_autocorrelation =
+            guard->number("oscillation_autocorrelation", g.oscillation_autocorrelation);
+        if (!(g.oscillation_autocorrelation > -1.0 && g.oscillation_autocorrelation < 1.0))
+            (*guard)["oscillation_autocorrelation"].fail("must lie in (-1, 1)");
+        if (guard->has("span_windows"))
+            g.span_windows = count((*guard)["span_windows"], 3);
+        guard->finish();
+    }
     if (auto implicit = coupling.optional("implicit")) {
         if (c.scheme.kind != SchemeKind::Implicit)
             implicit->fail("settings for implicit coupling, but scheme is not implicit");

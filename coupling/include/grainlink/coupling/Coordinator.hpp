@@ -3,6 +3,7 @@
 // windows of the coupling scheme until the end time. Any failure stops the run everywhere and
 // is thrown as one CouplingError naming who failed, in which window, and why.
 #include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/coupling/CouplingGuard.hpp"
 #include "grainlink/coupling/CouplingScheme.hpp"
 #include "grainlink/coupling/Security.hpp"
 #include "grainlink/coupling/Types.hpp"
@@ -55,6 +56,7 @@ struct CoordinatorConfig {
     double macro_step_s = 1e-3;    ///< [s] window length
     double min_macro_step_s = 0.0; ///< [s] adaptive stepping: lower bound (0 = fixed windows)
     double max_macro_step_s = 0.0; ///< [s] adaptive stepping: upper bound
+    GuardSettings guard;           ///< the energy and oscillation watch (CouplingGuard.hpp)
 
     double heartbeat_interval_s = 0.2;  ///< [s]
     double peer_timeout_s = 5.0;        ///< [s] silence after which a participant counts as dead
@@ -77,6 +79,7 @@ struct CoordinatorSummary {
     std::vector<BodyState> final_states;
     std::vector<Wrench> final_wrenches;
     std::string completed_by; ///< the participant that ended the run early (run_complete), if any
+    std::vector<std::string> guard_warnings; ///< what the coupling guard warned, in order
 };
 
 class Coordinator {

@@ -1,0 +1,60 @@
+#pragma once
+// The coordinator's watch on the coupling itself: an explicit coupling whose macro step is too
+// long for the contacts it carries injects energy (the coupling's energy mismatch grows against
+// the work the sides exchange) or makes the exchanged wrench flip sign from window to window.
+// Past a threshold it warns once, with the measured figure and a macro step that would fix it
+// (docs/physics.md §7.6 says how the thresholds were chosen).
+#include "grainlink/coupling/Types.hpp"
+
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlink::coupling {
+
+struct GuardSettings {
+    bool enabled = true;
+    /// Warn when |Σ mismatch| / Σ |soil work| over the span exceeds this.
+    double energy_ratio = 0.05;
+    /// Warn when a force component's lag-1 autocorrelation over the span is below this
+    /// (-1: it flips sign every window; white noise: 0; smooth: near +1).
+    double oscillation_autocorrelation = -0.5;
+    unsigned span_windows = 500; ///< the sliding span both are judged over
+};
+
+/// What the guard found after a window: which check fired, the figure, the advice.
+struct GuardWarning {
+    enum class Kind { Energy, Oscillation } kind;
+    double measured = 0.0;          ///< the energy ratio, or the autocorrelation
+    double suggested_step_s = 0.0;  ///< a macro step that should bring it within its threshold
+    std::string message;
+};
+
+class CouplingGuard {
+public:
+    explicit CouplingGuard(const GuardSettings &settings) : settings_(settings) {}
+
+    /// After each window of length `macro_step_s`: its work on each side and the wrenches the
+    /// soil returned. Each kind of warning is given once per run (and again only after
+    /// restart(), when the macro step was changed because of it).
+    std::optional<GuardWarning> afterWindow(double work_multibody_J, double work_soil_J,
+                                            const std::vector<Wrench> &wrenches,
+                                            double macro_step_s);
+    /// Forgets the span (the macro step changed): the checks start over and may warn again.
+    void restart();
+
+private:
+    struct Window {
+        double mismatch_J, soil_work_J;
+        std::vector<double> forces; ///< every body's force components
+    };
+    GuardSettings settings_;
+    std::deque<Window> span_;
+    bool energy_warned_ = false, oscillation_warned_ = false;
+};
+
+/// The lag-1 autocorrelation of `values` about their mean; 0 when they do not vary.
+double lagOneAutocorrelation(const std::vector<double> &values);
+
+} // namespace grainlink::coupling
