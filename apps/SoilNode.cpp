@@ -98,6 +98,7 @@ public:
                           body.state().angular_velocity_rad_s, dt);
             }
         }
+        watchClearance(in.end_s);
         coupling::WindowOutputs out = loads.outputs(in.duration_s);
         for (std::size_t b = 0; b < bodyCount(); ++b) {
             auto &w = out.wrenches[b];
@@ -124,6 +125,16 @@ public:
         return out;
     }
 
+    void finish() override {
+        if (closest_.body.empty())
+            return;
+        std::fprintf(stderr,
+                     "[%s] closest approach to a wall: body '%s' %.2f mm from wall '%s' at t = "
+                     "%.3f s (soil.wall_clearance_m = %.2f mm)\n",
+                     options_.name.c_str(), closest_.body.c_str(), 1000.0 * closest_.distance_m,
+                     closest_.wall.c_str(), closest_.time_s, 1000.0 * scenario_.wall_clearance_m);
+    }
+
     // The snapshots' times travel in the checkpoint, so a resumed run keeps them in its .pvd.
     void writeCheckpoint(const std::string &directory) override {
         dem::CheckpointExtras extras{{"dem_offset_s", dem_offset_s_},
@@ -145,6 +156,35 @@ public:
 
 private:
     std::size_t bodyCount() const { return options_.bodies.size(); }
+
+    /// The closest any body came to a wall (the mirror's symmetry wall, which a half wheel
+    /// touches by design, left out); closer than soil.wall_clearance_m stops the run: its
+    /// grains would be crushed against the wall or the answers would depend on it.
+    void watchClearance(double t) {
+        for (std::size_t b = 0; b < bodyCount(); ++b)
+            for (const auto &wall : sys_->planes()) {
+                if (mirror_ && std::abs(std::abs(wall.normal.y()) - 1.0) < 1e-12 &&
+                    std::abs(wall.point_m.y() - mirror_->plane_y_m) < 1e-12)
+                    continue;
+                double distance = 1e300;
+                for (const auto &v : sys_->body(int(b)).worldVertices())
+                    distance = std::min(distance, wall.normal.dot(v - wall.point_m));
+                if (distance < closest_.distance_m)
+                    closest_ = {distance, options_.bodies[b], wall.name, t};
+            }
+        const double limit = scenario_.wall_clearance_m;
+        if (limit > 0.0 && closest_.distance_m < limit) {
+            char text[400];
+            std::snprintf(text, sizeof text,
+                          "body '%s' came within %.3g mm of wall '%s' (soil.wall_clearance_m = "
+                          "%.3g mm): the bin is too small for this run (too shallow, short or "
+                          "narrow) and its answers would depend on the wall; enlarge the bin or "
+                          "end the run earlier",
+                          closest_.body.c_str(), 1000.0 * closest_.distance_m,
+                          closest_.wall.c_str(), 1000.0 * limit);
+            throw coupling::CouplingError(text);
+        }
+    }
     double lowestPoint(std::size_t b) const {
         double lowest = 1e300;
         for (const auto &v : sys_->body(int(b)).worldVertices())
@@ -158,6 +198,11 @@ private:
     std::string snapshot_directory_;
     std::unique_ptr<dem::DemSystem> sys_;
     double surface_ = 0.0;      ///< [m] the settled bed's top
+    struct Closest {
+        double distance_m = 1e300;
+        std::string body, wall;
+        double time_s = 0.0;
+    } closest_; ///< the closest approach of any body to a wall so far
     double dem_offset_s_ = 0.0; ///< [s] DEM time - coupling time
     bool resumed_ = false;
     double end_s_ = 0.0; ///< [s] the run's end, for the progress line

@@ -486,14 +486,15 @@ struct Coordinator::Impl {
     /// The next window's length: the nominal step, or with adaptive stepping the smallest hint
     /// (growing back to the nominal step when there is none), clamped; never past the end.
     /// The coupling guard after a window: a warning is logged once and kept for the summary;
-    /// with coupling.adaptive the coordinator shortens the nominal macro step itself.
+    /// with coupling.guard.shorten the coordinator shortens the nominal macro step itself,
+    /// within coupling.adaptive's bounds.
     void watch(double work_multibody, double work_soil, Ticks step, CoordinatorSummary &summary) {
         const auto warning =
             guard.afterWindow(work_multibody, work_soil, scheme->wrenches(), step * config.tick_s);
         if (!warning)
             return;
         std::string message = warning->message;
-        if (max_step_ticks > 0) {
+        if (config.guard.shorten && max_step_ticks > 0) {
             Ticks shorter = std::max<Ticks>(
                 Ticks(std::llround(warning->suggested_step_s / config.tick_s)), min_step_ticks);
             shorter -= shorter % min_step_ticks;
@@ -509,7 +510,8 @@ struct Coordinator::Impl {
                 message += "; coupling.adaptive cannot go lower than its min_macro_step_s";
             }
         } else {
-            message += " (with coupling.adaptive the coordinator shortens it itself)";
+            message += " (with coupling.guard.shorten and coupling.adaptive the coordinator "
+                       "shortens it itself)";
         }
         spdlog::warn("coupling guard: {}", message);
         summary.guard_warnings.push_back(message);

@@ -69,6 +69,11 @@ CoordinatorConfig coordinatorConfigFrom(const ConfigNode &root) {
             (*guard)["oscillation_autocorrelation"].fail("must lie in (-1, 1)");
         if (guard->has("span_windows"))
             g.span_windows = count((*guard)["span_windows"], 3);
+        g.shorten = guard->boolean("shorten", false);
+        if (g.shorten && !coupling.has("adaptive"))
+            (*guard)["shorten"].fail("the coordinator shortens the macro step within "
+                                     "coupling.adaptive's bounds: set min_macro_step_s and "
+                                     "max_macro_step_s there");
         guard->finish();
     }
     if (auto implicit = coupling.optional("implicit")) {

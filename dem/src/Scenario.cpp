@@ -455,6 +455,15 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
             if (!implausible.empty())
                 b["mesh"].fail("body '" + s.bodies.back().name + "': " + implausible);
         }
+    if (coupled) {
+        s.wall_clearance_m =
+            root.number("wall_clearance_m", 2.0 * s.deposition.radius.largest());
+        if (!(s.wall_clearance_m >= 0.0))
+            root["wall_clearance_m"].fail("must be >= 0 (0: no check)");
+    } else if (root.has("wall_clearance_m")) {
+        root["wall_clearance_m"].fail("only a coupled soil (grainlink dem-node) watches its bodies' "
+                                      "clearance to the walls: remove the key");
+    }
     if (!coupled) { // a coupled soil runs as long as the coordinator says
         const ConfigNode run = root["run"];
         s.duration_s = run["duration_s"].positive();

@@ -60,6 +60,15 @@ TEST_CASE("coupling guard: energy mismatch past the threshold warns once", "[cou
     for (int k = 0; k < 10; ++k)
         warnings += bool(loud.afterWindow(0.11, 0.1, force(1.0), 1e-3));
     CHECK(warnings == 2);
+    // A quiet span after a busy one is judged against the run's mean exchange per span: the
+    // body at rest (soil work 1e-6 J per window, mismatch 1e-7 J) is not "10 %".
+    CouplingGuard resting(settings);
+    int resting_warnings = 0;
+    for (int k = 0; k < 10; ++k)
+        resting_warnings += bool(resting.afterWindow(0.101, 0.1, force(1.0), 1e-3));
+    for (int k = 0; k < 90; ++k)
+        resting_warnings += bool(resting.afterWindow(1.1e-6, 1e-6, force(1.0), 1e-3));
+    CHECK(resting_warnings == 0);
 }
 
 TEST_CASE("coupling guard: a force flipping every window warns", "[coupling][guard]") {

@@ -188,3 +188,17 @@ TEST_CASE("a mesh whose size cannot fit the grains is refused", "[dem][scenario]
           "mesh 'wheel': 288 triangles, 0.15 x 0.08 x 0.15 m (body frame), placed at (0.05, "
           "0.05, 0.2) m, 15 grain diameters across");
 }
+
+TEST_CASE("wall clearance is a coupled soil's key", "[dem][scenario]") {
+    // A coupled soil watches its bodies' distance to the walls: one largest grain diameter by
+    // default (tiny.yaml: 2 x 5 mm), or what the key says; `grainlink dem` refuses the key.
+    const std::string coupled = replaced(kValid, "run: {duration_s: 0.1}\n", "");
+    CHECK(parseScenario(ConfigNode::loadString(coupled, "c.yaml"), true).wall_clearance_m ==
+          Approx(0.01));
+    CHECK(parseScenario(ConfigNode::loadString(coupled + "wall_clearance_m: 0.03\n", "c.yaml"),
+                        true)
+              .wall_clearance_m == Approx(0.03));
+    CHECK(errorOf(kValid + "wall_clearance_m: 0.03\n") ==
+          "bad.yaml:16: key 'wall_clearance_m': only a coupled soil (grainlink dem-node) watches "
+          "its bodies' clearance to the walls: remove the key");
+}

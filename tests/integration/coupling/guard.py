@@ -5,7 +5,8 @@ work exchanged (first order in the step: 17 % at 5 ms, 6.7 % at 2 ms, 3.8 % at 1
 
 1. the run warns once, naming the measured share — which this script recomputes from
    coupling.csv over the same 50 windows, within 0.1 percentage point — and a shorter step;
-2. with coupling.adaptive (1 ms to 10 ms) the coordinator shortens the step itself to 1 ms, the
+2. with coupling.guard.shorten and coupling.adaptive (1 ms to 10 ms) the coordinator shortens
+   the step itself to 1 ms, the
    later windows of coupling.csv are 1 ms long, and the share over the last 500 windows, from
    coupling.csv, is below the 5 % threshold.
 Usage: guard.py GRAINLINK CONFIG WORK"""
@@ -57,7 +58,7 @@ else:
         failures.append("the warning does not advise a step of about 1.1 ms")
 
 adaptive = base.replace("  guard: {span_windows: 50}",
-                        "  guard: {span_windows: 50}\n"
+                        "  guard: {span_windows: 50, shorten: true}\n"
                         "  adaptive: {min_macro_step_s: 0.001, max_macro_step_s: 0.01}")
 output, rows = run("adaptive", adaptive)
 if "coupling.adaptive: the macro step goes from 0.01 s to 0.001 s at t = 0.5 s" not in output:

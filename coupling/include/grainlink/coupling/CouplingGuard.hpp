@@ -15,12 +15,15 @@ namespace grainlink::coupling {
 
 struct GuardSettings {
     bool enabled = true;
-    /// Warn when |Σ mismatch| / Σ |soil work| over the span exceeds this.
+    /// Warn when |Σ mismatch| over the span exceeds this share of the work the soil exchanged
+    /// with the bodies over it (or, in a quiet span, of the run's mean exchange per span).
     double energy_ratio = 0.05;
     /// Warn when a force component's lag-1 autocorrelation over the span is below this
     /// (-1: it flips sign every window; white noise: 0; smooth: near +1).
     double oscillation_autocorrelation = -0.5;
     unsigned span_windows = 500; ///< the sliding span both are judged over
+    /// With coupling.adaptive, the coordinator shortens the macro step itself on a warning.
+    bool shorten = false;
 };
 
 /// What the guard found after a window: which check fired, the figure, the advice.
@@ -51,6 +54,8 @@ private:
     };
     GuardSettings settings_;
     std::deque<Window> span_;
+    double exchanged_J_ = 0.0; ///< Σ |soil work| over the run so far
+    std::size_t windows_ = 0;
     bool energy_warned_ = false, oscillation_warned_ = false;
 };
 

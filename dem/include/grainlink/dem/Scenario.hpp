@@ -59,6 +59,9 @@ struct DemScenario {
     std::vector<BodySpec> bodies;
     double duration_s = 0.0; ///< run phase after deposition
     OutputSpec output;
+    /// [m] coupled soil (`wall_clearance_m`): the run stops when a body comes this close to a
+    /// wall; by default one largest grain diameter. Unused by `grainlink dem`.
+    double wall_clearance_m = 0.0;
 };
 
 /// Bounds on the counts a scenario may ask for: a typo or a wrapped negative stops at its key
