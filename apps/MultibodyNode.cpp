@@ -3,6 +3,10 @@
 // other model (rover, mole, a user's URDF mechanism) runs to the end time and writes mbs.csv,
 // its observables and the soil's wrench on each of its coupled bodies.
 #include "MultibodySide.hpp"
+#include "SoilSide.hpp"
+#include "grainlink/dem/BedPreparation.hpp"
+#include "grainlink/dem/RigidFloor.hpp"
+#include "grainlink/dem/ScenarioRun.hpp"
 #include "Nodes.hpp"
 #include "grainlink/coupling/ParticipantNode.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
@@ -184,10 +188,42 @@ int runWindows(const config::ConfigNode &root, mbs::MultibodyModel &model, Repor
 
 } // namespace
 
+/// The rig's start height for `rig.clearance_above_bed_m`: the wheel's lowest point (of the mesh
+/// the soil builds from it) that far above the settled bed surface, or above the rigid floor.
+/// The bed is the soil section's cached packing (settled once, whichever node needs it first).
+double startHeightAboveBed(const config::ConfigNode &root, const mbs::SingleWheelRigSettings &s) {
+    double surface = 0.0;
+    if (root.has("soil")) {
+        const auto sys = dem::prepareSoil(parseSoilSection(root, "soil"), 0.0);
+        surface = dem::bedSurface(sys->particles());
+    } else if (root.has("floor")) {
+        surface = dem::parseRigidFloor(root["floor"]).height_m;
+    } else {
+        root["rig"]["clearance_above_bed_m"].fail(
+            "a clearance above the bed needs a bed: a `soil:` section (grainlink dem-node) or "
+            "a `floor:` (grainlink floor-node)");
+    }
+    body::BodyDescription wheel;
+    wheel.name = s.wheel_name;
+    wheel.geometry = s.wheel;
+    double lowest = 1e300;
+    for (const auto &v : meshOf(wheel).vertices_m)
+        lowest = std::min(lowest, v.z());
+    const double z = surface + *s.clearance_above_bed_m - lowest;
+    std::fprintf(stderr,
+                 "rig: bed surface at z = %.4f m; wheel centre starts at z = %.4f m, its lowest "
+                 "point %.4g mm above it (rig.clearance_above_bed_m)\n",
+                 surface, z, 1000.0 * *s.clearance_above_bed_m);
+    return z;
+}
+
 int runMultibodyNode(const NodeOptions &options) {
     const auto root = config::ConfigNode::loadFile(options.scenario_path);
     if (root.has("rig")) {
-        mbs::SingleWheelRig rig(mbs::parseSingleWheelRig(root["rig"]));
+        auto settings = mbs::parseSingleWheelRig(root["rig"]);
+        if (settings.clearance_above_bed_m)
+            settings.start_position_m.z() = startHeightAboveBed(root, settings);
+        mbs::SingleWheelRig rig(settings);
         return runWindows(root, rig, wheelTestReport(root, rig, options), options);
     }
     const auto model = makeModel(root, options.scenario_path);

@@ -341,6 +341,12 @@ SingleWheelRigSettings parseSingleWheelRig(const config::ConfigNode &node) {
     s.normal_load_kg = node["normal_load_kg"].positive();
     s.horizontal_mass_kg = node.number("horizontal_mass_kg", s.normal_load_kg);
     s.start_position_m = node["start_position_m"].vec3();
+    if (node.has("clearance_above_bed_m")) {
+        s.clearance_above_bed_m = node["clearance_above_bed_m"].number();
+        if (!(*s.clearance_above_bed_m >= 0.0))
+            node["clearance_above_bed_m"].fail("must be >= 0: a wheel started inside the bed "
+                                               "would be pushed out by crushed grains");
+    }
     s.angular_velocity_rad_s = node.number("angular_velocity_rad_s", s.angular_velocity_rad_s);
     s.drawbar_force_N = node.number("drawbar_force_N", 0.0);
     if (node.has("drive_torque_N_m")) {

@@ -18,6 +18,10 @@ struct SingleWheelRigSettings {
     double normal_load_kg = 8.33;            ///< [kg] wheel + carriage mass carried vertically
     double horizontal_mass_kg = 8.33;        ///< [kg] everything that moves with the carriage in x
     Vec3 start_position_m = Vec3(0, 0, 0.5); ///< [m] wheel centre at t = 0
+    /// [m] `clearance_above_bed_m`: the start height is set by the multibody node so that the
+    /// wheel's lowest point is this far above the settled bed (or the rigid floor); it replaces
+    /// the z of start_position_m.
+    std::optional<double> clearance_above_bed_m;
     double angular_velocity_rad_s = 3.0;     ///< [rad/s] driven speed (positive rolls towards +x)
     std::optional<double> drive_torque_N_m;  ///< [N m] torque drive instead of a speed drive
     double drawbar_force_N = 0.0;            ///< [N] horizontal resistance F_R on the carriage

@@ -1,0 +1,53 @@
+#!/usr/bin/python3
+"""rig.clearance_above_bed_m through the whole stack: the multibody node sets the wheel's start
+height from the bed, and the soil, measuring with its own mesh and its own settled surface,
+finds the wheel's lowest point that far above it.
+
+1. DEM soil (wheel_static.yaml with start z 0.5 m and clearance 10 mm): the soil node reports
+   the lowest point 10.00 mm above the bed surface;
+2. rigid floor (wheel_floor.yaml, floor at z = 0, with clearance 5 mm): the 150 mm wheel's
+   centre starts at 0.075 + 0.005 = 0.0800 m, the start wheel_floor.yaml gives by hand.
+Usage: clearance.py GRAINLINK STATIC_YAML FLOOR_YAML WORK"""
+import os
+import shutil
+import subprocess
+import sys
+
+grainlink, static, floor, work = map(os.path.abspath, sys.argv[1:5])
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+failures = []
+
+
+def run(name, text):
+    path = os.path.join(work, name + ".yaml")
+    open(path, "w").write(text)
+    done = subprocess.run([grainlink, "run", path, "--out", os.path.join(work, name),
+                           "--progress-interval", "0"], cwd=work, capture_output=True, text=True)
+    output = done.stdout + done.stderr
+    if done.returncode != 0:
+        failures.append(f"{name}: the run failed:\n{output[-2000:]}")
+    return output
+
+
+text = open(static).read()
+text = text.replace("start_position_m: [0.1, 0.04, 0.095]",
+                    "start_position_m: [0.1, 0.04, 0.5]\n  clearance_above_bed_m: 0.01")
+text = text.replace("end_time_s: 1.5 ", "end_time_s: 0.01")
+output = run("dem", text)
+print("\n".join(line for line in output.splitlines() if "lowest point" in line))
+if "lowest point 10.00 mm above the bed surface" not in output:
+    failures.append("the soil does not find the wheel 10 mm above the bed:\n" + output[-2000:])
+
+text = open(floor).read()
+text = text.replace("start_position_m: [0.0, 0.0, 0.080]",
+                    "start_position_m: [0.0, 0.0, 0.3]\n  clearance_above_bed_m: 0.005")
+text = text.replace("end_time_s: 1.5", "end_time_s: 0.01")
+output = run("floor", text)
+print("\n".join(line for line in output.splitlines() if line.startswith("rig: bed")))
+if "wheel centre starts at z = 0.0800 m" not in output:
+    failures.append("the wheel does not start 5 mm above the floor:\n" + output[-2000:])
+
+if failures:
+    sys.exit("FAILED:\n" + "\n".join(failures))
+print("the rig starts at its clearance above the bed and the floor")
