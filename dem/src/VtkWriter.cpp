@@ -81,7 +81,8 @@ void VtkWriter::writeParticles(const ParticleStore &p, const std::string &path) 
     openOrThrow(out, path + ".partial");
     const std::size_t n = p.size();
     out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
-        << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"0\">\n"
+        << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n
+        << "\">\n"
         << "<Points>\n";
     vectorArray(out, "position_m", n, [&](std::size_t i) { return p.position[i]; });
     out << "</Points>\n<PointData Scalars=\"radius_m\" Vectors=\"velocity_m_s\">\n"
@@ -96,11 +97,18 @@ void VtkWriter::writeParticles(const ParticleStore &p, const std::string &path) 
     vectorArray(out, "angular_velocity_rad_s", n,
                 [&](std::size_t i) { return p.angular_velocity[i]; });
     vectorArray(out, "force_N", n, [&](std::size_t i) { return p.force[i]; });
-    out << "</PointData>\n<Cells>\n"
-        << "<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\"></DataArray>\n"
-        << "<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\"></DataArray>\n"
-        << "<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\"></DataArray>\n"
-        << "</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
+    // One vertex cell per grain: without cells ParaView's default (Surface) view shows nothing.
+    out << "</PointData>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" "
+           "format=\"ascii\">\n";
+    for (std::size_t i = 0; i < n; ++i)
+        out << i << '\n';
+    out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+    for (std::size_t i = 0; i < n; ++i)
+        out << i + 1 << '\n';
+    out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
+    for (std::size_t i = 0; i < n; ++i)
+        out << "1\n"; // VTK_VERTEX
+    out << "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
     commit(out, path);
 }
 

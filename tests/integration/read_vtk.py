@@ -1,0 +1,76 @@
+#!/usr/bin/python3
+"""The ParaView snapshots of a run (tiny.yaml: grains and a plate), read back with Debian's VTK
+(python3-vtk9), the library ParaView is built on:
+- every file of particles.pvd and body_plate.pvd exists, at increasing times;
+- each particle snapshot holds one vertex cell per grain (the count summary.json gives) with the
+  radius, velocity and force
+  arrays, and vtkGeometryFilter — what ParaView's default Surface view runs — turns it into one
+  vertex per grain (a snapshot without cells shows nothing there);
+- each plate snapshot holds the plate's triangles (24 facets: 96 triangles).
+Usage: read_vtk.py GRAINLINK SCENARIO WORK"""
+import os
+import shutil
+import subprocess
+import sys
+import json
+import xml.etree.ElementTree as ET
+
+import vtk
+
+grainlink, scenario, work = map(os.path.abspath, sys.argv[1:4])
+shutil.rmtree(work, ignore_errors=True)
+os.makedirs(work)
+done = subprocess.run([grainlink, "dem", scenario, "--out", os.path.join(work, "out")], cwd=work,
+                      capture_output=True, text=True)
+if done.returncode != 0:
+    sys.exit("FAILED: the run failed:\n" + done.stderr[-2000:])
+folder = os.path.join(work, "out")
+failures = []
+
+
+def collection(name):
+    entries = ET.parse(os.path.join(folder, name)).getroot().iter("DataSet")
+    files = [(float(e.get("timestep")), os.path.join(folder, e.get("file"))) for e in entries]
+    times = [t for t, _ in files]
+    if not files or times != sorted(times) or len(set(times)) != len(times):
+        failures.append(f"{name}: times {times}")
+    for _, f in files:
+        if not os.path.exists(f):
+            failures.append(f"{name} names {f}, which does not exist")
+    return [f for _, f in files]
+
+
+def read(path):
+    reader = vtk.vtkXMLUnstructuredGridReader()
+    reader.SetFileName(path)
+    reader.Update()
+    return reader.GetOutput()
+
+
+grains = json.load(open(os.path.join(folder, "summary.json")))["particles"]
+particles = collection("particles.pvd")
+for path in particles:
+    grid = read(path)
+    n = grid.GetNumberOfPoints()
+    types = {grid.GetCellType(k) for k in range(grid.GetNumberOfCells())}
+    surface = vtk.vtkGeometryFilter()
+    surface.SetInputData(grid)
+    surface.Update()
+    shown = surface.GetOutput().GetNumberOfVerts()
+    arrays = {grid.GetPointData().GetArrayName(k) for k in range(grid.GetPointData().GetNumberOfArrays())}
+    if n != grains or grid.GetNumberOfCells() != n or types != {vtk.VTK_VERTEX} or shown != n:
+        failures.append(f"{path}: {n} points, {grid.GetNumberOfCells()} cells of types {types}, "
+                        f"{shown} shown by the geometry filter")
+    if not {"radius_m", "velocity_m_s", "force_N", "id"} <= arrays:
+        failures.append(f"{path}: point arrays {arrays}")
+print(f"{len(particles)} particle snapshots: {grains} vertex cells each, all shown by "
+      "vtkGeometryFilter")
+plates = collection("body_plate.pvd")
+for path in plates:
+    grid = read(path)
+    types = {grid.GetCellType(k) for k in range(grid.GetNumberOfCells())}
+    if grid.GetNumberOfCells() != 96 or types != {vtk.VTK_TRIANGLE}:
+        failures.append(f"{path}: {grid.GetNumberOfCells()} cells of types {types}")
+print(f"{len(plates)} plate snapshots: 96 triangles each")
+if failures:
+    sys.exit("FAILED:\n" + "\n".join(failures))
