@@ -137,14 +137,17 @@ public:
 
     // The snapshots' times travel in the checkpoint, so a resumed run keeps them in its .pvd.
     void writeCheckpoint(const std::string &directory) override {
-        dem::CheckpointExtras extras{{"dem_offset_s", dem_offset_s_},
-                                     {"snapshots", double(vtk_.count())}};
+        dem::CheckpointExtras extras = dem::scenarioFingerprint(scenario_);
+        extras["dem_offset_s"] = dem_offset_s_;
+        extras["snapshots"] = double(vtk_.count());
         for (int k = 0; k < vtk_.count(); ++k)
             extras["snapshot" + std::to_string(k) + "_s"] = vtk_.times()[std::size_t(k)];
         dem::writeCheckpoint(*sys_, directory + "/soil.bin", extras);
     }
 
     void readCheckpoint(const std::string &directory) override {
+        dem::checkFingerprint(dem::readCheckpointExtras(directory + "/soil.bin"), scenario_,
+                              directory + "/soil.bin");
         const auto extras = dem::readCheckpoint(*sys_, directory + "/soil.bin");
         dem_offset_s_ = extras.at("dem_offset_s");
         std::vector<double> times;

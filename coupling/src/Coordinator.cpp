@@ -562,6 +562,14 @@ struct Coordinator::Impl {
         run.tick = resumed->tick;
         macro_step_ticks = resumed->macro_step_ticks;
         cumulative_mismatch_J = resumed->cumulative_mismatch_J;
+        // Fixed windows: the checkpoint's step is the scenario's, unless the scenario changed
+        // (adaptive stepping varies it on purpose).
+        if (max_step_ticks == 0 && macro_step_ticks != nominal_step_ticks)
+            throw CouplingError("cannot resume from " + directory + ": coupling.macro_step_s was " +
+                                formatSeconds(macro_step_ticks * config.tick_s) +
+                                " s when it was written, is " +
+                                formatSeconds(nominal_step_ticks * config.tick_s) +
+                                " s now; start the run again, or restore the scenario");
         return directory;
     }
 

@@ -64,6 +64,61 @@ double extra(const CheckpointExtras &extras, const std::string &key, const std::
 
 } // namespace
 
+CheckpointExtras scenarioFingerprint(const DemScenario &scenario) {
+    const auto &d = scenario.deposition;
+    CheckpointExtras f{{"simulation.time_step_s", scenario.settings.time_step_s},
+                       {"deposition.count", double(d.count)},
+                       {"deposition.seed", double(d.seed)},
+                       {"deposition.radius (smallest)", d.radius.smallest()},
+                       {"deposition.radius (largest)", d.radius.largest()},
+                       {"material.youngs_modulus_Pa", scenario.material.youngs_modulus_Pa},
+                       {"material.density_kg_m3", scenario.material.density_kg_m3},
+                       {"bodies (count)", double(scenario.bodies.size())}};
+    for (const BodySpec &b : scenario.bodies) {
+        f["bodies." + b.name + " (triangles)"] = double(b.mesh.triangleCount());
+        f["bodies." + b.name + " (size, m)"] = b.mesh.extent().norm();
+    }
+    CheckpointExtras named;
+    for (const auto &[key, value] : f)
+        named["fingerprint:" + key] = value;
+    return named;
+}
+
+void checkFingerprint(const CheckpointExtras &saved, const DemScenario &scenario,
+                      const std::string &path) {
+    const auto now = scenarioFingerprint(scenario);
+    bool any = false;
+    for (const auto &[key, value] : saved)
+        any = any || key.rfind("fingerprint:", 0) == 0;
+    if (!any)
+        return; // written before fingerprints existed
+    std::string changed;
+    const auto differ = [](double a, double b) {
+        return std::abs(a - b) > 1e-12 * std::max(std::abs(a), std::abs(b));
+    };
+    const auto describe = [](double v) {
+        char text[32];
+        std::snprintf(text, sizeof text, "%.6g", v);
+        return std::string(text);
+    };
+    for (const auto &[key, value] : now) {
+        const auto found = saved.find(key);
+        const std::string name = key.substr(std::string("fingerprint:").size());
+        if (found == saved.end())
+            changed += "; " + name + " is new";
+        else if (differ(found->second, value))
+            changed += "; " + name + " was " + describe(found->second) + ", is " + describe(value);
+    }
+    for (const auto &[key, value] : saved)
+        if (key.rfind("fingerprint:", 0) == 0 && !now.count(key))
+            changed += "; " + key.substr(std::string("fingerprint:").size()) + " is gone";
+    if (!changed.empty())
+        throw std::runtime_error("cannot resume from '" + path +
+                                 "': the scenario changed since it was written (" +
+                                 changed.substr(2) +
+                                 "); start the run again, or restore the scenario");
+}
+
 std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progress_interval_s,
                                        bool *from_cache) {
     auto sys = makeSystem(scenario);
@@ -277,6 +332,7 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
             throw std::runtime_error("cannot resume: no checkpoint at '" + checkpoint + "'");
         // Bodies must exist before their state is restored; their start is stored in extras.
         extras = readCheckpointExtras(checkpoint);
+        checkFingerprint(extras, scenario, checkpoint);
         run_start_s = extra(extras, "run_start_s", checkpoint);
         for (std::size_t b = 0; b < scenario.bodies.size(); ++b) {
             RigidBodyState start = scenario.bodies[b].start;
@@ -338,7 +394,7 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
         vtk.write(*sys, 0.0);
 
     auto saveCheckpoint = [&] {
-        CheckpointExtras e;
+        CheckpointExtras e = scenarioFingerprint(scenario);
         e["run_start_s"] = run_start_s;
         for (std::size_t b = 0; b < starts.size(); ++b)
             e["body" + std::to_string(b) + "_start_z_m"] = starts[b].position_m.z();
