@@ -13,18 +13,34 @@ namespace grainlink::dem {
 namespace {
 
 // Version 2 adds the contact pass's thread split, version 3 the neighbour skin in use and the
-// bodies' and planes' loads; versions 1 and 2 are still read.
-constexpr char kMagic[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '3'};
+// bodies' and planes' loads, version 4 a checksum of everything between the magic and the
+// trailer; versions 1 to 3 are still read.
+constexpr char kMagic[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '4'};
+constexpr char kMagicVersion3[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '3'};
 constexpr char kMagicVersion2[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '2'};
 constexpr char kMagicVersion1[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '1'};
+
+/// FNV-1a, 64 bit: a flipped bit anywhere changes it (not a defence against a forger).
+struct Checksum {
+    std::uint64_t value = 14695981039346656037ull;
+    void add(const char *bytes, std::size_t n) {
+        for (std::size_t k = 0; k < n; ++k)
+            value = (value ^ std::uint8_t(bytes[k])) * 1099511628211ull;
+    }
+};
 
 class Writer {
 public:
     explicit Writer(std::ofstream &out) : out_(out) {}
     template <class T> void pod(const T &value) {
         static_assert(std::is_trivially_copyable_v<T>);
-        out_.write(reinterpret_cast<const char *>(&value), sizeof(T));
+        bytes(reinterpret_cast<const char *>(&value), sizeof(T));
     }
+    void bytes(const char *data, std::size_t n) {
+        out_.write(data, std::streamsize(n));
+        checksum_.add(data, n);
+    }
+    std::uint64_t checksum() const { return checksum_.value; }
     template <class T> void vec(const std::vector<T> &values) {
         pod<std::uint64_t>(values.size());
         for (const T &v : values)
@@ -64,11 +80,12 @@ public:
     template <class T> std::enable_if_t<std::is_arithmetic_v<T>> item(const T &v) { pod(v); }
     void text(const std::string &s) {
         pod<std::uint64_t>(s.size());
-        out_.write(s.data(), std::streamsize(s.size()));
+        bytes(s.data(), s.size());
     }
 
 private:
     std::ofstream &out_;
+    Checksum checksum_;
 };
 
 class Reader {
@@ -195,6 +212,8 @@ void writeCheckpoint(const DemSystem &system, const std::string &path,
             w.text(key);
             w.pod(value);
         }
+        const std::uint64_t checksum = w.checksum();
+        out.write(reinterpret_cast<const char *>(&checksum), sizeof checksum);
         out.write(kMagic, sizeof kMagic); // trailer: proves the file is complete
         if (!out)
             throw std::runtime_error("failed writing checkpoint '" + temporary + "'");
@@ -227,6 +246,40 @@ template <class T> void requireFinite(const std::vector<T> &items, const char *w
             throw std::runtime_error("checkpoint '" + path + "' is corrupt: a non-finite " + what);
 }
 
+/// Version 4: the checksum of everything between the magic and the stored checksum must match
+/// before a byte of it is believed. Leaves `in` where it was (after the magic).
+void verifyChecksum(std::ifstream &in, const std::string &path) {
+    const std::streampos start = in.tellg();
+    in.seekg(0, std::ios::end);
+    const std::streamoff size = in.tellg();
+    const std::streamoff body = size - std::streamoff(start) - 16; // checksum + trailer
+    if (body < 0)
+        throw std::runtime_error("checkpoint '" + path + "' is truncated");
+    // A cut file has lost its trailer: say so, rather than that its checksum differs.
+    char trailer[8];
+    in.seekg(size - 8);
+    in.read(trailer, sizeof trailer);
+    if (!in || std::memcmp(trailer, kMagic, sizeof trailer) != 0)
+        throw std::runtime_error("checkpoint '" + path + "' is truncated (no trailer)");
+    in.seekg(start);
+    Checksum sum;
+    std::vector<char> buffer(1 << 16);
+    for (std::streamoff left = body; left > 0;) {
+        const auto n = std::streamsize(std::min<std::streamoff>(left, std::streamoff(buffer.size())));
+        in.read(buffer.data(), n);
+        if (!in)
+            throw std::runtime_error("checkpoint '" + path + "' is truncated");
+        sum.add(buffer.data(), std::size_t(n));
+        left -= n;
+    }
+    std::uint64_t stored = 0;
+    in.read(reinterpret_cast<char *>(&stored), sizeof stored);
+    if (!in || stored != sum.value)
+        throw std::runtime_error("checkpoint '" + path +
+                                 "' is damaged: its checksum does not match its contents");
+    in.seekg(start);
+}
+
 CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Internals &s) {
     std::ifstream in(path, std::ios::binary);
     if (!in)
@@ -235,12 +288,15 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
     in.read(magic, sizeof magic);
     int version = 0;
     for (const auto &[known, number] :
-         {std::pair{kMagicVersion1, 1}, std::pair{kMagicVersion2, 2}, std::pair{kMagic, 3}})
+         {std::pair{kMagicVersion1, 1}, std::pair{kMagicVersion2, 2},
+          std::pair{kMagicVersion3, 3}, std::pair{kMagic, 4}})
         if (in && std::memcmp(magic, known, sizeof magic) == 0)
             version = number;
     if (version == 0)
         throw std::runtime_error("'" + path +
-                                 "' is not a grainlink DEM checkpoint (version 1, 2 or 3)");
+                                 "' is not a grainlink DEM checkpoint (version 1 to 4)");
+    if (version >= 4)
+        verifyChecksum(in, path);
     const std::string trailer(magic, sizeof magic);
     Reader r(in, path);
     p.setNextId(r.pod<std::uint64_t>());
@@ -304,6 +360,8 @@ CheckpointExtras load(const std::string &path, ParticleStore &p, DemSystem::Inte
         std::string key = r.text();
         extras[key] = r.pod<double>();
     }
+    if (version >= 4)
+        r.pod<std::uint64_t>(); // the checksum, verified before anything was read
     in.read(magic, sizeof magic);
     if (!in || std::memcmp(magic, trailer.data(), sizeof magic) != 0)
         throw std::runtime_error("checkpoint '" + path + "' is truncated (no trailer)");

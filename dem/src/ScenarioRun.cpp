@@ -318,7 +318,10 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
     RunSummary summary;
     const fs::path out = options.output_directory;
     fs::create_directories(out);
-    const std::string checkpoint = (out / "checkpoint.bin").string();
+    const std::string latest = (out / "checkpoint.bin").string();
+    std::string checkpoint = latest; // the one a resume reads
+    // The one before the latest, kept so that a damaged latest one costs an interval, not the run.
+    const std::string previous = (out / "checkpoint.previous.bin").string();
     const std::string series_path = (out / "series.csv").string();
     auto sys = makeSystem(scenario);
     const double dt = scenario.settings.time_step_s;
@@ -328,10 +331,19 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
     double run_start_s = 0.0;
     std::vector<RigidBodyState> starts;
     if (options.resume) {
-        if (!fs::exists(checkpoint))
+        if (!fs::exists(checkpoint) && !fs::exists(previous))
             throw std::runtime_error("cannot resume: no checkpoint at '" + checkpoint + "'");
         // Bodies must exist before their state is restored; their start is stored in extras.
-        extras = readCheckpointExtras(checkpoint);
+        try {
+            extras = readCheckpointExtras(checkpoint);
+        } catch (const std::exception &e) {
+            if (!fs::exists(previous))
+                throw;
+            std::fprintf(stderr, "[resume] %s; resuming from the previous checkpoint %s\n",
+                         e.what(), previous.c_str());
+            checkpoint = previous;
+            extras = readCheckpointExtras(checkpoint);
+        }
         checkFingerprint(extras, scenario, checkpoint);
         run_start_s = extra(extras, "run_start_s", checkpoint);
         for (std::size_t b = 0; b < scenario.bodies.size(); ++b) {
@@ -401,7 +413,9 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
         e["snapshots"] = vtk.count();
         for (int k = 0; k < vtk.count(); ++k)
             e["snapshot" + std::to_string(k) + "_s"] = vtk.times()[std::size_t(k)];
-        writeCheckpoint(*sys, checkpoint, e);
+        if (fs::exists(latest))
+            fs::rename(latest, previous);
+        writeCheckpoint(*sys, latest, e);
     };
 
     Progress progress("run", options.progress_interval_s);
@@ -430,8 +444,8 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
         std::ostringstream msg;
         msg << e.what() << "; series so far in " << series_path << ", state at failure in "
             << snapshot;
-        if (fs::exists(checkpoint))
-            msg << ", resume from " << checkpoint << " with --resume";
+        if (fs::exists(latest))
+            msg << ", resume from " << latest << " with --resume";
         throw std::runtime_error(msg.str());
     }
     saveCheckpoint();
@@ -450,7 +464,7 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
          << "  particle-steps/s     " << summary.particle_steps_per_s / 1e6 << " M\n"
          << "  neighbour builds     " << sys->neighbourBuilds() << "\n"
          << "  outputs              " << series_path << ", " << vtk.count()
-         << " snapshots (particles.pvd), " << checkpoint << "\n\n"
+         << " snapshots (particles.pvd), " << latest << "\n\n"
          << sys->timer().table();
     std::fprintf(stderr, "%s", text.str().c_str());
     std::ofstream(out / "summary.txt") << text.str();
