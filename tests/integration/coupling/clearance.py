@@ -10,8 +10,10 @@ finds the wheel's lowest point that far above it.
 Usage: clearance.py GRAINLINK STATIC_YAML FLOOR_YAML WORK"""
 import os
 import shutil
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from coupled_runs import run_variant  # noqa: E402
 
 grainlink, static, floor, work = map(os.path.abspath, sys.argv[1:5])
 shutil.rmtree(work, ignore_errors=True)
@@ -20,11 +22,7 @@ failures = []
 
 
 def run(name, text):
-    path = os.path.join(work, name + ".yaml")
-    open(path, "w").write(text)
-    done = subprocess.run([grainlink, "run", path, "--out", os.path.join(work, name),
-                           "--progress-interval", "0"], cwd=work, capture_output=True, text=True)
-    output = done.stdout + done.stderr
+    done, output = run_variant(grainlink, work, name, text)
     if done.returncode != 0:
         failures.append(f"{name}: the run failed:\n{output[-2000:]}")
     return output

@@ -14,8 +14,10 @@ import csv
 import os
 import re
 import shutil
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from coupled_runs import run_variant  # noqa: E402
 
 grainlink, config, work = map(os.path.abspath, sys.argv[1:4])
 shutil.rmtree(work, ignore_errors=True)
@@ -24,15 +26,11 @@ failures = []
 
 
 def run(name, text):
-    path = os.path.join(work, name + ".yaml")
-    open(path, "w").write(text)
-    out = os.path.join(work, name)
-    done = subprocess.run([grainlink, "run", path, "--out", out, "--progress-interval", "0"],
-                          cwd=work, capture_output=True, text=True)
+    done, output = run_variant(grainlink, work, name, text)
     if done.returncode != 0:
         failures.append(f"{name}: the run failed:\n{done.stderr[-2000:]}")
-    rows = list(csv.DictReader(open(os.path.join(out, "coupling.csv"))))
-    return done.stdout + done.stderr, rows
+    rows = list(csv.DictReader(open(os.path.join(work, name, "coupling.csv"))))
+    return output, rows
 
 
 def share(rows):

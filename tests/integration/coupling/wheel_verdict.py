@@ -11,8 +11,10 @@ Usage: wheel_verdict.py GRAINLINK FLOOR_YAML WORK"""
 import json
 import os
 import shutil
-import subprocess
 import sys
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from coupled_runs import run_variant  # noqa: E402
 
 grainlink, config, work = map(os.path.abspath, sys.argv[1:4])
 shutil.rmtree(work, ignore_errors=True)
@@ -23,12 +25,8 @@ failures = []
 
 def run(name, settings):
     text = base.replace("  run_until: end_time", "").replace("  drive_min_s: 5.0", settings)
-    path = os.path.join(work, name + ".yaml")
-    open(path, "w").write(text)
-    out = os.path.join(work, name)
-    done = subprocess.run([grainlink, "run", path, "--out", out, "--progress-interval", "0"],
-                          cwd=work, capture_output=True, text=True)
-    summary = json.load(open(os.path.join(out, "rig_summary.json")))
+    done, _ = run_variant(grainlink, work, name, text)
+    summary = json.load(open(os.path.join(work, name, "rig_summary.json")))
     print(f"{name}: exit status {done.returncode}; {summary['message']}")
     return done, summary
 
