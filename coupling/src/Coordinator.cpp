@@ -622,6 +622,7 @@ struct Coordinator::Impl {
                 row.cumulative_mismatch_J = cumulative_mismatch_J;
                 row.wall_s = sockets::secondsSince(window_started);
                 series->append(row, scheme->states(), scheme->wrenches()); // queued, cheap
+                series->check(); // a row the writer could not write stops the run
             }
             run.tick += step;
             ++run.window;

@@ -1,5 +1,10 @@
 #include "CouplingSeries.hpp"
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstring>
+
 #include <charconv>
 #include <filesystem>
 #include <fstream>
@@ -42,13 +47,24 @@ CouplingSeries::CouplingSeries(const std::string &directory, const std::vector<s
                 kept.push_back(line);
         }
     }
-    file_ = std::fopen(path_.c_str(), "w");
-    if (!file_)
-        throw CouplingError("cannot write " + path_);
-    std::fprintf(file_, "%s\n", expected_header.c_str());
+    // The kept rows go to a file beside it, synced and renamed over it: a crash while resuming
+    // never loses them. Then rows are appended.
+    const std::string partial = path_ + ".partial";
+    std::FILE *fresh = std::fopen(partial.c_str(), "w");
+    if (!fresh)
+        throw CouplingError("cannot write " + partial + ": " + std::strerror(errno));
+    std::fprintf(fresh, "%s\n", expected_header.c_str());
     for (const auto &line : kept)
-        std::fprintf(file_, "%s\n", line.c_str());
-    std::fflush(file_);
+        std::fprintf(fresh, "%s\n", line.c_str());
+    const bool written = std::fflush(fresh) == 0 && ::fsync(::fileno(fresh)) == 0;
+    const int error = errno;
+    std::fclose(fresh);
+    if (!written || std::rename(partial.c_str(), path_.c_str()) != 0)
+        throw CouplingError("cannot write " + path_ + ": " +
+                            std::strerror(written ? errno : error));
+    file_ = std::fopen(path_.c_str(), "a");
+    if (!file_)
+        throw CouplingError("cannot write " + path_ + ": " + std::strerror(errno));
     writer_ = std::thread([this] { writerLoop(); });
 }
 
@@ -80,8 +96,15 @@ void CouplingSeries::append(const Row &row, const std::vector<BodyState> &states
     e.wrenches.assign(wrenches.begin(), wrenches.end());
 }
 
+void CouplingSeries::check() const {
+    std::lock_guard write_lock(write_mutex_);
+    if (!error_.empty())
+        throw CouplingError(error_);
+}
+
 void CouplingSeries::flush() {
     writeQueued();
+    check();
 }
 
 void CouplingSeries::writerLoop() {
@@ -141,9 +164,11 @@ void CouplingSeries::writeQueued() {
                     put((*v)[k]);
         }
         line_.back() = '\n';
-        std::fwrite(line_.data(), 1, line_.size(), file_);
+        if (std::fwrite(line_.data(), 1, line_.size(), file_) != line_.size() && error_.empty())
+            error_ = "cannot write " + path_ + ": " + std::strerror(errno);
     }
-    std::fflush(file_);
+    if (std::fflush(file_) != 0 && error_.empty())
+        error_ = "cannot write " + path_ + ": " + std::strerror(errno);
     std::lock_guard lock(queue_mutex_);
     for (auto &e : writing_)
         spare_.push_back(std::move(e));

@@ -39,6 +39,9 @@ public:
     void append(const Row &row, const std::vector<BodyState> &states,
                 const std::vector<Wrench> &wrenches);
     void flush();
+    /// Throws, naming the file and the reason, when a row could not be written (a full disk):
+    /// a run must not go on, and end "complete", with its series cut short.
+    void check() const;
 
 private:
     struct Entry {
@@ -55,9 +58,10 @@ private:
     std::vector<Entry> queued_, spare_; ///< spare_: written entries, storage kept for reuse
     bool stop_ = false;
     std::condition_variable wake_;
-    std::mutex write_mutex_;     ///< one writer at a time: rows stay in order
+    mutable std::mutex write_mutex_; ///< one writer at a time: rows stay in order
     std::vector<Entry> writing_; ///< under write_mutex_
     std::string line_;           ///< reused row buffer, under write_mutex_
+    std::string error_;          ///< the first failed write, under write_mutex_
     std::thread writer_;
 };
 

@@ -15,6 +15,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <optional>
@@ -427,6 +428,13 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
             if (done % steps_per_row == 0) {
                 series << seriesRow(*sys, double(done) * dt, loads) << '\n';
                 series.flush();
+                // A full disk: stop with the last complete checkpoint, never end "finished"
+                // with a series cut short.
+                if (!series)
+                    throw std::runtime_error(
+                        "cannot write '" + series_path + "': " + std::strerror(errno) +
+                        (fs::exists(latest) ? "; resume from " + latest + " with --resume"
+                                            : std::string()));
                 ++rows;
                 if (rows_per_checkpoint && rows % rows_per_checkpoint == 0)
                     saveCheckpoint();

@@ -1,6 +1,8 @@
 #include "grainlink/dem/VtkWriter.hpp"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 
@@ -26,7 +28,7 @@ void openOrThrow(std::ofstream &out, const std::string &path) {
 void commit(std::ofstream &out, const std::string &path) {
     out.close();
     if (!out)
-        throw std::runtime_error("failed writing snapshot '" + path + "'");
+        throw std::runtime_error("cannot write snapshot '" + path + "': " + std::strerror(errno));
     if (std::rename((path + ".partial").c_str(), path.c_str()) != 0)
         throw std::runtime_error("cannot rename '" + path + ".partial' to '" + path + "'");
 }
