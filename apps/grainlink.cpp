@@ -126,7 +126,8 @@ int main(int argc, char **argv) {
 
     grainlink::apps::NodeOptions node;
     auto *mbs_node = app.add_subcommand(
-        "mbs-node", "the Simbody single-wheel rig as a multibody participant (started by run)");
+        "mbs-node", "the multibody participant (started by run): the Simbody single-wheel rig, "
+                    "rover, mole or a URDF model, whichever the scenario names");
     auto *dem_node =
         app.add_subcommand("dem-node", "the DEM soil as a soil participant (started by run)");
     auto *floor_node = app.add_subcommand(
@@ -151,7 +152,18 @@ int main(int argc, char **argv) {
     grainlink::apps::StudyCommand study(app);
     grainlink::apps::GapCommand gap(app);
 
+    // --threads on every command that runs grains: it overrides the scenarios' threads, in this
+    // process and in the processes it starts (a run's participants), through GRAINLINK_THREADS.
+    int threads = 0;
+    for (CLI::App *command : {dem, run, lab, soil_table, dem_node})
+        command->add_option("--threads", threads,
+                            "threads per DEM run, overriding the scenario's simulation.threads "
+                            "(default: the scenario's, else OMP_NUM_THREADS, else 1)")
+            ->check(CLI::Range(1, 1024));
+
     CLI11_PARSE(app, argc, argv);
+    if (threads > 0)
+        ::setenv("GRAINLINK_THREADS", std::to_string(threads).c_str(), 1);
     try {
         if (dem->parsed()) {
             const auto scenario = grainlink::dem::loadScenario(scenario_path);

@@ -1,5 +1,8 @@
 #include "grainlink/dem/Scenario.hpp"
 
+#include <algorithm>
+#include <cstdlib>
+#include <cstring>
 #include <sstream>
 
 namespace grainlink::dem {
@@ -402,6 +405,30 @@ BodySpec parseBody(const ConfigNode &node, const std::string &scenario_dir) {
 
 } // namespace
 
+int threadsFor(const ConfigNode &sim) {
+    const int given = int(sim.integer("threads", 1, kMaxThreads, 1)); // checked even if overridden
+    const auto count = [](const char *text) -> int {
+        char *end = nullptr;
+        const long n = std::strtol(text, &end, 10);
+        return end != text && n >= 1 && n <= kMaxThreads ? int(n) : 0;
+    };
+    if (const char *forced = std::getenv("GRAINLINK_THREADS")) {
+        const int n = count(forced);
+        if (n == 0 || *std::find_if(forced, forced + std::strlen(forced),
+                                    [](char c) { return c < '0' || c > '9'; }) != '\0')
+            throw std::invalid_argument(std::string("--threads / GRAINLINK_THREADS = '") + forced +
+                                        "' is not a thread count (1 to " +
+                                        std::to_string(kMaxThreads) + ")");
+        return n;
+    }
+    if (sim.has("threads"))
+        return given;
+    if (const char *omp = std::getenv("OMP_NUM_THREADS")) // "4" or "4,2": the first level
+        if (const int n = count(omp))
+            return n;
+    return 1;
+}
+
 DemScenario loadScenario(const std::string &path) {
     DemScenario s = parseScenario(ConfigNode::loadFile(path));
     s.file = path;
@@ -427,7 +454,7 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
         s.settings.gravity_m_s2 = gravityOf(*g);
     if (const auto g = sim.optional("gravity_m_s2"))
         s.settings.gravity_m_s2 = g->vec3();
-    s.settings.threads = int(sim.integer("threads", 1, kMaxThreads, 1));
+    s.settings.threads = threadsFor(sim);
     s.settings.skin_m = sim.number("skin_m", 0.0);
     s.settings.resort_every_builds = int(sim.integer("resort_every_builds", 0, 1000000, 25));
     s.settings.max_overlap_ratio = sim.number("max_overlap_ratio", 0.4);

@@ -469,7 +469,8 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
          << "  steps                " << summary.steps << " (dt = " << dt << " s)\n"
          << "  simulated time       " << summary.simulated_s << " s\n"
          << "  wall time            " << formatDuration(summary.wall_s) << "\n"
-         << "  particle-steps/s     " << summary.particle_steps_per_s / 1e6 << " M\n"
+         << "  particle-steps/s     " << summary.particle_steps_per_s / 1e6 << " M on "
+         << scenario.settings.threads << " thread(s)\n"
          << "  neighbour builds     " << sys->neighbourBuilds() << "\n"
          << "  outputs              " << series_path << ", " << vtk.count()
          << " snapshots (particles.pvd), " << latest << "\n\n"

@@ -202,3 +202,26 @@ TEST_CASE("wall clearance is a coupled soil's key", "[dem][scenario]") {
           "bad.yaml:16: key 'wall_clearance_m': only a coupled soil (grainlink dem-node) watches "
           "its bodies' clearance to the walls: remove the key");
 }
+
+TEST_CASE("thread count: --threads beats the scenario beats OMP_NUM_THREADS", "[dem][scenario]") {
+    // tiny.yaml gives no threads key; `with` adds `threads: 1`. GRAINLINK_THREADS is what
+    // `--threads N` sets for the command and the processes it starts.
+    const std::string without = kValid;
+    const std::string with = replaced(kValid, "  gravity: mars\n", "  gravity: mars\n  threads: 1\n");
+    const auto threads = [](const std::string &text) {
+        return parseScenario(ConfigNode::loadString(text, "t.yaml")).settings.threads;
+    };
+    ::unsetenv("GRAINLINK_THREADS");
+    ::unsetenv("OMP_NUM_THREADS");
+    CHECK(threads(without) == 1);
+    ::setenv("OMP_NUM_THREADS", "4,2", 1); // nested levels: the first
+    CHECK(threads(without) == 4);
+    CHECK(threads(with) == 1); // the scenario's own count beats the environment's
+    ::setenv("GRAINLINK_THREADS", "3", 1);
+    CHECK(threads(with) == 3); // --threads beats both
+    ::setenv("GRAINLINK_THREADS", "3x", 1);
+    CHECK_THROWS_WITH(threads(with), "--threads / GRAINLINK_THREADS = '3x' is not a thread count "
+                                     "(1 to 1024)");
+    ::unsetenv("GRAINLINK_THREADS");
+    ::unsetenv("OMP_NUM_THREADS");
+}

@@ -71,6 +71,11 @@ constexpr long long kMaxGrains = 50'000'000;
 constexpr long long kMaxThreads = 1024;
 constexpr long long kMaxLayers = 100'000;
 
+/// The thread count of a `simulation` block: `--threads N` (which sets GRAINLINK_THREADS, so
+/// that a run's participant processes follow it too) overrides the scenario's `threads`;
+/// without either, OMP_NUM_THREADS; else 1.
+int threadsFor(const ConfigNode &sim);
+
 /// Reads and validates a scenario; errors name the file, key and line.
 DemScenario loadScenario(const std::string &path);
 /// `coupled`: the soil section of a coupled run (no `run:`; bodies come from the coupling).
