@@ -345,6 +345,8 @@ DepositionSpec parseDeposition(const ConfigNode &node) {
     d.max_settle_time_s = node.number("max_settle_time_s", 5.0);
     if (const auto rolling = node.optional("rolling"))
         d.rolling = parseRolling(*rolling);
+    if (const auto g = node.optional("gravity"))
+        d.gravity_m_s2 = gravityOf(*g);
     parsePreparation(node, d);
     node.finish();
     return d;
@@ -554,7 +556,8 @@ std::string packingKey(const DemScenario &s) {
         << " nu=" << s.material.poisson_ratio << " rho=" << s.material.density_kg_m3
         << "|dt=" << s.settings.time_step_s << " int=" << int(s.settings.integrator) << ','
         << s.settings.newmark_beta << ',' << s.settings.newmark_gamma
-        << " g=" << s.settings.gravity_m_s2.transpose() << " threads=" << s.settings.threads << "|"
+        << " g=" << s.deposition.gravity_m_s2.value_or(s.settings.gravity_m_s2).transpose()
+        << " threads=" << s.settings.threads << "|"
         << s.deposition.describe();
     if (s.contact_wall.any()) // grain-wall contacts shape the packing, grain-tool ones do not
         key << "|contact_wall " << settling_wall.describe();

@@ -124,13 +124,17 @@ std::unique_ptr<DemSystem> prepareSoil(const DemScenario &scenario, double progr
                                        bool *from_cache) {
     auto sys = makeSystem(scenario);
     // deposition.rolling: the packing (settled or cached) is that law's; the run goes on with
-    // its own law, every rolling history starting afresh (docs/scenario.md).
+    // its own law, every rolling history starting afresh (docs/scenario.md). Likewise
+    // deposition.gravity: settled under it, run under simulation.gravity (a slope).
     const auto &settling_rolling = scenario.deposition.rolling;
     if (settling_rolling)
         sys->setRolling(*settling_rolling);
+    if (scenario.deposition.gravity_m_s2)
+        sys->setGravity(*scenario.deposition.gravity_m_s2);
     const auto runLaw = [&] {
         if (settling_rolling)
             sys->setRolling(contactLaws(scenario));
+        sys->setGravity(scenario.settings.gravity_m_s2);
         return std::move(sys);
     };
     const std::string key = packingKey(scenario);

@@ -1,5 +1,6 @@
 // Scenario files: strict validation with file, key and line in every error (docs/scenario.md).
 #include "grainlink/dem/Scenario.hpp"
+#include "grainlink/dem/ScenarioRun.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -224,4 +225,35 @@ TEST_CASE("thread count: --threads beats the scenario beats OMP_NUM_THREADS", "[
                                      "(1 to 1024)");
     ::unsetenv("GRAINLINK_THREADS");
     ::unsetenv("OMP_NUM_THREADS");
+}
+
+TEST_CASE("a slope: the bed settles level and the run tilts gravity", "[dem][scenario]") {
+    // tiny.yaml run on a 20° slope (gravity tilted in x), once with deposition.gravity earth:
+    // its packing is the level bed's, grain for grain (deposited and settled under vertical
+    // gravity), its cache key the level bed's, and the system it hands to the run pulls at
+    // 20°. Without deposition.gravity the grains settle under the tilted gravity: another bed.
+    const double g = 9.81, a = 20.0 * M_PI / 180.0;
+    const std::string tilted = "gravity_m_s2: [" + std::to_string(-g * std::sin(a)) + ", 0, " +
+                               std::to_string(-g * std::cos(a)) + "]";
+    const std::string level_text = replaced(kValid, "gravity: mars", "gravity: earth");
+    const std::string slope_text = replaced(kValid, "gravity: mars", tilted);
+    const std::string settled_level_text =
+        replaced(slope_text, "  count: 100\n", "  count: 100\n  gravity: earth\n");
+    const auto scenario = [](const std::string &text) {
+        DemScenario s = parseScenario(ConfigNode::loadString(text, "slope.yaml"));
+        s.packing_cache_directory = ""; // each settles its own bed
+        s.deposition.max_settle_time_s = 0.3;
+        return s;
+    };
+    const DemScenario level = scenario(level_text), slope = scenario(slope_text),
+                      settled_level = scenario(settled_level_text);
+    CHECK(packingKey(settled_level) == packingKey(level));
+    CHECK(packingKey(slope) != packingKey(level));
+    const auto level_bed = prepareSoil(level, 0.0);
+    const auto slope_bed = prepareSoil(settled_level, 0.0);
+    const auto tilted_bed = prepareSoil(slope, 0.0);
+    CHECK(slope_bed->particles().position == level_bed->particles().position);
+    CHECK(tilted_bed->particles().position != level_bed->particles().position);
+    CHECK(slope_bed->settings().gravity_m_s2.x() == Approx(-g * std::sin(a)).epsilon(1e-6));
+    CHECK(slope_bed->settings().gravity_m_s2.z() == Approx(-g * std::cos(a)).epsilon(1e-6));
 }

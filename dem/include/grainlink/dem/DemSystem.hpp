@@ -65,6 +65,8 @@ public:
     const ContactLaws &laws() const { return laws_; }
     const ContactLaw &law() const { return laws_.grain_grain; } ///< the grain-grain law
     const DemSettings &settings() const { return settings_; }
+    /// The gravity from now on (deposition.gravity: settle level, run on a slope).
+    void setGravity(const Vec3 &gravity_m_s2) { settings_.gravity_m_s2 = gravity_m_s2; }
     const std::vector<Material> &materials() const { return materials_; }
 
     /// Adds a plane; a material left unset (E = 0) is the particles' first material.

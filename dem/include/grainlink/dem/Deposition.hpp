@@ -53,6 +53,9 @@ struct DepositionSpec {
     /// rolling laws. deposit() does not switch laws; its callers do (prepareSoil, the repose
     /// test): DemSystem::setRolling before deposit() and back to the run's law after it.
     std::optional<RollingModel> rolling;
+    /// Gravity while the grains settle and the bed is prepared, if not the run's own: a slope is
+    /// run by tilting the run's gravity on a bed settled level (docs/scenario.md).
+    std::optional<Vec3> gravity_m_s2;
     // The settled bed's preparation, in this order, each followed by settling again
     // (docs/physics.md §6.1): struck off, compacted, given a crust.
     std::optional<double> strike_off_height_m; ///< [m] grains with centres above it go
