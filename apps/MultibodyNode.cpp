@@ -35,6 +35,10 @@ struct Report {
     /// model run to its end time.
     std::function<void(const std::string &directory)> write_checkpoint = [](const auto &) {};
     std::function<void(const std::string &directory)> read_checkpoint = [](const auto &) {};
+    /// The procedure's state at a window's start and back (implicit coupling); none for a
+    /// model run to its end time.
+    std::function<void()> save_state = [] {};
+    std::function<void()> restore_state = [] {};
 };
 
 /// The seed's single-wheel procedure (mbs/WheelTest): rig.csv, the steady-state report
@@ -71,6 +75,9 @@ Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
     r.read_checkpoint = [test](const std::string &directory) {
         test->readCheckpoint(directory + "/wheel_test.txt");
     };
+    auto saved = std::make_shared<std::optional<mbs::WheelTest>>();
+    r.save_state = [test, saved] { *saved = *test; };
+    r.restore_state = [test, saved] { *test = **saved; };
     r.finish = [test, &rig, options] {
         const std::string summary = test->summary(rig.time());
         std::printf("%s\n", summary.c_str());
@@ -130,6 +137,7 @@ public:
           bodies_(model.coupledBodies()), soil_(bodies_.size()) {}
 
     void start(const coupling::RunInfo &run) override {
+        implicit_ = run.scheme == coupling::SchemeKind::Implicit;
         std::filesystem::create_directories(options_.output_directory);
         series_.emplace(options_.output_directory + "/" + report_.series_file, report_.header,
                         run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
@@ -143,7 +151,8 @@ public:
         const auto work = model_.advanceTo(in.end_s);
         coupling::WindowOutputs out;
         out.run_complete = report_.after_window(series_->rows(), soil_);
-        series_->write();
+        if (!implicit_) // implicit: written when the window is accepted (saveState)
+            series_->write();
         const auto states = model_.bodyStates();
         for (std::size_t b = 0; b < bodies_.size(); ++b) {
             out.states.push_back(toCoupling(bodies_[b].name, states[b]));
@@ -153,10 +162,21 @@ public:
         return out;
     }
 
-    void saveState() override { model_.saveState(); }
-    void restoreState() override { model_.restoreState(); }
+    // Implicit coupling repeats a window: the model and the procedure go back to its start,
+    // its rows are written once the next window begins, a rejected try's dropped.
+    void saveState() override {
+        series_->write();
+        model_.saveState();
+        report_.save_state();
+    }
+    void restoreState() override {
+        series_->discard();
+        model_.restoreState();
+        report_.restore_state();
+    }
 
     void writeCheckpoint(const std::string &directory) override {
+        series_->write();
         model_.writeCheckpoint(directory + "/" + report_.checkpoint_file);
         report_.write_checkpoint(directory);
     }
@@ -165,7 +185,10 @@ public:
         report_.read_checkpoint(directory);
     }
 
-    void finish() override { exit_status_ = report_.finish(); }
+    void finish() override {
+        series_->write();
+        exit_status_ = report_.finish();
+    }
     int exitStatus() const { return exit_status_; }
 
 private:
@@ -176,6 +199,7 @@ private:
     std::vector<mbs::Wrench> soil_; ///< the soil's wrenches of the current window
     std::optional<Series> series_;
     int exit_status_ = 0;
+    bool implicit_ = false; ///< implicit coupling: windows may be repeated
 };
 
 int runWindows(const config::ConfigNode &root, mbs::MultibodyModel &model, Report report,

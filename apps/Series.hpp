@@ -28,6 +28,9 @@ public:
     std::ostream &rows() { return rows_; }
     /// Appends the rows given since the last call to the file in one write.
     void write();
+    /// Drops the rows given since the last write (a window repeated by implicit coupling: its
+    /// rejected try's rows never reach the file).
+    void discard() { rows_.str(std::string()); }
 
 private:
     std::string path_;

@@ -61,6 +61,21 @@ public:
                         run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
                                     : std::nullopt);
         first_step_ = sys_->stepCount();
+        implicit_ = run.scheme == coupling::SchemeKind::Implicit;
+    }
+
+    // Implicit coupling repeats a window until the wrenches converge: the DEM goes back to the
+    // window's start bit for bit (DemSystem::State), and so do the node's own records: a
+    // window's rows are written when the next window begins, a rejected try's dropped.
+    void saveState() override {
+        series_->write(); // the previous window was accepted
+        saved_.emplace(Saved{sys_->saveState(), vtk_.count(), vtk_.times(), closest_});
+    }
+    void restoreState() override {
+        series_->discard();
+        sys_->restoreState(saved_->dem);
+        vtk_.resumeAt(saved_->snapshots, saved_->snapshot_times);
+        closest_ = saved_->closest;
     }
 
     coupling::WindowOutputs advance(const coupling::WindowInputs &in) override {
@@ -112,7 +127,8 @@ public:
                             << w.torque_N_m.x() << ',' << w.torque_N_m.y() << ','
                             << w.torque_N_m.z() << ',' << sys_->wallContactCount() << '\n';
         }
-        series_->write();
+        if (!implicit_)
+            series_->write();
         // Particle and wheel snapshots for ParaView (soil.output.snapshot_interval_s), at the
         // first window end past each multiple of the interval.
         const double interval_s = scenario_.output.snapshot_interval_s;
@@ -126,6 +142,7 @@ public:
     }
 
     void finish() override {
+        series_->write();
         if (closest_.body.empty())
             return;
         std::fprintf(stderr,
@@ -137,6 +154,7 @@ public:
 
     // The snapshots' times travel in the checkpoint, so a resumed run keeps them in its .pvd.
     void writeCheckpoint(const std::string &directory) override {
+        series_->write();
         dem::CheckpointExtras extras = dem::scenarioFingerprint(scenario_);
         extras["dem_offset_s"] = dem_offset_s_;
         extras["snapshots"] = double(vtk_.count());
@@ -213,6 +231,14 @@ private:
     std::optional<Series> series_;
     dem::Progress progress_;
     std::uint64_t first_step_ = 0;
+    bool implicit_ = false; ///< implicit coupling: windows may be repeated
+    struct Saved {
+        dem::DemSystem::State dem;
+        int snapshots;
+        std::vector<double> snapshot_times;
+        Closest closest;
+    };
+    std::optional<Saved> saved_; ///< the current window's start (implicit coupling)
 };
 
 } // namespace
@@ -222,6 +248,7 @@ int runSoilNode(const NodeOptions &options) {
     SoilNode node(options, root);
     auto config = soilParticipantConfig(options, root);
     config.capabilities.checkpoint = true;
+    config.capabilities.rollback = true;
     coupling::Participant participant(config);
     coupling::runParticipant(participant, node);
     return 0;
