@@ -82,7 +82,9 @@ Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
         const std::string summary = test->summary(rig.time());
         std::printf("%s\n", summary.c_str());
         std::ofstream(options.output_directory + "/rig_summary.txt") << summary << '\n';
-        test->writeSummaryJson(options.output_directory + "/rig_summary.json", rig.time());
+        const auto &rig_settings = rig.settings();
+        test->writeSummaryJson(options.output_directory + "/rig_summary.json", rig.time(),
+                               rig_settings.normal_load_kg * rig_settings.gravity_m_s2.norm());
         if (test->succeeded())
             return 0;
         std::fprintf(stderr, "%s\n", summary.c_str());

@@ -1,12 +1,17 @@
 #!/usr/bin/python3
 """Plots a coupled single-wheel run (grainlink run scenarios/wheel_demo.yaml): the soil's force
 in travel direction against travel (the seed's Figure 11 view), slip and sinkage against time,
-and the motor torque. Reads RUN_DIR/rig.csv (multibody node) and RUN_DIR/soil.csv (DEM node).
+and the motor torque. Reads RUN_DIR/rig.csv (multibody node), RUN_DIR/soil.csv (DEM node) and,
+when the run reached it, the steady state of RUN_DIR/rig_summary.json: the judged span is
+shaded, its mean ± sd drawn and written on each panel, and the normal load is a line beside the
+support force.
 
 Usage: tools/plot_wheel.py RUN_DIR   -> RUN_DIR/wheel.png
 Runs under Debian's /usr/bin/python3 (python3-matplotlib).
 """
 import csv
+import json
+import os
 import sys
 
 import matplotlib
@@ -33,10 +38,17 @@ def main():
     drive = [r for r in rig if r["phase"] != "drop"]
     t_drive = drive[0]["time_s"] if drive else None
 
+    summary_path = f"{run_dir}/rig_summary.json"
+    summary = json.load(open(summary_path)) if os.path.exists(summary_path) else {}
+    steady = summary.get("steady", False)
+
     fig, axes = plt.subplots(4, 1, figsize=(8, 11))
     if drive:
         axes[0].plot(col(drive, "travel_m"), col(drive, "soil_Fx_N"), lw=0.6, label="F_x (traction)")
         axes[0].plot(col(drive, "travel_m"), col(drive, "soil_Fz_N"), lw=0.6, label="F_z (support)")
+    if "normal_load_N" in summary:
+        load = summary["normal_load_N"]
+        axes[0].axhline(load, color="k", ls=":", lw=0.8, label=f"normal load (weight) {load:.1f} N")
     axes[0].set_xlabel("travel while driving [m]")
     axes[0].set_ylabel("soil force on wheel [N]")
     axes[0].legend(fontsize="small")
@@ -50,9 +62,24 @@ def main():
         axis.set_xlabel("time [s]")
         if t_drive:
             axis.axvline(float(t_drive), color="gray", ls="--", lw=0.8)
+    if steady:
+        # The judged span, and each quantity's mean ± sd over it (sinkage from the soil).
+        start, end = summary["span_s"]
+        for axis, key, scale, unit in ((axes[1], "slip", 1.0, ""),
+                                       (axes[2], "sinkage_m", 1000.0, " mm"),
+                                       (axes[3], "motor_torque_N_m", 1.0, " N m")):
+            axis.axvspan(start, end, color="tab:green", alpha=0.15)
+            if key in summary:
+                v = summary[key]
+                mean, sd = scale * v["mean"], scale * v["sd"]
+                axis.hlines([mean - sd, mean, mean + sd], start, end, colors="tab:green",
+                            linestyles=[":", "-", ":"], lw=1.0)
+                axis.set_title(f"steady: {mean:.3g} ± {sd:.2g}{unit} (se "
+                               f"{scale * v['standard_error']:.2g})", fontsize="small")
     for axis in axes:
         axis.grid(alpha=0.3)
-    fig.suptitle(f"{run_dir}: single-wheel coupled run (dashed: drive starts)")
+    fig.suptitle(f"{run_dir}: single-wheel coupled run (dashed: drive starts"
+                 + ("; shaded: the steady span)" if steady else "; no steady state)"))
     fig.tight_layout()
     fig.savefig(f"{run_dir}/wheel.png", dpi=110)
     print(f"plot: {run_dir}/wheel.png")

@@ -190,7 +190,8 @@ std::string WheelTest::summary(double run_end_s) const {
     return text;
 }
 
-void WheelTest::writeSummaryJson(const std::string &path, double run_end_s) const {
+void WheelTest::writeSummaryJson(const std::string &path, double run_end_s,
+                                 double normal_load_N) const {
     using nlohmann::json;
     const auto value = [](const SteadyValue &v) {
         return json{{"mean", v.mean}, {"sd", v.sd}, {"standard_error", v.standard_error}};
@@ -204,7 +205,8 @@ void WheelTest::writeSummaryJson(const std::string &path, double run_end_s) cons
     json j{{"steady", r.reached},
            {"phase", phaseName()},
            {"message", summary(run_end_s)},
-           {"run_end_s", run_end_s}};
+           {"run_end_s", run_end_s},
+           {"normal_load_N", normal_load_N}};
     if (phase_ != Phase::Drop) {
         j["drive_start_s"] = drive_start_s_;
         j["span_s"] = {r.span_start_s, r.time_s};

@@ -221,7 +221,7 @@ TEST_CASE("Wheel test: a phase past its maximum fails", "[mbs][procedure]") {
         CHECK_FALSE(drift.consistent_with_zero);
     }
     // The JSON summary says the same for a script: not steady, the phase, the message.
-    test.writeSummaryJson(dir + "/rig_summary.json", end);
+    test.writeSummaryJson(dir + "/rig_summary.json", end, 0.0);
     const auto json = nlohmann::json::parse(std::ifstream(dir + "/rig_summary.json"));
     CHECK(json["steady"] == false);
     CHECK(json["phase"] == test.phaseName());
@@ -239,11 +239,12 @@ TEST_CASE("Wheel test: the JSON summary of a steady run", "[mbs][procedure]") {
     const std::string path = (std::filesystem::temp_directory_path() /
                               ("grainlink-rig-summary-" + std::to_string(::getpid()) + ".json"))
                                  .string();
-    p.test.writeSummaryJson(path, 0.8);
+    p.test.writeSummaryJson(path, 0.8, 81.7);
     const auto json = nlohmann::json::parse(std::ifstream(path));
     std::filesystem::remove(path);
     CHECK(json["steady"] == true);
     CHECK(json["phase"] == "steady");
+    CHECK(json["normal_load_N"].get<double>() == 81.7);
     CHECK(json["slip"]["mean"].get<double>() == Approx(0.25));
     CHECK(json["drawbar_pull_N"]["mean"].get<double>() == Approx(-4.0));
     CHECK(json["drawbar_pull_N"]["standard_error"].get<double>() == Approx(0.0).margin(1e-12));

@@ -77,8 +77,9 @@ public:
     /// The closing report: the steady values, or why there are none (a phase past its maximum,
     /// or the run ended at `run_end_s` before the procedure did) and what was still changing.
     std::string summary(double run_end_s) const;
-    /// The same as JSON (rig_summary.json: docs/scenario.md), for studies and scripts.
-    void writeSummaryJson(const std::string &path, double run_end_s) const;
+    /// The same as JSON (rig_summary.json: docs/scenario.md), for studies and scripts, with
+    /// the rig's normal load (its weight) for comparison with the vertical force.
+    void writeSummaryJson(const std::string &path, double run_end_s, double normal_load_N) const;
     bool failed() const { return !failure_.empty(); }
     /// Whether the run that ended at `run_end_s` did what the procedure asks (the node's exit
     /// status follows it).
