@@ -1,10 +1,13 @@
 #include "grainlink/dem/VtkWriter.hpp"
 
 #include <cerrno>
+#include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
 #include <stdexcept>
+#include <type_traits>
+#include <vector>
 
 namespace grainlink::dem {
 
@@ -14,13 +17,6 @@ std::string numbered(const std::string &prefix, int index) {
     char name[64];
     std::snprintf(name, sizeof name, "%s_%06d.vtu", prefix.c_str(), index);
     return name;
-}
-
-void openOrThrow(std::ofstream &out, const std::string &path) {
-    out.open(path);
-    if (!out)
-        throw std::runtime_error("cannot write snapshot '" + path + "'");
-    out.precision(9);
 }
 
 /// Completes a snapshot written to `path`.partial: renamed over `path` in one step, so a crash
@@ -33,45 +29,103 @@ void commit(std::ofstream &out, const std::string &path) {
         throw std::runtime_error("cannot rename '" + path + ".partial' to '" + path + "'");
 }
 
-template <class Get>
-void vectorArray(std::ofstream &out, const char *name, std::size_t n, Get get) {
-    out << "<DataArray type=\"Float64\" Name=\"" << name
-        << "\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i) {
-        const Vec3 v = get(i);
-        out << v.x() << ' ' << v.y() << ' ' << v.z() << '\n';
+/// One .vtu file: its arrays are collected, then written as VTK XML with the data appended raw
+/// (binary, little-endian, each array a UInt64 byte count and its bytes): a 62,000-grain
+/// snapshot takes about a third of the ASCII size and keeps every number to the bit.
+class VtuFile {
+public:
+    enum class Section { Points, PointData, CellData, Cells };
+
+    template <class T>
+    void add(Section section, const char *type, const char *name, int components,
+             const std::vector<T> &values) {
+        static_assert(std::is_trivially_copyable_v<T>);
+        Array a{section, type, name, components, {}};
+        a.bytes.resize(values.size() * sizeof(T));
+        if (!values.empty())
+            std::memcpy(a.bytes.data(), values.data(), a.bytes.size());
+        arrays_.push_back(std::move(a));
     }
-    out << "</DataArray>\n";
-}
+    void vectors(Section section, const char *name, const std::vector<Vec3> &values) {
+        std::vector<double> flat;
+        flat.reserve(3 * values.size());
+        for (const Vec3 &v : values)
+            flat.insert(flat.end(), {v.x(), v.y(), v.z()});
+        add(section, "Float64", name, 3, flat);
+    }
+
+    void write(const std::string &path, std::size_t points, std::size_t cells,
+               const std::string &point_scalars = "") const {
+        std::ofstream out(path + ".partial", std::ios::binary);
+        if (!out)
+            throw std::runtime_error("cannot write snapshot '" + path + "'");
+        out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
+               "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n"
+            << "<Piece NumberOfPoints=\"" << points << "\" NumberOfCells=\"" << cells << "\">\n";
+        std::uint64_t offset = 0;
+        const auto section = [&](Section which, const std::string &open, const std::string &close) {
+            bool any = false;
+            for (const Array &a : arrays_)
+                any = any || a.section == which;
+            if (!any && which != Section::Points && which != Section::Cells)
+                return;
+            out << open;
+            for (const Array &a : arrays_)
+                if (a.section == which) {
+                    out << "<DataArray type=\"" << a.type << "\" Name=\"" << a.name
+                        << "\" NumberOfComponents=\"" << a.components
+                        << "\" format=\"appended\" offset=\"" << offset << "\"/>\n";
+                    offset += sizeof(std::uint64_t) + a.bytes.size();
+                }
+            out << close;
+        };
+        section(Section::Points, "<Points>\n", "</Points>\n");
+        section(Section::PointData,
+                point_scalars.empty() ? "<PointData>\n"
+                                      : "<PointData Scalars=\"" + point_scalars + "\">\n",
+                "</PointData>\n");
+        section(Section::CellData, "<CellData>\n", "</CellData>\n");
+        section(Section::Cells, "<Cells>\n", "</Cells>\n");
+        out << "</Piece>\n</UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_";
+        for (const Section which :
+             {Section::Points, Section::PointData, Section::CellData, Section::Cells})
+            for (const Array &a : arrays_)
+                if (a.section == which) {
+                    const std::uint64_t size = a.bytes.size();
+                    out.write(reinterpret_cast<const char *>(&size), sizeof size);
+                    out.write(a.bytes.data(), std::streamsize(a.bytes.size()));
+                }
+        out << "\n</AppendedData>\n</VTKFile>\n";
+        commit(out, path);
+    }
+
+private:
+    struct Array {
+        Section section;
+        const char *type;
+        const char *name;
+        int components;
+        std::vector<char> bytes;
+    };
+    std::vector<Array> arrays_;
+};
 
 void writeMesh(const MeshBody &body, const std::string &path) {
-    std::ofstream out;
-    openOrThrow(out, path + ".partial");
-    const auto &v = body.worldVertices();
     const auto &t = body.mesh().triangles;
-    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
-        << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << v.size() << "\" NumberOfCells=\""
-        << t.size() << "\">\n<Points>\n";
-    vectorArray(out, "position_m", v.size(), [&](std::size_t i) { return v[i]; });
-    out << "</Points>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" "
-           "format=\"ascii\">\n";
-    for (const auto &tri : t)
-        out << tri[0] << ' ' << tri[1] << ' ' << tri[2] << '\n';
-    out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t k = 0; k < t.size(); ++k)
-        out << 3 * (k + 1) << '\n';
-    out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-    for (std::size_t k = 0; k < t.size(); ++k)
-        out << "5\n"; // VTK_TRIANGLE
-    out << "</DataArray>\n</Cells>\n";
-    if (body.record_triangle_loads) {
-        out << "<CellData>\n";
-        vectorArray(out, "force_N", t.size(),
-                    [&](std::size_t k) { return body.triangle_force_N[k]; });
-        out << "</CellData>\n";
+    VtuFile file;
+    file.vectors(VtuFile::Section::Points, "position_m", body.worldVertices());
+    std::vector<std::int64_t> connectivity, offsets;
+    for (const auto &tri : t) {
+        connectivity.insert(connectivity.end(), {tri[0], tri[1], tri[2]});
+        offsets.push_back(std::int64_t(connectivity.size()));
     }
-    out << "</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-    commit(out, path);
+    file.add(VtuFile::Section::Cells, "Int64", "connectivity", 1, connectivity);
+    file.add(VtuFile::Section::Cells, "Int64", "offsets", 1, offsets);
+    file.add(VtuFile::Section::Cells, "UInt8", "types", 1,
+             std::vector<std::uint8_t>(t.size(), 5)); // VTK_TRIANGLE
+    if (body.record_triangle_loads)
+        file.vectors(VtuFile::Section::CellData, "force_N", body.triangle_force_N);
+    file.write(path, body.worldVertices().size(), t.size());
 }
 
 } // namespace
@@ -79,39 +133,26 @@ void writeMesh(const MeshBody &body, const std::string &path) {
 VtkWriter::VtkWriter(std::string directory) : directory_(std::move(directory)) {}
 
 void VtkWriter::writeParticles(const ParticleStore &p, const std::string &path) {
-    std::ofstream out;
-    openOrThrow(out, path + ".partial");
     const std::size_t n = p.size();
-    out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\">\n"
-        << "<UnstructuredGrid>\n<Piece NumberOfPoints=\"" << n << "\" NumberOfCells=\"" << n
-        << "\">\n"
-        << "<Points>\n";
-    vectorArray(out, "position_m", n, [&](std::size_t i) { return p.position[i]; });
-    out << "</Points>\n<PointData Scalars=\"radius_m\" Vectors=\"velocity_m_s\">\n"
-        << "<DataArray type=\"Int64\" Name=\"id\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i)
-        out << p.id[i] << '\n';
-    out << "</DataArray>\n<DataArray type=\"Float64\" Name=\"radius_m\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i)
-        out << p.radius[i] << '\n';
-    out << "</DataArray>\n";
-    vectorArray(out, "velocity_m_s", n, [&](std::size_t i) { return p.velocity[i]; });
-    vectorArray(out, "angular_velocity_rad_s", n,
-                [&](std::size_t i) { return p.angular_velocity[i]; });
-    vectorArray(out, "force_N", n, [&](std::size_t i) { return p.force[i]; });
+    VtuFile file;
+    file.vectors(VtuFile::Section::Points, "position_m", p.position);
+    std::vector<std::int64_t> ids(p.id.begin(), p.id.end());
+    file.add(VtuFile::Section::PointData, "Int64", "id", 1, ids);
+    file.add(VtuFile::Section::PointData, "Float64", "radius_m", 1, p.radius);
+    file.vectors(VtuFile::Section::PointData, "velocity_m_s", p.velocity);
+    file.vectors(VtuFile::Section::PointData, "angular_velocity_rad_s", p.angular_velocity);
+    file.vectors(VtuFile::Section::PointData, "force_N", p.force);
     // One vertex cell per grain: without cells ParaView's default (Surface) view shows nothing.
-    out << "</PointData>\n<Cells>\n<DataArray type=\"Int64\" Name=\"connectivity\" "
-           "format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i)
-        out << i << '\n';
-    out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i)
-        out << i + 1 << '\n';
-    out << "</DataArray>\n<DataArray type=\"UInt8\" Name=\"types\" format=\"ascii\">\n";
-    for (std::size_t i = 0; i < n; ++i)
-        out << "1\n"; // VTK_VERTEX
-    out << "</DataArray>\n</Cells>\n</Piece>\n</UnstructuredGrid>\n</VTKFile>\n";
-    commit(out, path);
+    std::vector<std::int64_t> connectivity(n), offsets(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        connectivity[i] = std::int64_t(i);
+        offsets[i] = std::int64_t(i + 1);
+    }
+    file.add(VtuFile::Section::Cells, "Int64", "connectivity", 1, connectivity);
+    file.add(VtuFile::Section::Cells, "Int64", "offsets", 1, offsets);
+    file.add(VtuFile::Section::Cells, "UInt8", "types", 1,
+             std::vector<std::uint8_t>(n, 1)); // VTK_VERTEX
+    file.write(path, n, n, "radius_m");
 }
 
 void VtkWriter::write(const DemSystem &system, double time_s) {

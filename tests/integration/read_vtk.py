@@ -6,7 +6,9 @@
   radius, velocity and force
   arrays, and vtkGeometryFilter — what ParaView's default Surface view runs — turns it into one
   vertex per grain (a snapshot without cells shows nothing there);
-- each plate snapshot holds the plate's triangles (24 facets: 96 triangles).
+- the binary (appended raw) numbers decode to what the scenario allows: every radius within
+  tiny.yaml's 3.5-4.5 mm, every grain centre inside its 60 x 60 mm bin;
+- each plate snapshot holds the plate's triangles (24 facets: 96 triangles) and their loads.
 Usage: read_vtk.py GRAINLINK SCENARIO WORK"""
 import os
 import shutil
@@ -63,13 +65,21 @@ for path in particles:
                         f"{shown} shown by the geometry filter")
     if not {"radius_m", "velocity_m_s", "force_N", "id"} <= arrays:
         failures.append(f"{path}: point arrays {arrays}")
+        continue
+    radius = grid.GetPointData().GetArray("radius_m").GetRange()
+    bounds = grid.GetBounds()
+    if not (0.0035 <= radius[0] <= radius[1] <= 0.0045):
+        failures.append(f"{path}: radii {radius} outside 3.5-4.5 mm")
+    if not (0.0 < bounds[0] and bounds[1] < 0.06 and 0.0 < bounds[2] and bounds[3] < 0.06):
+        failures.append(f"{path}: grain centres {bounds} outside the bin")
 print(f"{len(particles)} particle snapshots: {grains} vertex cells each, all shown by "
       "vtkGeometryFilter")
 plates = collection("body_plate.pvd")
 for path in plates:
     grid = read(path)
     types = {grid.GetCellType(k) for k in range(grid.GetNumberOfCells())}
-    if grid.GetNumberOfCells() != 96 or types != {vtk.VTK_TRIANGLE}:
+    if grid.GetNumberOfCells() != 96 or types != {vtk.VTK_TRIANGLE} or \
+            grid.GetCellData().GetArray("force_N") is None:
         failures.append(f"{path}: {grid.GetNumberOfCells()} cells of types {types}")
 print(f"{len(plates)} plate snapshots: 96 triangles each")
 if failures:
