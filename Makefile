@@ -3,7 +3,7 @@ BUILD ?= build
 JOBS ?= $(shell nproc)
 CMAKE_FLAGS ?=
 
-.PHONY: deps configure build demo test bench gap-selftest asan-build asan fuzz tsan soak clean
+.PHONY: deps configure build demo test install bench gap-selftest asan-build asan fuzz tsan soak clean
 
 deps:
 	@scripts/install-deps
@@ -19,6 +19,11 @@ demo: build
 
 test: build
 	@cd $(BUILD) && ctest --output-on-failure -j $(JOBS)
+
+# The program and the files it ships under PREFIX (bin/grainlink, share/grainlink/...).
+PREFIX ?= /usr/local
+install: build
+	@cmake --install $(BUILD) --prefix $(PREFIX)
 
 bench: build
 	@bench/run-all $(BUILD)

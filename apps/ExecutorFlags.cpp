@@ -1,11 +1,33 @@
 #include "ExecutorFlags.hpp"
 
+#include <cstdlib>
 #include <filesystem>
+#include <stdexcept>
+#include <vector>
 
 namespace grainlink::apps {
 
 std::string thisExecutable() {
     return std::filesystem::read_symlink("/proc/self/exe").string();
+}
+
+std::string shipped(const std::string &relative) {
+    namespace fs = std::filesystem;
+    const fs::path exe = fs::path(thisExecutable()).parent_path();
+    std::vector<fs::path> places;
+    if (const char *share = std::getenv("GRAINLINK_SHARE"))
+        places.push_back(fs::path(share) / relative);
+    for (const fs::path &p : {exe / ".." / "share" / "grainlink" / relative,
+                              exe / ".." / ".." / relative, fs::path(relative)})
+        places.push_back(p);
+    std::string looked;
+    for (const fs::path &p : places) {
+        if (fs::exists(p))
+            return fs::canonical(p).string();
+        looked += (looked.empty() ? "" : ", ") + p.lexically_normal().string();
+    }
+    throw std::runtime_error("cannot find the shipped file " + relative + " (looked in: " +
+                             looked + "); set GRAINLINK_SHARE to the folder that holds it");
 }
 
 void ExecutorFlags::addTo(CLI::App &command) {

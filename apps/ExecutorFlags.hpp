@@ -14,6 +14,12 @@ namespace grainlink::apps {
 /// The running grainlink program (the study runner starts its points with it).
 std::string thisExecutable();
 
+/// A file the program ships (data/..., tools/..., scenarios/gap/...), found where it is, not
+/// where the user stands: under $GRAINLINK_SHARE when set, beside the installed program
+/// (<prefix>/share/grainlink), in the source tree of a build (build/apps/grainlink), or under
+/// the current directory. Throws naming every place it looked.
+std::string shipped(const std::string &relative);
+
 struct ExecutorFlags {
     std::string executor = "local";
     int jobs = 1;

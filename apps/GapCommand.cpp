@@ -20,19 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 
-/// A file the program ships (data/..., tools/...): beside the installed program
-/// (<prefix>/share/grainlink), in the source tree of a build (build/apps/grainlink), or under
-/// the current directory.
-std::string shipped(const std::string &relative) {
-    const fs::path exe = fs::path(thisExecutable()).parent_path();
-    for (const fs::path &p : {exe / ".." / "share" / "grainlink" / relative,
-                              exe / ".." / ".." / relative, fs::path(relative)})
-        if (fs::exists(p))
-            return fs::canonical(p).string();
-    throw std::runtime_error("cannot find " + relative + " beside " + exe.string() +
-                             " nor in the current directory");
-}
-
 std::string duration(double s) {
     char text[32];
     if (s < 0.0 || !std::isfinite(s))

@@ -10,7 +10,7 @@ struct ParamsOptions {
     std::string output_path; ///< .yaml or .csv; empty: out/params/<input stem>.yaml
     std::optional<double> friction_angle_deg; ///< psi: invert the soil table (docs/lab.md)
     std::optional<double> repose_angle_deg;   ///< with it, also match the angle of repose
-    std::string table_path = "data/soil_table.csv";
+    std::string table_path; ///< empty: the shipped data/soil_table.csv (apps::shipped)
 };
 /// Prints Lambda_P and a `soil:` block, writes the matrix; returns the exit code.
 int runParams(const ParamsOptions &options);

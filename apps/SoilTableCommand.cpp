@@ -1,5 +1,6 @@
 // `grainlink soil-table SPEC.yaml --out FILE.csv` (the lookup table) and the table's inversion
 // behind `grainlink params --friction-angle PSI` (docs/lab.md).
+#include "ExecutorFlags.hpp"
 #include "LabCommands.hpp"
 
 #include "grainlink/lab/SoilTable.hpp"
@@ -22,7 +23,8 @@ int runSoilTable(const SoilTableCommandOptions &options) {
 }
 
 int runTableInversion(const ParamsOptions &options) {
-    const auto table = lab::readSoilTable(options.table_path);
+    const auto table = lab::readSoilTable(
+        options.table_path.empty() ? shipped("data/soil_table.csv") : options.table_path);
     const auto inversion =
         lab::invertSoilTable(table, *options.friction_angle_deg, options.repose_angle_deg);
     std::printf("Soil table %s: phi %g..%g deg, gamma %g..%g deg\n", table.file.c_str(),

@@ -92,7 +92,7 @@ int main(int argc, char **argv) {
     params->add_option("--repose-angle", params_options.repose_angle_deg,
                        "with --friction-angle: also match this angle of repose [deg]");
     params->add_option("--table", params_options.table_path,
-                       "soil table CSV (default data/soil_table.csv)");
+                       "soil table CSV (default: the data/soil_table.csv grainlink ships)");
     params->add_option("--out", params_options.output_path,
                        "matrix file, .yaml or .csv (default out/params/<name>.yaml)");
 

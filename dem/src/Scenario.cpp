@@ -473,7 +473,11 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
         for (const ConfigNode &w : walls->items())
             parseWall(w, s.material, s.planes);
     s.deposition = parseDeposition(root["deposition"]);
-    s.packing_cache_directory = root.text("packing_cache_directory", ".cache/packings");
+    // The cache's place: the scenario's key, else GRAINLINK_PACKING_CACHE (one cache for every
+    // scenario and folder of a user), else .cache/packings under the working folder.
+    const char *cache = std::getenv("GRAINLINK_PACKING_CACHE");
+    s.packing_cache_directory =
+        root.text("packing_cache_directory", cache ? cache : ".cache/packings");
     if (const auto bodies = root.optional("bodies"))
         for (const ConfigNode &b : bodies->items()) {
             s.bodies.push_back(parseBody(b, dir));
