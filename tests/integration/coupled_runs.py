@@ -14,3 +14,20 @@ def run_variant(grainlink, work, name, text, *extra):
                            "--progress-interval", "0", *extra], cwd=work, capture_output=True,
                           text=True)
     return done, done.stdout + done.stderr
+
+
+def two_mass(end_time_s, macro_step_s, extra=""):
+    """The two-mass problem (examples/two_mass) coupled explicitly: the smallest coupled run, for
+    checks of the machinery rather than of physics. `extra`: more `coupling:` lines."""
+    return f"""coupling:
+  scheme: explicit-serial
+  end_time_s: {end_time_s}
+  macro_step_s: {macro_step_s}
+{extra}participants:
+  - name: mbs
+    role: multibody
+    command: [grainlink-two-mass-node, --side, multibody, --name, "{{name}}", --endpoint, "{{endpoint}}"]
+  - name: soil
+    role: soil
+    command: [grainlink-two-mass-node, --side, soil, --name, "{{name}}", --endpoint, "{{endpoint}}"]
+"""

@@ -13,6 +13,9 @@ import signal
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from coupled_runs import two_mass  # noqa: E402
+
 grainlink, tiny, work = map(os.path.abspath, sys.argv[1:4])
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
@@ -38,20 +41,9 @@ print(f"dem: exit {code}: {last}")
 if code == 0 or "File too large" not in last or "cannot write" not in last:
     failures.append("grainlink dem did not stop on the full disk by name")
 
-two_mass = os.path.join(work, "two_mass.yaml")
-open(two_mass, "w").write("""coupling:
-  scheme: explicit-serial
-  end_time_s: 20.0
-  macro_step_s: 0.001
-participants:
-  - name: mbs
-    role: multibody
-    command: [grainlink-two-mass-node, --side, multibody, --name, "{name}", --endpoint, "{endpoint}"]
-  - name: soil
-    role: soil
-    command: [grainlink-two-mass-node, --side, soil, --name, "{name}", --endpoint, "{endpoint}"]
-""")
-code, last = run(["run", two_mass, "--out", "coupled", "--progress-interval", "0"], 65536)
+coupled = os.path.join(work, "two_mass.yaml")
+open(coupled, "w").write(two_mass(20.0, 0.001))
+code, last = run(["run", coupled, "--out", "coupled", "--progress-interval", "0"], 65536)
 print(f"run: exit {code}: {last}")
 if code == 0 or "coupling.csv: File too large" not in last:
     failures.append("grainlink run did not stop on the full disk by name")

@@ -9,6 +9,9 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from coupled_runs import two_mass  # noqa: E402
+
 build, work = map(os.path.abspath, sys.argv[1:3])
 shutil.rmtree(work, ignore_errors=True)
 prefix, elsewhere = os.path.join(work, "prefix"), os.path.join(work, "elsewhere")
@@ -26,18 +29,7 @@ table = os.path.join(prefix, "share", "grainlink", "data", "soil_table.csv")
 print(params.stdout.splitlines()[0] if params.stdout else params.stderr[-500:])
 if params.returncode != 0 or f"Soil table {table}:" not in params.stdout:
     failures.append("the installed params did not use the shipped soil table:\n" + params.stderr)
-open(os.path.join(elsewhere, "two_mass.yaml"), "w").write("""coupling:
-  scheme: explicit-serial
-  end_time_s: 0.1
-  macro_step_s: 0.01
-participants:
-  - name: mbs
-    role: multibody
-    command: [grainlink-two-mass-node, --side, multibody, --name, "{name}", --endpoint, "{endpoint}"]
-  - name: soil
-    role: soil
-    command: [grainlink-two-mass-node, --side, soil, --name, "{name}", --endpoint, "{endpoint}"]
-""")
+open(os.path.join(elsewhere, "two_mass.yaml"), "w").write(two_mass(0.1, 0.01))
 run = subprocess.run([grainlink, "run", "two_mass.yaml", "--out", "out", "--progress-interval",
                       "0"], cwd=elsewhere, capture_output=True, text=True, env=env)
 if run.returncode != 0:

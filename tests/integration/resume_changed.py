@@ -12,6 +12,9 @@ import shutil
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from coupled_runs import two_mass  # noqa: E402
+
 grainlink, tiny, work = map(os.path.abspath, sys.argv[1:4])
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
@@ -47,23 +50,11 @@ if resumed.returncode == 0 or not all(e in message for e in expected):
 if open(os.path.join(work, "dem", "series.csv")).read() != series:
     failures.append("the refused resume changed series.csv")
 
-two_mass = """coupling:
-  scheme: explicit-serial
-  end_time_s: 0.3
-  macro_step_s: 0.01
-  checkpoint_every_windows: 10
-participants:
-  - name: mbs
-    role: multibody
-    command: [grainlink-two-mass-node, --side, multibody, --name, "{name}", --endpoint, "{endpoint}"]
-  - name: soil
-    role: soil
-    command: [grainlink-two-mass-node, --side, soil, --name, "{name}", --endpoint, "{endpoint}"]
-"""
-if run("run", write("two_mass.yaml", two_mass), "--out", "coupled",
+coupled = two_mass(0.3, 0.01, "  checkpoint_every_windows: 10\n")
+if run("run", write("two_mass.yaml", coupled), "--out", "coupled",
        "--progress-interval", "0").returncode != 0:
     failures.append("the two-mass run failed")
-shorter = two_mass.replace("macro_step_s: 0.01", "macro_step_s: 0.005")
+shorter = coupled.replace("macro_step_s: 0.01", "macro_step_s: 0.005")
 resumed = run("run", write("two_mass_changed.yaml", shorter), "--out", "coupled", "--resume",
               "--progress-interval", "0")
 output = resumed.stdout + resumed.stderr
