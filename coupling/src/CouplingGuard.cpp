@@ -79,11 +79,11 @@ std::optional<GuardWarning> CouplingGuard::afterWindow(double work_multibody_J, 
         double lowest = 1.0;
         std::size_t component = 0;
         for (std::size_t c = 0; c < span_.front().forces.size(); ++c) {
-            std::vector<double> series;
+            component_.clear(); // reused: this runs after every window
             for (const Window &s : span_)
                 if (c < s.forces.size())
-                    series.push_back(s.forces[c]);
-            const double r = lagOneAutocorrelation(series);
+                    component_.push_back(s.forces[c]);
+            const double r = lagOneAutocorrelation(component_);
             if (r < lowest) {
                 lowest = r;
                 component = c;

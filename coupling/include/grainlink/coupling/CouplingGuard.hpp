@@ -57,6 +57,7 @@ private:
     double exchanged_J_ = 0.0; ///< Σ |soil work| over the run so far
     std::size_t windows_ = 0;
     bool energy_warned_ = false, oscillation_warned_ = false;
+    std::vector<double> component_; ///< one force component over the span (reused storage)
 };
 
 /// The lag-1 autocorrelation of `values` about their mean; 0 when they do not vary.
