@@ -75,6 +75,22 @@ template <class F> Profile minimiseProfile(F chi2, double t0, double t1, double 
     return p;
 }
 
+/// Whether chi^2 keeps falling past the prior end at which the profile's best point lies (an
+/// end that is not "off": the data asking for less than nothing is no claim anyway): a fifth
+/// of the span further it is lower by 3.84 and by a tenth of itself. Not by 3.84 times the
+/// Birge ratio: a fit pinned at an edge is poor because it is pinned.
+template <class F>
+bool beyondPrior(F chi2, const Profile &p, double t0, double t1, double t_off) {
+    if (!p.at_bound)
+        return false;
+    const bool upper = std::abs(p.t_best - t1) < std::abs(p.t_best - t0);
+    if (std::abs((upper ? t1 : t0) - t_off) < 1e-9 * std::max(1.0, std::abs(t1 - t0)))
+        return false;
+    const double beyond = upper ? t1 + 0.2 * (t1 - t0) : t0 - 0.2 * (t1 - t0);
+    const double c = chi2(beyond);
+    return std::isfinite(c) && c < p.chi2 - std::max(kDeltaChi2_95, 0.1 * p.chi2);
+}
+
 } // namespace
 
 double Prior::toScale(double s) const {
@@ -174,6 +190,7 @@ StrengthFit fitStrength(const Response &response, const Prior &prior,
     fit.hi = prior.fromScale(p.t_hi);
     fit.chi2 = p.chi2;
     fit.at_bound = p.at_bound;
+    fit.beyond_prior = beyondPrior(chi2, p, t0, t1, prior.toScale(prior.off));
     fit.chi2_off = chi2(prior.toScale(prior.off));
     return fit;
 }
@@ -219,17 +236,18 @@ PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Pri
     const double birge = std::max(1.0, fit.chi2 / dof);
     const Profile qa = minimiseProfile([&](double t) { return chi2(t, tb); }, a0, a1, birge);
     const Profile qb = minimiseProfile([&](double t) { return chi2(ta, t); }, b0, b1, birge);
-    const auto fill = [&](StrengthFit &f, const Profile &q, const Prior &p) {
+    const auto fill = [&](StrengthFit &f, const Profile &q, const Prior &p, auto profile) {
         f.strength = p.fromScale(q.t_best);
         f.lo = p.fromScale(q.t_lo);
         f.hi = p.fromScale(q.t_hi);
         f.chi2 = q.chi2;
         f.at_bound = q.at_bound;
+        f.beyond_prior = beyondPrior(profile, q, p.toScale(p.lo), p.toScale(p.hi), p.toScale(p.off));
         f.features = int(use.size());
         f.birge = birge;
     };
-    fill(fit.a, qa, pa);
-    fill(fit.b, qb, pb);
+    fill(fit.a, qa, pa, [&](double t) { return chi2(t, tb); });
+    fill(fit.b, qb, pb, [&](double t) { return chi2(ta, t); });
     fit.chi2 = std::min({fit.chi2, qa.chi2, qb.chi2});
     fit.a.chi2_off = fit.b.chi2_off = chi2(pa.toScale(pa.off), pb.toScale(pb.off));
     return fit;

@@ -59,6 +59,8 @@ const char *outcomeName(Diagnosis::Outcome outcome) {
         return "explained_by_pair";
     case Diagnosis::Outcome::Unexplained:
         return "unexplained";
+    case Diagnosis::Outcome::Unresolved:
+        return "unresolved";
     }
     return "?";
 }
@@ -199,6 +201,15 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                    ? std::string()
                    : "; not compared (no simulated feature): " + joined(D.not_compared);
     };
+    D.numerical_warning = numericalWarning(V);
+    if (!D.numerical_warning.empty())
+        log("warning: " + D.numerical_warning);
+    if (!D.verdict.gap && !D.numerical_warning.empty()) {
+        D.outcome = Diagnosis::Outcome::Unresolved;
+        D.claim = "unresolved: no gap can be shown or excluded, " + D.numerical_warning + " (" +
+                  D.verdict.summary + ")" + notCompared();
+        return D;
+    }
     if (!D.verdict.gap) {
         D.outcome = Diagnosis::Outcome::NoGap;
         D.claim = std::string(D.not_compared.empty() ? "no gap: every experiment agrees"
@@ -427,7 +438,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const bool better = evaluateModel(final_rows[c], R.held_out, R.p_value, R.after,
                                           R.confirmed_mean);
         R.beats_null = better && R.p_value < level && !D.held_out.empty();
-        R.explains = R.beats_null && !R.after.gap;
+        // A strength pinned at its prior's edge while the data ask for more stands in for
+        // something the catalogue lacks (the fit of another code's softer soil by the softest
+        // grains allowed): it may beat the null, it is still not the cause.
+        R.explains = R.beats_null && !R.after.gap && !R.fit.beyond_prior;
     }
     for (Live &L : live)
         D.candidates.push_back(L.result);
@@ -482,7 +496,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             P.confirmed = true;
             const bool better = evaluateModel(pair_rows[i], P.held_out, P.p_value, P.after,
                                               P.confirmed_mean);
-            P.explains = better && P.p_value < pair_level && !P.after.gap && !D.held_out.empty();
+            P.explains = better && P.p_value < pair_level && !P.after.gap && !D.held_out.empty() &&
+                         !P.fit.a.beyond_prior && !P.fit.b.beyond_prior;
         }
         D.pairs = pairs;
     }
@@ -542,7 +557,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                       << " (held-out gap " << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
                       << fmt(100.0 * best->held_out.gap, 2) << " %, " << best->after.flagged
                       << " features still beyond " << fmt(opt.flag_at, 2) << " u_val, p = "
-                      << fmt(best->p_value, 2) << ")";
+                      << fmt(best->p_value, 2)
+                      << (best->fit.beyond_prior ? ", pinned at its prior's edge: the data ask for "
+                                                   "more of it than is plausible"
+                                                 : "")
+                      << ")";
         }
     }
     D.claim = claim.str() + notCompared();

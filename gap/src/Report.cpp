@@ -40,7 +40,8 @@ Json verdict(const GapVerdict &g) {
 Json strength(const Effect &e, const StrengthFit &f) {
     return {{"parameter", e.parameter}, {"unit", e.unit},          {"value", number(f.strength)},
             {"ci95", {number(f.lo), number(f.hi)}}, {"base_value", number(e.prior.off)},
-            {"prior", {e.prior.lo, e.prior.hi}}, {"at_prior_bound", f.at_bound}};
+            {"prior", {e.prior.lo, e.prior.hi}}, {"at_prior_bound", f.at_bound},
+            {"beyond_prior", f.beyond_prior}};
 }
 
 void writeAtomically(const fs::path &path, const std::string &text) {
@@ -69,6 +70,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     j["measurements"] = set.name;
     j["outcome"] = outcomeName(d.outcome);
     j["claim"] = d.claim;
+    j["numerical_warning"] = d.numerical_warning;
     j["explained_by"] = d.explained_by;
     j["best_model"] = d.best_model;
     j["where"] = Json::array();
@@ -138,6 +140,8 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
     std::ostringstream r;
     r << "grainlink gap diagnose: " << set.name << "\n\n";
     r << "Result: " << d.claim << "\n\n";
+    if (!d.numerical_warning.empty() && d.outcome != Diagnosis::Outcome::Unresolved)
+        r << "Warning: " << d.numerical_warning << "\n\n";
     r << "Numerical uncertainty and the gap test: " << d.verdict.summary << "\n";
     r << "Where the gap lies:\n";
     for (const RegimeFinding &f : d.findings)
@@ -165,8 +169,13 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
           << "] " << c.effect.unit << ", chi^2 " << c.fit.chi2 << " (off: " << c.fit.chi2_off << ")";
         if (c.confirmed)
             r << "; confirmed: held-out gap " << pct(c.held_out.gap) << ", p = " << c.p_value
-              << (c.explains ? ", EXPLAINS" : c.beats_null ? ", beats the null but leaves a gap"
-                                                            : ", does not beat the null");
+              << (c.explains                          ? ", EXPLAINS"
+                  : c.beats_null && c.fit.beyond_prior ? ", beats the null but only at its prior's edge"
+                  : c.beats_null                       ? ", beats the null but leaves a gap"
+                                                       : ", does not beat the null");
+        if (c.fit.beyond_prior)
+            r << "; pinned at its prior's edge (the data ask for more than " << c.effect.prior.lo
+              << "-" << c.effect.prior.hi << " allows)";
         r << '\n';
     }
     if (!d.indistinguishable.empty()) {

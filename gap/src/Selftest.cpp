@@ -61,6 +61,8 @@ std::string outcomeWord(const Diagnosis &d) {
         return "no gap";
     case Diagnosis::Outcome::Unexplained:
         return "unexplained";
+    case Diagnosis::Outcome::Unresolved:
+        return "unresolved";
     case Diagnosis::Outcome::Explained:
     case Diagnosis::Outcome::ExplainedByPair:
         return d.explained_by; // the model the claim names, not the first that explains

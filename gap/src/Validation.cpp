@@ -338,4 +338,30 @@ std::vector<RegimeFinding> localise(const std::vector<FeatureKey> &keys,
     return findings;
 }
 
+std::string numericalWarning(const ValidationResult &V) {
+    constexpr double kUnresolved = 0.5;
+    std::string worst;
+    double worst_median = kUnresolved;
+    for (const auto &[name, u] : V.u_checks) {
+        std::vector<double> rel;
+        for (Eigen::Index k = 0; k < u.size(); ++k)
+            if (std::isfinite(u[k]) && std::abs(V.simulated[k]) > 0.0)
+                rel.push_back(u[k] / std::abs(V.simulated[k]));
+        if (rel.empty())
+            continue;
+        std::nth_element(rel.begin(), rel.begin() + std::ptrdiff_t(rel.size() / 2), rel.end());
+        const double median = rel[rel.size() / 2];
+        if (median > worst_median)
+            worst_median = median, worst = name;
+    }
+    if (worst.empty())
+        return "";
+    std::ostringstream w;
+    w << "the base model is not resolved numerically: its " << worst
+      << " check changes the simulated features by a median " << std::lround(100.0 * worst_median)
+      << " % of their value; refine that choice in the base model (numerics.checks, docs/gap.md "
+         "step 2) and diagnose again";
+    return w.str();
+}
+
 } // namespace grainlink::gap

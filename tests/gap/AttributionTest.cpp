@@ -173,3 +173,24 @@ TEST_CASE("the held-out density test: a model as good as the null is not better;
     CHECK(miss.mean_gain < 0.0);
     CHECK(miss.p_value > 0.99);
 }
+
+TEST_CASE("a fit pinned at its prior's edge is flagged only when the data ask for more",
+          "[gap][attribution]") {
+    // m(s) = 5 + s (1 1 1 1), prior [0, 1], off 0, u = 0.05. Data at s = 1.6: the best strength
+    // is the prior's end and chi^2 falls from 576 to 256 0.2 beyond it, so
+    // beyond_prior. Data at s = 1.0: also at the end, but chi^2 rises beyond it: not flagged.
+    // Data at s = 0.5: inside.
+    const Prior prior{0.0, 1.0, 0.0, false};
+    const Eigen::VectorXd base = Eigen::VectorXd::Constant(4, 5.0), J = Eigen::VectorXd::Ones(4);
+    const auto r = linear(prior, base, J, {0.0, 1.0});
+    const Eigen::VectorXd u2 = Eigen::VectorXd::Constant(4, 0.0025);
+    const auto far = fitStrength(r, prior, base + 1.6 * J, u2, all(4));
+    CHECK(far.at_bound);
+    CHECK(far.beyond_prior);
+    const auto edge = fitStrength(r, prior, base + 1.0 * J, u2, all(4));
+    CHECK(edge.strength == Approx(1.0).margin(1e-3));
+    CHECK_FALSE(edge.beyond_prior);
+    CHECK_FALSE(fitStrength(r, prior, base + 0.5 * J, u2, all(4)).beyond_prior);
+    // At the "off" end the data asking for less than nothing is no claim either way.
+    CHECK_FALSE(fitStrength(r, prior, base - 0.6 * J, u2, all(4)).beyond_prior);
+}

@@ -208,3 +208,22 @@ TEST_CASE("localise names an observable in words, without its unit", "[gap][vali
         CHECK(findings[0].text.rfind(words + " 2x too high", 0) == 0);
     }
 }
+
+TEST_CASE("a check that moves the base by over half its value makes the base unresolved",
+          "[gap][validation]") {
+    // Seeds 1.0 1.2 0.8 1.0 (mean 1). A time-step check at 10 (the Mindlin soil at twice its
+    // step, docs/gap.md) moves the feature by 900 %: named, with its figure. A resolution check
+    // at 1.05 moves it by about 5 %, far below half: no warning.
+    Eigen::MatrixXd base(4, 1);
+    base << 1.0, 1.2, 0.8, 1.0;
+    Eigen::MatrixXd stiff(2, 1), close(2, 1);
+    stiff << 10.0, 10.0;
+    close << 1.05, 1.05;
+    const auto bad = validate(oneFeature(1.5, 0.1, true), base,
+                              {{"resolution", close}, {"time_step", stiff}});
+    const std::string w = numericalWarning(bad);
+    CHECK(w.find("time_step check") != std::string::npos);
+    CHECK(w.find("900 %") != std::string::npos);
+    CHECK(numericalWarning(validate(oneFeature(1.5, 0.1, true), base, {{"resolution", close}}))
+              .empty());
+}

@@ -85,6 +85,11 @@ struct StrengthFit {
     int features = 0;
     double birge = 1.0;
     bool at_bound = false; ///< the best strength is an end of the prior range
+    /// At an end of the prior, chi^2 still falls by more than 3.84 and a tenth of itself a
+    /// fifth of the prior's span beyond it (the response extrapolated): the data ask for more
+    /// of the effect than its prior allows, so it stands in for something else and is never
+    /// claimed (docs/gap.md, step 7).
+    bool beyond_prior = false;
 };
 StrengthFit fitStrength(const Response &response, const Prior &prior,
                         const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,

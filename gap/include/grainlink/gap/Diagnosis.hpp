@@ -119,8 +119,13 @@ struct Diagnosis {
     std::vector<std::vector<double>> overlap;
     std::vector<std::string> indistinguishable; ///< candidates the design cannot tell from the leader
     std::string separating_experiment;         ///< the probe that would separate them best
-    enum class Outcome { NoGap, Explained, ExplainedByPair, Unexplained };
+    /// Unresolved: no gap is found, but only because a numerical check of the base model moves
+    /// the simulation by more than half its value: nothing can be said until it is refined.
+    enum class Outcome { NoGap, Explained, ExplainedByPair, Unexplained, Unresolved };
     Outcome outcome = Outcome::NoGap;
+    /// Non-empty when a numerical check moves the base's features by a median of more than
+    /// half their value (the check and the figure), whatever the outcome.
+    std::string numerical_warning;
     /// The model the claim names: the winning effect, the explaining pair ("a + b"), or the
     /// closest confirmed candidate when unexplained (empty when nothing was confirmed).
     std::string best_model;

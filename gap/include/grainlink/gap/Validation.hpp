@@ -65,6 +65,12 @@ double normalEquivalent(double t, double dof);
 ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
                           const std::vector<NumericalCheck> &checks);
 
+/// The numerical check that moves the base's features most, in words, when it moves them by a
+/// median of more than half their value: a base model not resolved in that choice, against
+/// which no comparison means anything (a soil stepped near its stability limit pressed the
+/// plates tenfold softer at twice the time step). Empty when every check is below that.
+std::string numericalWarning(const ValidationResult &validation);
+
 /// The gap test, three tests each at a third of the family-wise level alpha, valid whatever the
 /// correlation between an experiment's features (experiments independent): (a) some |z| above
 /// the Bonferroni bound over all features; (b) some experiment's root-mean-square z above the
