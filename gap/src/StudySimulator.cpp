@@ -21,6 +21,14 @@ using config::ConfigNode;
 
 namespace {
 
+/// v rounded up to two significant digits (0.01089 -> 0.011); 0 stays 0.
+double roundUp2(double v) {
+    if (!(v > 0.0))
+        return v;
+    const double step = std::pow(10.0, std::floor(std::log10(v)) - 1.0);
+    return std::ceil(v / step * (1.0 - 1e-12)) * step;
+}
+
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// `over` merged into `target`: mappings key by key, anything else replaced; a key set to
@@ -382,16 +390,18 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
                 reach = std::max(reach, r->second);
         }
     // Conditions of the experiments, and a reach beyond the measured one: room for a zero
-    // offset (the catalogue's prior: +-2 mm) and a compliant rig's extra travel.
+    // offset (the catalogue's prior: +-2 mm) and a compliant rig's extra travel. Rounded up to
+    // two significant digits, so that data sets reaching nearly as far share their runs.
+    const double beyond = roundUp2(1.1 * reach);
     if (test == "bevameter") {
         section["plate_radii_m"] = flowList(conditionValues(design, group, "plate_diameter_m", 0.5));
-        section["max_sinkage_m"] = 1.1 * reach + 0.002;
+        section["max_sinkage_m"] = beyond + 0.002;
     } else if (test == "direct_shear") {
         section["normal_stresses_Pa"] = flowList(conditionValues(design, group, "normal_stress_Pa", 1.0));
-        section["max_displacement_m"] = 1.1 * reach;
+        section["max_displacement_m"] = beyond;
     } else if (test == "bevameter_shear") {
         section["normal_pressures_Pa"] = flowList(conditionValues(design, group, "normal_pressure_Pa", 1.0));
-        section["max_shear_displacement_m"] = 1.1 * reach;
+        section["max_shear_displacement_m"] = beyond;
     } else if (test == "wheel") {
         wheelSection(section, design, fd, group, base_.path);
     }

@@ -174,3 +174,23 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     });
     fs::remove_all(scratch);
 }
+
+TEST_CASE("data sets that reach nearly as far share their simulations", "[gap][simulator]") {
+    // Plates measured to 9.90 and 9.93 mm: 1.1 times the reach rounded up to two significant
+    // digits is 11 mm for both, plus the zero offset's 2 mm: one scenario, one cached run.
+    const StudySimulator sim(loadBaseModel(kDir + "/base.yaml"), "", {});
+    const ExperimentSet design = loadDesign(kDir + "/design.yaml").set;
+    const auto reaching = [&](double reach) {
+        ExperimentSet set = design;
+        for (Experiment &e : set.experiments)
+            for (Trial &t : e.trials)
+                for (auto &[name, curve] : t.curves)
+                    curve.x.back() = reach;
+        return set;
+    };
+    const std::string id = design.experiments.front().id;
+    const std::string a = sim.scenarioText(reaching(0.0099), {id}, {}, 1);
+    CHECK(a == sim.scenarioText(reaching(0.00993), {id}, {}, 1));
+    CHECK(YAML::Load(a)["bevameter"]["max_sinkage_m"].as<double>() == Approx(0.013));
+    CHECK(a != sim.scenarioText(reaching(0.0105), {id}, {}, 1));
+}
