@@ -42,6 +42,23 @@ std::string strengthText(const Effect &e, double s) {
     return e.parameter + " " + fmt(s) + (e.unit == "-" ? "" : " " + e.unit);
 }
 
+/// Whether `mean` has some feature on every experiment where the base has one: a failed run
+/// leaves its experiment with none (a shifted curve may still leave a bin at its end empty).
+bool coversBase(const Eigen::VectorXd &mean, const Eigen::VectorXd &base,
+                const std::vector<FeatureKey> &keys) {
+    std::map<std::string, std::pair<int, int>> count; // base's features, mean's among them
+    for (Eigen::Index k = 0; k < base.size(); ++k)
+        if (std::isfinite(base[k])) {
+            auto &c = count[keys[std::size_t(k)].experiment];
+            ++c.first;
+            c.second += std::isfinite(mean[k]);
+        }
+    for (const auto &[experiment, c] : count)
+        if (c.second == 0)
+            return false;
+    return true;
+}
+
 /// The effect at the strength of the seeds' first n rows of `rows`.
 Eigen::MatrixXd firstRows(const Eigen::MatrixXd &rows, int n) {
     return rows.topRows(std::min<Eigen::Index>(rows.rows(), n));
@@ -287,15 +304,25 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // The base at the same seeds (common random numbers: a signature is a difference).
         const auto off = meanAndVariance(firstRows(base_rows, seeds), bed_sd);
         std::vector<Eigen::VectorXd> means{off.first}, vars{off.second};
+        std::vector<std::string> failed;
         for (std::size_t k = 0; k < sig.size(); ++k)
             if (sig_of[k].first == li) {
                 const auto mv = meanAndVariance(sig_rows[k], bed_sd);
+                // A strength whose runs all failed on some experiment has no features there: a
+                // fit would read them as agreeing (chi^2 0), so the strength is left out.
+                if (!coversBase(mv.first, off.first, meas.keys)) {
+                    failed.push_back(fmt(sig_of[k].second));
+                    continue;
+                }
                 s.push_back(sig_of[k].second);
                 means.push_back(mv.first);
                 vars.push_back(mv.second);
             }
         if (s.size() < 2) {
-            L.result.applicability = "no strength to simulate apart from the base's own";
+            L.result.applicability =
+                failed.empty() ? "no strength to simulate apart from the base's own"
+                               : "its signature runs failed at every strength (" + joined(failed) +
+                                     "; their errors and logs are above)";
             continue;
         }
         L.response = std::make_unique<TabulatedResponse>(L.result.effect.prior, s, means, vars);
@@ -367,6 +394,16 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                                    double &p_value, GapVerdict &after, Eigen::VectorXd &mean) {
         const auto mv = meanAndVariance(rows, bed_sd);
         mean = mv.first;
+        if (!coversBase(mean, V.simulated, meas.keys)) { // its runs failed somewhere: it predicts nothing there
+            const double inf = std::numeric_limits<double>::infinity();
+            score = HeldOutScore{};
+            score.gap = score.relative_rmse = score.smse = inf;
+            score.log_density = -inf;
+            p_value = 1.0;
+            after.gap = true;
+            after.summary = "its confirming runs failed on some experiment";
+            return false;
+        }
         const Eigen::VectorXd var = u2_fixed + mv.second;
         score = scoreHeldOut(meas.value, mean, var, u2_val, D.held_out);
         const DensityComparison c =
@@ -412,6 +449,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         for (std::size_t c = 0; c < to_confirm.size(); ++c) {
             Live &L = live[to_confirm[c]];
             const auto mv = meanAndVariance(confirm_rows[c], bed_sd);
+            if (!coversBase(mv.first, V.simulated, meas.keys))
+                continue; // failed runs: nothing to add, nothing to refit
             L.response->add(L.result.fit.strength, mv.first, mv.second);
             const StrengthFit refit = fitStrength(*L.response, L.result.effect.prior, meas.value,
                                                   u2_fixed, D.calibration, correlation);
