@@ -35,7 +35,7 @@ BOXES = {"wide": {"x0": 0.0, "x1": 0.05, "count": 1300, "height": 0.08},
          "narrow": {"x0": 0.0075, "x1": 0.0425, "count": 640, "height": 0.09}}
 PLATES = [("wide", 0.020), ("wide", 0.025), ("wide", 0.030), ("narrow", 0.020)]
 SPEED = 0.05          # m/s, the base's bevameter speed
-REACH = 0.010         # m of sinkage below the bed surface
+REACH = 0.008         # m of sinkage below the bed surface (deeper, soft grains overlap by 0.4 r)
 CLEARANCE = 0.001     # m above the highest grain under the plate at the start
 SAMPLE_S = 0.002      # force averaging interval
 SETTLE_S = 0.5
