@@ -221,9 +221,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     D.numerical_warning = numericalWarning(V);
     if (!D.numerical_warning.empty())
         log("warning: " + D.numerical_warning);
-    if (!D.verdict.gap && !D.numerical_warning.empty()) {
+    const std::string unresolved = unresolvedCheck(V);
+    if (!D.verdict.gap && !unresolved.empty()) {
         D.outcome = Diagnosis::Outcome::Unresolved;
-        D.claim = "unresolved: no gap can be shown or excluded, " + D.numerical_warning + " (" +
+        D.claim = "unresolved: no gap can be shown or excluded, " + unresolved + " (" +
                   D.verdict.summary + ")" + notCompared();
         return D;
     }

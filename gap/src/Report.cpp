@@ -140,7 +140,7 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
     std::ostringstream r;
     r << "grainlink gap diagnose: " << set.name << "\n\n";
     r << "Result: " << d.claim << "\n\n";
-    if (!d.numerical_warning.empty() && d.outcome != Diagnosis::Outcome::Unresolved)
+    if (!d.numerical_warning.empty())
         r << "Warning: " << d.numerical_warning << "\n\n";
     r << "Numerical uncertainty and the gap test: " << d.verdict.summary << "\n";
     r << "Where the gap lies:\n";

@@ -117,8 +117,14 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
                 var += pooled * (1.0 / nc + 1.0 / std::max(1.0, nb)) / (b.mean[k] * b.mean[k]);
                 ++k_used;
             }
-            if (k_used == 0)
+            if (k_used == 0) {
+                for (Eigen::Index k : idx)
+                    if (std::isfinite(b.mean[k])) {
+                        v.check_failures.emplace_back(check.name, id);
+                        break;
+                    }
                 continue;
+            }
             const double mean = sum / k_used;
             const double rho = correlation.rho(id);
             const double var_mean = var / k_used * (1.0 + (k_used - 1) * rho) / k_used;
@@ -338,7 +344,7 @@ std::vector<RegimeFinding> localise(const std::vector<FeatureKey> &keys,
     return findings;
 }
 
-std::string numericalWarning(const ValidationResult &V) {
+std::string unresolvedCheck(const ValidationResult &V) {
     constexpr double kUnresolved = 0.5;
     std::string worst;
     double worst_median = kUnresolved;
@@ -362,6 +368,19 @@ std::string numericalWarning(const ValidationResult &V) {
       << " % of their value; refine that choice in the base model (numerics.checks, docs/gap.md "
          "step 2) and diagnose again";
     return w.str();
+}
+
+std::string numericalWarning(const ValidationResult &V) {
+    std::string text = unresolvedCheck(V);
+    std::map<std::string, std::string> failed; // check -> experiments
+    for (const auto &[check, experiment] : V.check_failures)
+        failed[check] += (failed[check].empty() ? "" : ", ") + experiment;
+    for (const auto &[check, experiments] : failed)
+        text += (text.empty() ? "" : "; ") + std::string("every run of the ") + check +
+                " check failed on " + experiments +
+                ": its part of the numerical uncertainty is unknown there (counted as none, so "
+                "a gap found there may be numerical)";
+    return text;
 }
 
 } // namespace grainlink::gap

@@ -221,9 +221,26 @@ TEST_CASE("a check that moves the base by over half its value makes the base unr
     close << 1.05, 1.05;
     const auto bad = validate(oneFeature(1.5, 0.1, true), base,
                               {{"resolution", close}, {"time_step", stiff}});
-    const std::string w = numericalWarning(bad);
+    const std::string w = unresolvedCheck(bad);
     CHECK(w.find("time_step check") != std::string::npos);
     CHECK(w.find("900 %") != std::string::npos);
     CHECK(numericalWarning(validate(oneFeature(1.5, 0.1, true), base, {{"resolution", close}}))
               .empty());
+}
+
+TEST_CASE("a check whose runs all failed is named as unknown and not read as none",
+          "[gap][validation]") {
+    // Its contribution to u_val stays 0 (u_val can only be too small, so a 'no gap' stands),
+    // but the warning names the check and the experiment, and it is no reason for 'unresolved'.
+    Eigen::MatrixXd base(4, 1);
+    base << 1.0, 1.2, 0.8, 1.0;
+    Eigen::MatrixXd failed(2, 1);
+    failed << std::nan(""), std::nan("");
+    const auto v = validate(oneFeature(1.5, 0.1, true), base, {{"time_step", failed}});
+    REQUIRE(v.check_failures.size() == 1);
+    CHECK(v.check_failures[0] == std::pair<std::string, std::string>{"time_step", "e1"});
+    CHECK(v.u_checks[0].second[0] == 0.0);
+    CHECK(unresolvedCheck(v).empty());
+    CHECK(numericalWarning(v).find("every run of the time_step check failed on e1") !=
+          std::string::npos);
 }

@@ -124,7 +124,8 @@ struct Diagnosis {
     enum class Outcome { NoGap, Explained, ExplainedByPair, Unexplained, Unresolved };
     Outcome outcome = Outcome::NoGap;
     /// Non-empty when a numerical check moves the base's features by a median of more than
-    /// half their value (the check and the figure), whatever the outcome.
+    /// half their value (the check and the figure), or failed on every run of an experiment,
+    /// whatever the outcome.
     std::string numerical_warning;
     /// The model the claim names: the winning effect, the explaining pair ("a + b"), or the
     /// closest confirmed candidate when unexplained (empty when nothing was confirmed).

@@ -40,6 +40,9 @@ struct ValidationResult {
     Eigen::VectorXd u_seed;     ///< seed_sd / sqrt(seeds): the simulated mean's own scatter
     Eigen::VectorXd u_bed;      ///< seed_sd where the measurement has no repeats, else 0
     std::vector<std::pair<std::string, Eigen::VectorXd>> u_checks; ///< systematic part per check
+    /// (check, experiment) where every run of the check failed: its part of u_num there is
+    /// unknown (counted as 0, so u_val is too small there, never too large).
+    std::vector<std::pair<std::string, std::string>> check_failures;
     Eigen::VectorXd u_num;      ///< sqrt(u_seed^2 + sum u_check^2)
     Eigen::VectorXd u_D;        ///< measurement
     Eigen::VectorXd u_val;      ///< sqrt(u_num^2 + u_bed^2 + u_D^2)
@@ -69,6 +72,10 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
 /// median of more than half their value: a base model not resolved in that choice, against
 /// which no comparison means anything (a soil stepped near its stability limit pressed the
 /// plates tenfold softer at twice the time step). Empty when every check is below that.
+std::string unresolvedCheck(const ValidationResult &validation);
+
+/// Everything to warn about the numerical uncertainty, in words: the unresolved check above and
+/// the experiments where a check's runs all failed. Empty when there is nothing.
 std::string numericalWarning(const ValidationResult &validation);
 
 /// The gap test, three tests each at a third of the family-wise level alpha, valid whatever the
