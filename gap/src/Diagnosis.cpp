@@ -428,19 +428,46 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 (to_confirm.empty() || live[i].result.fit.chi2 <= tie))
                 to_confirm.push_back(i);
     }
-    std::vector<VariantRequest> confirm;
-    for (std::size_t i : to_confirm) {
+    const auto confirmRequest = [&](std::size_t i) {
         const Effect *raw = nullptr;
         for (const Effect *e : effects)
             if (e->name == live[i].result.name)
                 raw = e;
-        confirm.push_back({"confirm " + live[i].result.name, raw, live[i].result.fit.strength,
-                           nullptr, 0.0, "", opt.seeds});
-    }
+        return VariantRequest{"confirm " + live[i].result.name, raw, live[i].result.fit.strength,
+                              nullptr, 0.0, "", opt.seeds};
+    };
+    std::vector<VariantRequest> confirm;
+    for (std::size_t i : to_confirm)
+        confirm.push_back(confirmRequest(i));
     log("confirming " + std::to_string(confirm.size()) + " candidates");
-    const auto confirm_rows = simulator.simulate(set, design, confirm);
+    auto confirm_rows = simulator.simulate(set, design, confirm);
     for (const auto &r : confirm)
         D.simulations += r.seeds;
+    // A candidate whose confirming runs failed predicts nothing: the next one by calibration
+    // chi^2 is confirmed in its place (once), so that one failed run does not end the search.
+    {
+        int failed = 0;
+        for (const auto &rows : confirm_rows)
+            failed += !coversBase(meanAndVariance(rows, bed_sd).first, V.simulated, meas.keys);
+        std::vector<VariantRequest> more;
+        for (std::size_t i : applicable)
+            if (failed > 0 && live[i].result.calibration_gain > 0.0 &&
+                std::find(to_confirm.begin(), to_confirm.end(), i) == to_confirm.end()) {
+                to_confirm.push_back(i);
+                more.push_back(confirmRequest(i));
+                --failed;
+            }
+        if (!more.empty()) {
+            log("confirming runs failed: confirming " + std::to_string(more.size()) +
+                " more candidates in their place");
+            const auto more_rows = simulator.simulate(set, design, more);
+            for (std::size_t k = 0; k < more.size(); ++k) {
+                confirm.push_back(more[k]);
+                confirm_rows.push_back(more_rows[k]);
+                D.simulations += more[k].seeds;
+            }
+        }
+    }
     // The signature is a coarse table: add each confirming run to it, refit, and where the
     // best strength moved, confirm once more there.
     std::vector<Eigen::MatrixXd> final_rows = confirm_rows;

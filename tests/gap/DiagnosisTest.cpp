@@ -325,16 +325,19 @@ private:
 /// stopping at its overlap limit under a plate, as soft grains did with LIGGGHTS' data).
 class FailingEffectSimulator final : public Simulator {
 public:
-    FailingEffectSimulator(std::string effect, std::set<std::string> failing)
-        : effect_(std::move(effect)), failing_(std::move(failing)) {}
+    FailingEffectSimulator(std::string effect, std::set<std::string> failing,
+                           bool only_confirming = false)
+        : effect_(std::move(effect)), failing_(std::move(failing)),
+          only_confirming_(only_confirming) {}
     std::vector<std::string> checks() const override { return inner_.checks(); }
     YAML::Node referenceScenario() const override { return inner_.referenceScenario(); }
     std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &set, const FeatureDesign &design,
                                           const std::vector<VariantRequest> &requests) override {
         auto rows = inner_.simulate(set, design, requests);
         for (std::size_t i = 0; i < requests.size(); ++i)
-            if ((requests[i].effect && requests[i].effect->name == effect_) ||
-                (requests[i].second && requests[i].second->name == effect_))
+            if (((requests[i].effect && requests[i].effect->name == effect_) ||
+                 (requests[i].second && requests[i].second->name == effect_)) &&
+                (!only_confirming_ || requests[i].label.rfind("confirm", 0) == 0))
                 for (const auto &id : failing_)
                     for (Eigen::Index k : design.by_experiment.at(id))
                         rows[i].col(k).setConstant(std::numeric_limits<double>::quiet_NaN());
@@ -345,6 +348,7 @@ private:
     AnalyticSimulator inner_;
     std::string effect_;
     std::set<std::string> failing_;
+    bool only_confirming_ = false;
 };
 } // namespace
 
@@ -410,4 +414,29 @@ TEST_CASE("diagnosis: an effect whose runs failed is not fitted as if it agreed"
     CHECK(poly->applicability.find("signature runs failed") != std::string::npos);
     CHECK(d.outcome == Diagnosis::Outcome::Explained);
     CHECK(d.explained_by == "cohesion");
+}
+
+TEST_CASE("diagnosis: a candidate whose confirming runs failed is replaced by the next one",
+          "[gap][diagnosis]") {
+    // The hidden cohesion leads; its confirming runs fail on a held-out plate. It is not
+    // claimed, and one more candidate than otherwise is confirmed in its place.
+    const EffectCatalogue c = catalogue();
+    DiagnosisOptions o;
+    o.seeds = 4;
+    o.signature_seeds = 3;
+    o.held_out = {"large_90", "large_110", "small_90", "small_110"};
+    const ExperimentSet set = measuredSet({"cohesion", 4.0e4}, 7);
+    const auto confirmed = [](const Diagnosis &d) {
+        int n = 0;
+        for (const auto &cand : d.candidates)
+            n += cand.confirmed;
+        return n;
+    };
+    AnalyticSimulator fine;
+    const Diagnosis before = diagnose(set, c.diagnosable(), fine, o);
+    FailingEffectSimulator failing("cohesion", {"large_90"}, true);
+    const Diagnosis d = diagnose(set, c.diagnosable(), failing, o);
+    INFO(d.claim);
+    CHECK(d.explained_by != "cohesion");
+    CHECK(confirmed(d) == confirmed(before) + 1);
 }
