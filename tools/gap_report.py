@@ -164,6 +164,8 @@ def main(directory):
              "pre-wrap}} img{{max-width:100%}}</style></head><body>",
              f"<h1>Sim-to-real diagnosis: {html.escape(diag['measurements'])}</h1>",
              f"<p><b>{html.escape(diag['outcome'])}</b>: {html.escape(diag['claim'])}</p>",
+             (f"<p style='color:#a00'><b>Warning</b>: {html.escape(diag['numerical_warning'])}</p>"
+              if diag.get("numerical_warning") else ""),
              "<ul>" + "".join(f"<li>{html.escape(w['text'])}</li>" for w in diag["where"]) + "</ul>"]
     for title, fig in figures:
         if fig:
