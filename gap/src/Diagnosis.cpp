@@ -391,8 +391,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                         .fraction;
 
     // 4. Confirm the leading candidates: re-simulate at the fitted strength, score held out.
+    // The held-out prediction of a fitted model carries the uncertainty of its fitted strength
+    // (`strength_var`), as the null model's carries its posterior: each predicts with what it
+    // knows. The gap left with the model is judged without it.
     const auto evaluateModel = [&](const Eigen::MatrixXd &rows, HeldOutScore &score,
-                                   double &p_value, GapVerdict &after, Eigen::VectorXd &mean) {
+                                   double &p_value, GapVerdict &after, Eigen::VectorXd &mean,
+                                   const Eigen::VectorXd &strength_var) {
         const auto mv = meanAndVariance(rows, bed_sd);
         mean = mv.first;
         if (!coversBase(mean, V.simulated, meas.keys)) { // its runs failed somewhere: it predicts nothing there
@@ -406,9 +410,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             return false;
         }
         const Eigen::VectorXd var = u2_fixed + mv.second;
-        score = scoreHeldOut(meas.value, mean, var, u2_val, D.held_out);
-        const DensityComparison c =
-            compareDensities(meas.value, mean, var, null_mean, null_var, D.held_out, n_eff);
+        const Eigen::VectorXd predictive = var + strength_var;
+        score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);
+        const DensityComparison c = compareDensities(meas.value, mean, predictive, null_mean,
+                                                     null_var, D.held_out, n_eff);
         p_value = c.p_value;
         Eigen::VectorXd e = (meas.value - mean).array() / var.array().sqrt();
         for (Eigen::Index k = 0; k < e.size(); ++k)
@@ -502,8 +507,15 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     for (std::size_t c = 0; c < to_confirm.size(); ++c) {
         CandidateResult &R = live[to_confirm[c]].result;
         R.confirmed = true;
+        // The strength's 95 % interval as a normal spread of the prediction.
+        const TabulatedResponse &table = *live[to_confirm[c]].response;
+        const Eigen::VectorXd half = (table.mean(R.fit.hi) - table.mean(R.fit.lo)) / (2.0 * 1.96);
+        Eigen::VectorXd strength_var = half.array().square().matrix();
+        for (Eigen::Index k = 0; k < strength_var.size(); ++k)
+            if (!std::isfinite(strength_var[k]))
+                strength_var[k] = 0.0;
         const bool better = evaluateModel(final_rows[c], R.held_out, R.p_value, R.after,
-                                          R.confirmed_mean);
+                                          R.confirmed_mean, strength_var);
         R.beats_null = better && R.p_value < level && !D.held_out.empty();
         // A strength pinned at its prior's edge while the data ask for more stands in for
         // something the catalogue lacks (the fit of another code's softer soil by the softest
@@ -562,7 +574,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             PairResult &P = pairs[i];
             P.confirmed = true;
             const bool better = evaluateModel(pair_rows[i], P.held_out, P.p_value, P.after,
-                                              P.confirmed_mean);
+                                              P.confirmed_mean, Eigen::VectorXd::Zero(n));
             P.explains = better && P.p_value < pair_level && !P.after.gap && !D.held_out.empty() &&
                          !P.fit.a.beyond_prior && !P.fit.b.beyond_prior;
         }
