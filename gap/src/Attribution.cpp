@@ -75,6 +75,14 @@ template <class F> Profile minimiseProfile(F chi2, double t0, double t1, double 
     return p;
 }
 
+/// Whether the profile's best point is at a prior end that is not "off".
+bool atPriorEdge(const Profile &p, double t0, double t1, double t_off) {
+    if (!p.at_bound)
+        return false;
+    const double end = std::abs(p.t_best - t1) < std::abs(p.t_best - t0) ? t1 : t0;
+    return std::abs(end - t_off) > 1e-9 * std::max(1.0, std::abs(t1 - t0));
+}
+
 /// Whether chi^2 keeps falling past the prior end at which the profile's best point lies (an
 /// end that is not "off": the data asking for less than nothing is no claim anyway): a fifth
 /// of the span further it is lower by 3.84 and by a tenth of itself. Not by 3.84 times the
@@ -191,6 +199,7 @@ StrengthFit fitStrength(const Response &response, const Prior &prior,
     fit.chi2 = p.chi2;
     fit.at_bound = p.at_bound;
     fit.beyond_prior = beyondPrior(chi2, p, t0, t1, prior.toScale(prior.off));
+    fit.at_prior_edge = atPriorEdge(p, t0, t1, prior.toScale(prior.off));
     fit.chi2_off = chi2(prior.toScale(prior.off));
     return fit;
 }
@@ -243,6 +252,7 @@ PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Pri
         f.chi2 = q.chi2;
         f.at_bound = q.at_bound;
         f.beyond_prior = beyondPrior(profile, q, p.toScale(p.lo), p.toScale(p.hi), p.toScale(p.off));
+        f.at_prior_edge = atPriorEdge(q, p.toScale(p.lo), p.toScale(p.hi), p.toScale(p.off));
         f.features = int(use.size());
         f.birge = birge;
     };

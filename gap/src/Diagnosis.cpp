@@ -517,10 +517,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const bool better = evaluateModel(final_rows[c], R.held_out, R.p_value, R.after,
                                           R.confirmed_mean, strength_var);
         R.beats_null = better && R.p_value < level && !D.held_out.empty();
-        // A strength pinned at its prior's edge while the data ask for more stands in for
-        // something the catalogue lacks (the fit of another code's softer soil by the softest
-        // grains allowed): it may beat the null, it is still not the cause.
-        R.explains = R.beats_null && !R.after.gap && !R.fit.beyond_prior;
+        // A strength at its prior's edge may stand in for something the catalogue lacks (LIGGGHTS'
+        // 5x softer soil fitted by the softest grains allowed): it may beat the null, it is
+        // still not claimed as the cause.
+        R.explains = R.beats_null && !R.after.gap && !R.fit.at_prior_edge;
     }
     for (Live &L : live)
         D.candidates.push_back(L.result);
@@ -576,7 +576,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             const bool better = evaluateModel(pair_rows[i], P.held_out, P.p_value, P.after,
                                               P.confirmed_mean, Eigen::VectorXd::Zero(n));
             P.explains = better && P.p_value < pair_level && !P.after.gap && !D.held_out.empty() &&
-                         !P.fit.a.beyond_prior && !P.fit.b.beyond_prior;
+                         !P.fit.a.at_prior_edge && !P.fit.b.at_prior_edge;
         }
         D.pairs = pairs;
     }
@@ -639,7 +639,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                       << fmt(best->p_value, 2)
                       << (best->fit.beyond_prior ? ", pinned at its prior's edge: the data ask for "
                                                    "more of it than is plausible"
-                                                 : "")
+                          : best->fit.at_prior_edge ? ", at its prior's edge: not claimed"
+                                                    : "")
                       << ")";
         }
     }

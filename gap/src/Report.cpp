@@ -41,7 +41,7 @@ Json strength(const Effect &e, const StrengthFit &f) {
     return {{"parameter", e.parameter}, {"unit", e.unit},          {"value", number(f.strength)},
             {"ci95", {number(f.lo), number(f.hi)}}, {"base_value", number(e.prior.off)},
             {"prior", {e.prior.lo, e.prior.hi}}, {"at_prior_bound", f.at_bound},
-            {"beyond_prior", f.beyond_prior}};
+            {"beyond_prior", f.beyond_prior}, {"at_prior_edge", f.at_prior_edge}};
 }
 
 void writeAtomically(const fs::path &path, const std::string &text) {
@@ -170,12 +170,15 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
         if (c.confirmed)
             r << "; confirmed: held-out gap " << pct(c.held_out.gap) << ", p = " << c.p_value
               << (c.explains                          ? ", EXPLAINS"
-                  : c.beats_null && c.fit.beyond_prior ? ", beats the null but only at its prior's edge"
+                  : c.beats_null && c.fit.at_prior_edge ? ", beats the null but only at its prior's edge"
                   : c.beats_null                       ? ", beats the null but leaves a gap"
                                                        : ", does not beat the null");
         if (c.fit.beyond_prior)
             r << "; pinned at its prior's edge (the data ask for more than " << c.effect.prior.lo
               << "-" << c.effect.prior.hi << " allows)";
+        else if (c.fit.at_prior_edge)
+            r << "; at its prior's edge (" << c.effect.prior.lo << "-" << c.effect.prior.hi
+              << "): never claimed";
         r << '\n';
     }
     if (!d.indistinguishable.empty()) {

@@ -187,10 +187,16 @@ TEST_CASE("a fit pinned at its prior's edge is flagged only when the data ask fo
     const auto far = fitStrength(r, prior, base + 1.6 * J, u2, all(4));
     CHECK(far.at_bound);
     CHECK(far.beyond_prior);
+    CHECK(far.at_prior_edge);
     const auto edge = fitStrength(r, prior, base + 1.0 * J, u2, all(4));
     CHECK(edge.strength == Approx(1.0).margin(1e-3));
     CHECK_FALSE(edge.beyond_prior);
-    CHECK_FALSE(fitStrength(r, prior, base + 0.5 * J, u2, all(4)).beyond_prior);
+    CHECK(edge.at_prior_edge); // at the end all the same: the prior cuts its interval
+    const auto inside = fitStrength(r, prior, base + 0.5 * J, u2, all(4));
+    CHECK_FALSE(inside.beyond_prior);
+    CHECK_FALSE(inside.at_prior_edge);
     // At the "off" end the data asking for less than nothing is no claim either way.
-    CHECK_FALSE(fitStrength(r, prior, base - 0.6 * J, u2, all(4)).beyond_prior);
+    const auto below = fitStrength(r, prior, base - 0.6 * J, u2, all(4));
+    CHECK_FALSE(below.beyond_prior);
+    CHECK_FALSE(below.at_prior_edge);
 }

@@ -90,6 +90,9 @@ struct StrengthFit {
     /// of the effect than its prior allows, so it stands in for something else and is never
     /// claimed (docs/gap.md, step 7).
     bool beyond_prior = false;
+    /// The best strength is an end of the prior that is not "off": the prior cuts its interval,
+    /// so the data may want more of the effect than is plausible, and it is never claimed.
+    bool at_prior_edge = false;
 };
 StrengthFit fitStrength(const Response &response, const Prior &prior,
                         const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
