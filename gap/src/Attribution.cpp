@@ -89,11 +89,9 @@ bool atPriorEdge(const Profile &p, double t0, double t1, double t_off) {
 /// Birge ratio: a fit pinned at an edge is poor because it is pinned.
 template <class F>
 bool beyondPrior(F chi2, const Profile &p, double t0, double t1, double t_off) {
-    if (!p.at_bound)
+    if (!atPriorEdge(p, t0, t1, t_off))
         return false;
     const bool upper = std::abs(p.t_best - t1) < std::abs(p.t_best - t0);
-    if (std::abs((upper ? t1 : t0) - t_off) < 1e-9 * std::max(1.0, std::abs(t1 - t0)))
-        return false;
     const double beyond = upper ? t1 + 0.2 * (t1 - t0) : t0 - 0.2 * (t1 - t0);
     const double c = chi2(beyond);
     return std::isfinite(c) && c < p.chi2 - std::max(kDeltaChi2_95, 0.1 * p.chi2);
