@@ -159,8 +159,32 @@ std::pair<std::size_t, double> axisColumn(const ConfigNode &node, const Table &t
     } catch (const std::invalid_argument &e) {
         node["unit"].fail(e.what());
     }
+    // Another code's sign convention (z up: a sinkage and a plate force come out negative).
+    const double scale = node.number("scale", 1.0);
+    if (scale == 0.0 || !std::isfinite(scale))
+        node["scale"].fail("a scale multiplies the column: give a finite number other than 0");
     node.finish();
-    return {col, factor};
+    return {col, factor * scale};
+}
+
+/// Refuses a plate test that reads as pulled out of the soil: grainlink takes a plate's pressure
+/// as positive and its sinkage as growing into the soil, and a curve with another code's signs
+/// (z up) would otherwise read as an enormous gap. Judged at the most loaded sample, which must
+/// push (pressure > 0) and lie deeper than the first.
+void checkPlateSigns(const Curve &curve, const ConfigNode &data, const std::string &file) {
+    if (curve.y.size() < 2)
+        return;
+    std::size_t peak = 0;
+    for (std::size_t i = 1; i < curve.y.size(); ++i)
+        if (std::abs(curve.y[i]) > std::abs(curve.y[peak]))
+            peak = i;
+    const std::string fix = "; grainlink takes a plate's pressure as positive and its sinkage as "
+                            "growing into the soil (add `scale: -1` where this code's axis "
+                            "points up)";
+    if (curve.y[peak] < 0.0)
+        data["y"].fail(file + ": the largest pressure is negative" + fix);
+    if (curve.x[peak] < curve.x.front())
+        data["x"].fail(file + ": the sinkage falls as the plate is loaded" + fix);
 }
 
 double siValue(const ConfigNode &parent, const std::string &value_key, const std::string &unit_key,
@@ -328,6 +352,7 @@ ExperimentSet loadExperiments(const std::string &directory) {
         }
 
         const ConfigNode data = node["data"];
+        double plate_area = 0.0; // > 0: the data give the plate's force (force_N)
         if (e.x_name.empty()) {
             // A scalar: values (repeats) with a unit.
             const std::string &obs = ti.observables.front();
@@ -355,9 +380,21 @@ ExperimentSet loadExperiments(const std::string &directory) {
             const ConfigNode files = data["files"];
             const ConfigNode y = data["y"];
             std::vector<std::string> obs_names = y.keys();
+            // A plate's force, as most codes and load cells give it, read as the pressure under
+            // the plate (the simulation's observable).
+            if (e.type == ExperimentType::PlateSinkage && y.has("force_N")) {
+                if (y.has("pressure_Pa"))
+                    y["force_N"].fail("give a plate's force or its pressure, not both");
+                const auto d = e.numbers.find("plate_diameter_m");
+                if (d == e.numbers.end() || !(d->second > 0.0))
+                    y["force_N"].fail("a plate's force needs conditions.plate_diameter_m to "
+                                      "become its pressure");
+                plate_area = M_PI * d->second * d->second / 4.0;
+            }
             for (const auto &o : obs_names)
                 if (std::find(ti.observables.begin(), ti.observables.end(), o) ==
-                    ti.observables.end()) {
+                        ti.observables.end() &&
+                    !(o == "force_N" && plate_area > 0.0)) {
                     std::string allowed;
                     for (const auto &a : ti.observables)
                         allowed += (allowed.empty() ? "" : ", ") + a;
@@ -367,6 +404,8 @@ ExperimentSet loadExperiments(const std::string &directory) {
             if (obs_names.empty())
                 y.fail("name at least one observable");
             e.observables = obs_names;
+            std::replace(e.observables.begin(), e.observables.end(), std::string("force_N"),
+                         std::string("pressure_Pa"));
             const auto filter = data.optional("filter");
             for (const ConfigNode &f : files.items()) {
                 const fs::path path = dir / f.text();
@@ -375,7 +414,10 @@ ExperimentSet loadExperiments(const std::string &directory) {
                 std::vector<std::tuple<std::string, std::size_t, double>> ycols;
                 for (const auto &o : obs_names) {
                     const auto [c, fac] = axisColumn(y[o], table, o);
-                    ycols.emplace_back(o, c, fac);
+                    if (o == "force_N")
+                        ycols.emplace_back("pressure_Pa", c, fac / plate_area);
+                    else
+                        ycols.emplace_back(o, c, fac);
                 }
                 std::vector<std::pair<std::size_t, double>> keep;
                 if (filter)
@@ -408,6 +450,8 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     // No row passed the filter: no curve was started at all.
                     if (whole.curves.empty() || whole.curves.begin()->second.empty())
                         f.fail("no rows of " + path.string() + " pass the filter");
+                    if (e.type == ExperimentType::PlateSinkage)
+                        checkPlateSigns(whole.curves.begin()->second, data, path.string());
                     e.trials.push_back(std::move(whole));
                 }
             }
@@ -425,17 +469,25 @@ ExperimentSet loadExperiments(const std::string &directory) {
                 e.zero.method = ZeroConvention::Method::FirstSample;
             if (method == "force_threshold") {
                 e.zero.method = ZeroConvention::Method::ForceThreshold;
+                // In the data's own terms: a force when the data give the plate's force.
                 e.zero.threshold =
-                    siValue(*zero, "threshold", "unit", dimensionOf(e.observables.front()));
+                    plate_area > 0.0
+                        ? siValue(*zero, "threshold", "unit", "force") / plate_area
+                        : siValue(*zero, "threshold", "unit", dimensionOf(e.observables.front()));
             }
             zero->finish();
         }
         if (const auto u = node.optional("uncertainty")) {
-            const std::string dim = dimensionOf(e.observables.front());
+            // In the data's own terms, as the zero's threshold.
+            const auto yValue = [&](const std::string &key) {
+                return plate_area > 0.0
+                           ? siValue(*u, key, "unit", "force") / plate_area
+                           : siValue(*u, key, "unit", dimensionOf(e.observables.front()));
+            };
             if (u->has("y_sigma"))
-                e.uncertainty.y_sigma = siValue(*u, "y_sigma", "unit", dim);
+                e.uncertainty.y_sigma = yValue("y_sigma");
             if (u->has("y_systematic"))
-                e.uncertainty.y_systematic = siValue(*u, "y_systematic", "unit", dim);
+                e.uncertainty.y_systematic = yValue("y_systematic");
             e.uncertainty.y_relative = u->number("y_relative", 0.0);
             if (u->has("x_zero_sigma"))
                 e.uncertainty.x_zero_sigma =

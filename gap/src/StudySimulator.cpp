@@ -79,9 +79,12 @@ std::string rigOf(const Experiment &e) {
 std::string unsupported(const Experiment &e) {
     if (e.type == ExperimentType::WheelSteadyState) {
         const auto beta = e.numbers.find("slip_angle_deg");
-        if (beta != e.numbers.end() && beta->second != 0.0)
-            return "slip angle " + std::to_string(beta->second) +
-                   " deg: the lab's wheel runs straight (slip angle 0)";
+        if (beta != e.numbers.end() && beta->second != 0.0) {
+            std::ostringstream why;
+            why << "slip angle " << beta->second
+                << " deg: the lab's wheel runs straight (slip angle 0)";
+            return why.str();
+        }
     }
     return "";
 }

@@ -166,3 +166,59 @@ TEST_CASE("experiments.yaml: bad input names the file, the key and the line",
     fails(plateYaml() + "  - id: p60\n    type: angle_of_repose\n    data: {values: [1], unit: deg}\n",
           "used twice");
 }
+
+// Another code's output: the plate's force in N with z up (force and sinkage negative). Read
+// with `force_N` and `scale: -1`, it is the pressure F / (pi d^2 / 4) on a growing sinkage; read
+// as it is, it is refused with the fix, not compared as an enormous gap.
+TEST_CASE("experiments.yaml: a plate force with z up becomes its pressure", "[gap][experiments]") {
+    const fs::path dir = folder("force");
+    const double d = 0.06, area = M_PI * d * d / 4.0; // 2.827e-3 m^2
+    for (const char *name : {"f1.csv", "f2.csv"}) {
+        std::ofstream out(dir / name);
+        out << "z_mm,Fz_N\n";
+        for (int i = 0; i <= 20; ++i)
+            out << -0.5 * i << ',' << -10.0 * i << '\n'; // 10 N per 0.5 mm, both negative
+    }
+    const std::string head = "name: other-code\nexperiments:\n"
+                             "  - id: p60\n    type: plate_sinkage\n"
+                             "    conditions: {plate_diameter_m: 0.06}\n"
+                             "    data:\n      files: [f1.csv, f2.csv]\n";
+    write(dir / "experiments.yaml",
+          head + "      x: {column: z_mm, unit: mm, scale: -1}\n"
+                 "      y: {force_N: {column: Fz_N, unit: N, scale: -1}}\n"
+                 "    zero: {method: force_threshold, threshold: 5, unit: N}\n"
+                 "    uncertainty: {y_sigma: 2, unit: N}\n");
+    const ExperimentSet set = loadExperiments(dir.string());
+    const Experiment &e = set.experiments.at(0);
+    REQUIRE(e.observables == std::vector<std::string>{"pressure_Pa"});
+    const Curve &c = e.trials.at(0).curves.at("pressure_Pa");
+    CHECK(c.x.back() == Approx(0.010));
+    CHECK(c.y.back() == Approx(200.0 / area)); // 70.7 kPa
+    CHECK(e.zero.threshold == Approx(5.0 / area));
+    CHECK(e.uncertainty.y_sigma == Approx(2.0 / area));
+
+    const auto refused = [&](const std::string &axes, const std::string &what) {
+        write(dir / "experiments.yaml", head + axes);
+        try {
+            loadExperiments(dir.string());
+            FAIL("accepted: " << axes);
+        } catch (const grainlink::config::ConfigError &ex) {
+            INFO(ex.what());
+            CHECK(std::string(ex.what()).find(what) != std::string::npos);
+            CHECK(std::string(ex.what()).find("scale: -1") != std::string::npos);
+        }
+    };
+    refused("      x: {column: z_mm, unit: mm, scale: -1}\n"
+            "      y: {force_N: {column: Fz_N, unit: N}}\n",
+            "the largest pressure is negative");
+    refused("      x: {column: z_mm, unit: mm}\n"
+            "      y: {force_N: {column: Fz_N, unit: N, scale: -1}}\n",
+            "the sinkage falls as the plate is loaded");
+
+    write(dir / "experiments.yaml",
+          "name: other-code\nexperiments:\n  - id: p60\n    type: plate_sinkage\n"
+          "    data:\n      files: [f1.csv]\n      x: {column: z_mm, unit: mm, scale: -1}\n"
+          "      y: {force_N: {column: Fz_N, unit: N, scale: -1}}\n");
+    CHECK_THROWS_WITH(loadExperiments(dir.string()),
+                      Catch::Contains("needs conditions.plate_diameter_m"));
+}
