@@ -44,6 +44,18 @@ std::string plateYaml(const std::string &extra = "") {
            extra;
 }
 
+/// Writes `yaml` as dir's experiments.yaml and requires it refused with a message holding `what`.
+void checkRefused(const fs::path &dir, const std::string &yaml, const std::string &what) {
+    write(dir / "experiments.yaml", yaml);
+    try {
+        loadExperiments(dir.string());
+        FAIL("accepted: " << yaml);
+    } catch (const grainlink::config::ConfigError &e) {
+        INFO(e.what());
+        CHECK(std::string(e.what()).find(what) != std::string::npos);
+    }
+}
+
 } // namespace
 
 TEST_CASE("experiments.yaml: repeats in SI, and their mean and scatter per bin",
@@ -143,14 +155,7 @@ TEST_CASE("experiments.yaml: bad input names the file, the key and the line",
     linearTrial(dir / "a2.csv", 1.0);
     linearTrial(dir / "a3.csv", 1.0);
     const auto fails = [&](const std::string &yaml, const std::string &what) {
-        write(dir / "experiments.yaml", yaml);
-        try {
-            loadExperiments(dir.string());
-            FAIL("accepted: " << yaml);
-        } catch (const grainlink::config::ConfigError &e) {
-            INFO(e.what());
-            CHECK(std::string(e.what()).find(what) != std::string::npos);
-        }
+        checkRefused(dir, yaml, what);
     };
     fails(plateYaml("    colour: red\n"), "experiments.yaml:");
     fails(plateYaml("    colour: red\n"), "colour");
@@ -198,15 +203,8 @@ TEST_CASE("experiments.yaml: a plate force with z up becomes its pressure", "[ga
     CHECK(e.uncertainty.y_sigma == Approx(2.0 / area));
 
     const auto refused = [&](const std::string &axes, const std::string &what) {
-        write(dir / "experiments.yaml", head + axes);
-        try {
-            loadExperiments(dir.string());
-            FAIL("accepted: " << axes);
-        } catch (const grainlink::config::ConfigError &ex) {
-            INFO(ex.what());
-            CHECK(std::string(ex.what()).find(what) != std::string::npos);
-            CHECK(std::string(ex.what()).find("scale: -1") != std::string::npos);
-        }
+        checkRefused(dir, head + axes, what);
+        checkRefused(dir, head + axes, "scale: -1");
     };
     refused("      x: {column: z_mm, unit: mm, scale: -1}\n"
             "      y: {force_N: {column: Fz_N, unit: N}}\n",
