@@ -202,6 +202,8 @@ double siValue(const ConfigNode &parent, const std::string &value_key, const std
 
 const char *typeName(ExperimentType type) { return info(type).name; }
 
+const std::vector<std::string> &observablesOf(ExperimentType type) { return info(type).observables; }
+
 ExperimentType parseType(const std::string &name) {
     std::string known;
     for (const auto &t : types()) {

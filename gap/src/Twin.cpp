@@ -4,6 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -51,6 +52,30 @@ std::string observableOf(ExperimentType type) {
                                 " experiments yet");
 }
 
+/// The unit an observable's SI name ends with ("traction_N" -> "N", "torque_N_m" -> "N_m").
+std::string siUnit(const std::string &observable) {
+    if (observable.size() > 4 && observable.compare(observable.size() - 4, 4, "_N_m") == 0)
+        return "N_m";
+    return observable.substr(observable.rfind('_') + 1);
+}
+
+/// A wheel design's observables: its `observables` list, or what the lab's wheel test reports.
+std::vector<std::string> wheelObservables(const ConfigNode &n) {
+    const auto list = n.optional("observables");
+    if (!list)
+        return {"traction_N", "sinkage_m", "torque_N_m"};
+    const auto &allowed = observablesOf(ExperimentType::WheelSteadyState);
+    std::vector<std::string> out;
+    for (const ConfigNode &o : list->items()) {
+        if (std::find(allowed.begin(), allowed.end(), o.text()) == allowed.end())
+            o.fail("'" + o.text() + "' is not an observable of wheel_steady_state");
+        out.push_back(o.text());
+    }
+    if (out.empty())
+        list->fail("name at least one observable");
+    return out;
+}
+
 } // namespace
 
 Design loadDesign(const std::string &path) {
@@ -67,10 +92,13 @@ Design loadDesign(const std::string &path) {
             n["id"].fail("experiment id '" + e.id + "' is used twice");
         try {
             e.type = parseType(n["type"].text());
-            e.observables = {observableOf(e.type)};
+            if (e.type != ExperimentType::WheelSteadyState)
+                e.observables = {observableOf(e.type)};
         } catch (const std::invalid_argument &ex) {
             n["type"].fail(ex.what());
         }
+        if (e.type == ExperimentType::WheelSteadyState)
+            e.observables = wheelObservables(n);
         e.x_name = xName(e.type);
         if (const auto c = n.optional("conditions")) {
             for (const auto &key : c->keys()) {
@@ -82,14 +110,30 @@ Design loadDesign(const std::string &path) {
             }
             c->finish();
         }
-        Trial stand_in;
-        if (e.x_name.empty()) {
-            stand_in.curves[e.observables[0]] = Curve{{0.0}, {0.0}};
+        if (e.type == ExperimentType::WheelSteadyState) {
+            // A scatter over slip: one stand-in run at each slip the wheel is tested at.
+            e.scatter = true;
+            const ConfigNode slips = n["slips"];
+            for (double slip : slips.numbers()) {
+                if (!(slip >= -1.0 && slip <= 1.0))
+                    slips.fail("a slip lies in [-1, 1]");
+                Trial run;
+                for (const std::string &o : e.observables)
+                    run.curves[o] = Curve{{slip}, {0.0}};
+                e.trials.push_back(run);
+            }
+            if (e.trials.empty())
+                slips.fail("give at least one slip");
         } else {
-            const double reach = n["reach"].positive();
-            stand_in.curves[e.observables[0]] = Curve{{0.0, reach}, {0.0, 0.0}};
+            Trial stand_in;
+            if (e.x_name.empty()) {
+                stand_in.curves[e.observables[0]] = Curve{{0.0}, {0.0}};
+            } else {
+                const double reach = n["reach"].positive();
+                stand_in.curves[e.observables[0]] = Curve{{0.0, reach}, {0.0, 0.0}};
+            }
+            e.trials.push_back(stand_in);
         }
-        e.trials.push_back(stand_in);
         d.repeats[e.id] = int(n.integer("repeats", 1, 32, 2));
         n.finish();
         d.set.experiments.push_back(std::move(e));
@@ -133,10 +177,14 @@ TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySi
     // The twin's beds are other realisations than the ones the diagnosis simulates.
     truth.seed_offset = 1000 + 37 * int(options.seed % 1000);
     std::vector<int> seeds;
-    const auto curves = simulator.curves(design.set, {truth}, seeds);
+    writeTwin(design, simulator.curves(design.set, {truth}, seeds), key, out, key_path);
+    return key;
+}
 
+void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves, const TwinKey &key,
+               const std::string &out, const std::string &key_path) {
     fs::create_directories(fs::path(out) / "data");
-    std::mt19937 rng(options.seed * 7919u + 3u);
+    std::mt19937 rng(key.seed * 7919u + 3u);
     std::normal_distribution<double> z;
     YAML::Node root;
     root["name"] = fs::path(out).filename().string();
@@ -164,22 +212,49 @@ TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySi
                 continue;
             }
             const Curve &c = it->second.at(obs);
-            const double level = 1.0 + options.level_noise * z(rng);
+            const double level = 1.0 + key.level_noise * z(rng);
             if (e.x_name.empty()) {
                 // A repose test whose grains spread gives no angle: that repeat has no value.
                 if (std::isfinite(c.y[0]))
-                    scalar_values.push_back(c.y[0] * level * (1.0 + options.noise * z(rng)));
+                    scalar_values.push_back(c.y[0] * level * (1.0 + key.noise * z(rng)));
                 continue;
             }
-            // Only as far as the design reaches: the diagnosis then simulates the same tests.
-            const double reach = e.trials.front().curves.at(obs).x.back();
             const std::string file = "data/" + e.id + "_" + std::to_string(r + 1) + ".csv";
             std::ofstream f(fs::path(out) / file);
             f.precision(10);
-            f << "# twin of " << e.id << ", repeat " << r + 1 << "\n" << e.x_name << ',' << obs << '\n';
-            for (std::size_t i = 0; i < c.x.size(); ++i)
-                if (c.x[i] <= reach)
-                    f << c.x[i] << ',' << c.y[i] * level * (1.0 + options.noise * z(rng)) << '\n';
+            f << "# twin of " << e.id << ", repeat " << r + 1 << "\n" << e.x_name;
+            for (const std::string &o : e.observables)
+                f << ',' << o;
+            f << '\n';
+            if (e.scatter) {
+                // A wheel: a row per slip run, where every observable has its steady value.
+                for (double x : c.x) {
+                    std::vector<double> row;
+                    for (const std::string &o : e.observables) {
+                        const auto found = it->second.find(o);
+                        if (found == it->second.end())
+                            break;
+                        const Curve &oc = found->second;
+                        const auto at = std::find(oc.x.begin(), oc.x.end(), x);
+                        const std::size_t j = std::size_t(at - oc.x.begin());
+                        if (at == oc.x.end() || !std::isfinite(oc.y[j]))
+                            break;
+                        row.push_back(oc.y[j]);
+                    }
+                    if (row.size() < e.observables.size())
+                        continue; // this slip's run failed or did not settle
+                    f << x;
+                    for (double v : row)
+                        f << ',' << v * level * (1.0 + key.noise * z(rng));
+                    f << '\n';
+                }
+            } else {
+                // Only as far as the design reaches: the diagnosis then simulates the same tests.
+                const double reach = e.trials.front().curves.at(obs).x.back();
+                for (std::size_t i = 0; i < c.x.size(); ++i)
+                    if (c.x[i] <= reach)
+                        f << c.x[i] << ',' << c.y[i] * level * (1.0 + key.noise * z(rng)) << '\n';
+            }
             files.push_back(file);
         }
         if (!e.x_name.empty() && files.size() == 0)
@@ -193,18 +268,23 @@ TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySi
             data["unit"] = "deg";
         } else {
             data["files"] = files;
-            YAML::Node x, y, yc;
+            if (e.scatter)
+                data["scatter"] = true;
+            YAML::Node x, y;
             x["column"] = e.x_name;
             x["unit"] = e.x_name == "slip" ? "-" : "m";
             data["x"] = x;
-            yc["column"] = obs;
-            yc["unit"] = dimensionOf(obs) == "pressure" ? "Pa" : "deg";
-            y[obs] = yc;
+            for (const std::string &o : e.observables) {
+                YAML::Node yc;
+                yc["column"] = o;
+                yc["unit"] = siUnit(o);
+                y[o] = yc;
+            }
             data["y"] = y;
         }
         n["data"] = data;
         YAML::Node u;
-        u["y_relative"] = options.level_noise;
+        u["y_relative"] = key.level_noise;
         u["repeats"] = "rebuilt_bed";
         n["uncertainty"] = u;
         list.push_back(n);
@@ -228,7 +308,6 @@ TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySi
     fs::create_directories(fs::absolute(key_path).parent_path());
     std::ofstream(key_path) << j.dump(2) << '\n';
     loadExperiments(out); // reads back strictly
-    return key;
 }
 
 } // namespace grainlink::gap

@@ -194,3 +194,55 @@ TEST_CASE("data sets that reach nearly as far share their simulations", "[gap][s
     CHECK(YAML::Load(a)["bevameter"]["max_sinkage_m"].as<double>() == Approx(0.013));
     CHECK(a != sim.scenarioText(reaching(0.0105), {id}, {}, 1));
 }
+
+// A design may hold wheels: a scatter over the slips it names, with the lab's wheel observables.
+// Its twin folder holds one file per repeat with a row per slip run whose every observable
+// settled, and reads back as the measurements it was written from.
+TEST_CASE("a wheel design makes a twin folder the diagnosis reads", "[gap][twin][wheel]") {
+    const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-wheel-twin";
+    fs::remove_all(scratch);
+    fs::create_directories(scratch);
+    std::ofstream(scratch / "design.yaml")
+        << "name: wheel-design\nexperiments:\n"
+           "  - {id: wheel, type: wheel_steady_state, slips: [0.1, 0.3, 0.6], repeats: 2,\n"
+           "     conditions: {load_N: 20, grouser_count: 0}}\n"
+           "  - {id: plate, type: plate_sinkage, conditions: {plate_diameter_m: 0.02}, "
+           "reach: 0.004, repeats: 2}\n";
+    const Design design = loadDesign((scratch / "design.yaml").string());
+    const Experiment &wheel = design.set.find("wheel");
+    CHECK(wheel.scatter);
+    CHECK(wheel.observables == std::vector<std::string>{"traction_N", "sinkage_m", "torque_N_m"});
+    REQUIRE(wheel.trials.size() == 3);
+    CHECK(wheel.trials[2].curves.at("torque_N_m").x == std::vector<double>{0.6});
+
+    // Two repeats; in the second the 0.6 slip's torque did not settle (no value).
+    std::vector<SimulatedCurves> curves(2);
+    for (int r = 0; r < 2; ++r) {
+        const std::vector<double> slips = {0.1, 0.3, 0.6};
+        curves[r]["wheel"]["traction_N"] = Curve{slips, {2.0 + r, 5.0 + r, 9.0 + r}};
+        curves[r]["wheel"]["sinkage_m"] = Curve{slips, {0.010, 0.015, 0.030}};
+        curves[r]["wheel"]["torque_N_m"] =
+            r == 0 ? Curve{slips, {0.3, 0.5, 0.8}} : Curve{{0.1, 0.3}, {0.3, 0.5}};
+        curves[r]["plate"]["pressure_Pa"] = Curve{{0.0, 0.002, 0.004, 0.006}, {0, 1e4, 2e4, 3e4}};
+    }
+    TwinKey key;
+    key.seed = 3;
+    key.noise = key.level_noise = 0.0;
+    writeTwin(design, curves, key, (scratch / "twin").string(), (scratch / "twin.key.json").string());
+
+    const ExperimentSet read = loadExperiments((scratch / "twin").string());
+    const Experiment &w = read.find("wheel");
+    CHECK(w.type == ExperimentType::WheelSteadyState);
+    CHECK(w.scatter);
+    REQUIRE(w.trials.size() == 5); // 3 runs of the first repeat, 2 of the second
+    CHECK(w.trials[1].curves.at("traction_N").x[0] == Approx(0.3));
+    CHECK(w.trials[1].curves.at("traction_N").y[0] == Approx(5.0));
+    CHECK(w.trials[4].curves.at("torque_N_m").y[0] == Approx(0.5));
+    CHECK(w.trials[4].curves.at("sinkage_m").y[0] == Approx(0.015));
+    CHECK(w.numbers.at("load_N") == 20.0);
+    // The plate's data stop at the design's reach.
+    const Experiment &p = read.find("plate");
+    REQUIRE(p.trials.size() == 2);
+    CHECK(p.trials[0].curves.at("pressure_Pa").x.back() == Approx(0.004));
+    fs::remove_all(scratch);
+}

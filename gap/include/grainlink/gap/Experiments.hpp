@@ -23,6 +23,8 @@ enum class ExperimentType {
 };
 const char *typeName(ExperimentType type);
 ExperimentType parseType(const std::string &name); ///< throws std::invalid_argument
+/// The observables an experiment of `type` may hold (SI names, e.g. "pressure_Pa").
+const std::vector<std::string> &observablesOf(ExperimentType type);
 
 /// The SI factor of a unit name ("kPa" -> 1000, "mm" -> 0.001, "deg" -> 1); throws naming the
 /// unit when it is unknown or not of `dimension` ("length", "pressure", "force", ...).

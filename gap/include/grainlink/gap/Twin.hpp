@@ -41,8 +41,13 @@ struct TwinOptions {
 /// Draws a strength uniformly on the effect's prior (on its own scale).
 double drawStrength(const Effect &effect, unsigned seed);
 
-/// Simulates the twin into `out` (experiments.yaml + data/), writes its key to `key_path`, and
-/// returns the key.
+/// Writes a twin's measurements folder `out` (experiments.yaml + data/) from its simulated
+/// repeats (`curves[r]`: repeat r's curves per experiment id and observable) with the key's
+/// noise (its seed draws it), and the key to `key_path`; reads the folder back strictly.
+void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves, const TwinKey &key,
+               const std::string &out, const std::string &key_path);
+
+/// Simulates the twin into `out` (writeTwin) and returns its key.
 TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySimulator &simulator,
                  const TwinOptions &options, const std::string &out, const std::string &key_path);
 
