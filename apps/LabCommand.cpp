@@ -35,7 +35,8 @@ int runLab(const LabOptions &options) {
     std::printf("written: %s/{%s}%s\n", directory.c_str(), files.c_str(),
                 run.checks.empty() ? "" : ", reruns in check_*/");
     // The plot is a view of the results: without python3 or matplotlib the run still succeeded.
-    std::printf("%s\n", lab::plotLabRun(directory, run.summary.test).message.c_str());
+    if (!options.no_plot)
+        std::printf("%s\n", lab::plotLabRun(directory, run.summary.test).message.c_str());
     return 0;
 }
 

@@ -22,6 +22,7 @@ struct LabOptions {
     double progress_interval_s = 5.0;
     std::string check;         ///< "", "walls", "resolution" or "both" (lab/NumericalChecks.hpp)
     double check_factor = 0.0; ///< 0: the check's default (width x 2, radii x 0.75)
+    bool no_plot = false;      ///< runs that only feed a diagnosis need none
 };
 int runLab(const LabOptions &options);
 

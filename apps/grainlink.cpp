@@ -121,6 +121,9 @@ int main(int argc, char **argv) {
                     "rerun on a wider box (walls), finer grains (resolution) or both and report "
                     "how far the answers moved")
         ->check(CLI::IsMember({"walls", "resolution", "both"}));
+    lab->add_flag("--no-plot", lab_options.no_plot,
+                  "skip the plot (the diagnosis' runs: it reads only summary.json, and a plot "
+                  "costs about a fifth of a small test's time)");
     lab->add_option("--check-factor", lab_options.check_factor,
                     "box width factor (> 1, default 2) or grain radius factor (< 1, default 0.75)");
 

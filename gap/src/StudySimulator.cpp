@@ -476,8 +476,11 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
         for (int s = 0; s < requests[r].seeds; ++s)
             for (std::size_t g = 0; g < gs.size(); ++g) {
                 const Experiment &e = design.find(gs[g].front());
+                // The diagnosis reads the summary only: no plot per run (a fifth of a plate's time).
+                study::Kind kind = study::standardKind("lab", labTestOf(e.type));
+                kind.command.push_back("--no-plot");
                 const study::Point p = study::makePoint(
-                    study::standardKind("lab", labTestOf(e.type)),
+                    kind,
                     scenarioText(design, gs[g], requests[r], requests[r].seed_offset + s),
                     requests[r].label + " seed " + std::to_string(s) + " " + gs[g].front());
                 auto [it, fresh] = index.try_emplace(p.id, st.points.size());
