@@ -204,6 +204,8 @@ const char *typeName(ExperimentType type) { return info(type).name; }
 
 const std::vector<std::string> &observablesOf(ExperimentType type) { return info(type).observables; }
 
+const char *xNameOf(ExperimentType type) { return info(type).x_name; }
+
 ExperimentType parseType(const std::string &name) {
     std::string known;
     for (const auto &t : types()) {
@@ -236,6 +238,13 @@ std::string dimensionOf(const std::string &si_name) {
         if (endsWith(si_name, tail))
             return dim;
     return "dimensionless";
+}
+
+std::string unitOf(const std::string &si_name) {
+    for (const auto &suffix : suffixes())
+        if (endsWith(si_name, suffix.first))
+            return suffix.first.substr(1);
+    return "";
 }
 
 std::string Experiment::kind(const std::string &observable) const {

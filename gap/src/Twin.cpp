@@ -10,7 +10,6 @@
 #include <fstream>
 #include <random>
 #include <set>
-#include <sstream>
 
 namespace grainlink::gap {
 
@@ -18,46 +17,6 @@ namespace fs = std::filesystem;
 using config::ConfigNode;
 
 namespace {
-
-std::string xName(ExperimentType type) {
-    switch (type) {
-    case ExperimentType::PlateSinkage:
-        return "sinkage_m";
-    case ExperimentType::BevameterShear:
-    case ExperimentType::DirectShear:
-        return "shear_displacement_m";
-    case ExperimentType::AngleOfRepose:
-        return "";
-    case ExperimentType::WheelSteadyState:
-        return "slip";
-    case ExperimentType::Mole:
-        return "stroke";
-    }
-    return "";
-}
-
-std::string observableOf(ExperimentType type) {
-    switch (type) {
-    case ExperimentType::PlateSinkage:
-        return "pressure_Pa";
-    case ExperimentType::BevameterShear:
-    case ExperimentType::DirectShear:
-        return "shear_stress_Pa";
-    case ExperimentType::AngleOfRepose:
-        return "angle_deg";
-    default:
-        break;
-    }
-    throw std::invalid_argument(std::string("a design cannot hold ") + typeName(type) +
-                                " experiments yet");
-}
-
-/// The unit an observable's SI name ends with ("traction_N" -> "N", "torque_N_m" -> "N_m").
-std::string siUnit(const std::string &observable) {
-    if (observable.size() > 4 && observable.compare(observable.size() - 4, 4, "_N_m") == 0)
-        return "N_m";
-    return observable.substr(observable.rfind('_') + 1);
-}
 
 /// A wheel design's observables: its `observables` list, or what the lab's wheel test reports.
 std::vector<std::string> wheelObservables(const ConfigNode &n) {
@@ -92,14 +51,16 @@ Design loadDesign(const std::string &path) {
             n["id"].fail("experiment id '" + e.id + "' is used twice");
         try {
             e.type = parseType(n["type"].text());
-            if (e.type != ExperimentType::WheelSteadyState)
-                e.observables = {observableOf(e.type)};
         } catch (const std::invalid_argument &ex) {
             n["type"].fail(ex.what());
         }
-        if (e.type == ExperimentType::WheelSteadyState)
-            e.observables = wheelObservables(n);
-        e.x_name = xName(e.type);
+        if (e.type == ExperimentType::Mole)
+            n["type"].fail("a design cannot hold mole experiments yet");
+        // A wheel reports several observables; every other test one.
+        e.observables = e.type == ExperimentType::WheelSteadyState
+                            ? wheelObservables(n)
+                            : std::vector<std::string>{observablesOf(e.type).front()};
+        e.x_name = xNameOf(e.type);
         if (const auto c = n.optional("conditions")) {
             for (const auto &key : c->keys()) {
                 const ConfigNode v = (*c)[key];
@@ -277,7 +238,7 @@ void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves,
             for (const std::string &o : e.observables) {
                 YAML::Node yc;
                 yc["column"] = o;
-                yc["unit"] = siUnit(o);
+                yc["unit"] = unitOf(o);
                 y[o] = yc;
             }
             data["y"] = y;

@@ -1,6 +1,7 @@
 #include "grainlink/gap/Validation.hpp"
 
 #include "grainlink/gap/Correlation.hpp"
+#include "grainlink/gap/Experiments.hpp"
 
 #include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
@@ -23,14 +24,11 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 double sq(double v) { return v * v; }
 
 /// "pressure" from "pressure_Pa", "vertical load" from "vertical_load_N": the observable's name
-/// without its unit suffix (the last word; "N_m" is one unit), in words.
+/// without its unit suffix, in words.
 std::string observableName(const std::string &observable) {
-    std::string name = observable;
-    for (const char *unit : {"_N_m", "_"})
-        if (const auto cut = name.rfind(unit); cut != std::string::npos && cut > 0) {
-            name = name.substr(0, cut);
-            break;
-        }
+    const std::string unit = unitOf(observable);
+    std::string name =
+        unit.empty() ? observable : observable.substr(0, observable.size() - unit.size() - 1);
     std::replace(name.begin(), name.end(), '_', ' ');
     return name;
 }

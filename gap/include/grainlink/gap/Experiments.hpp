@@ -25,6 +25,8 @@ const char *typeName(ExperimentType type);
 ExperimentType parseType(const std::string &name); ///< throws std::invalid_argument
 /// The observables an experiment of `type` may hold (SI names, e.g. "pressure_Pa").
 const std::vector<std::string> &observablesOf(ExperimentType type);
+/// The SI name of its x ("sinkage_m", "slip"); "" for a scalar.
+const char *xNameOf(ExperimentType type);
 
 /// The SI factor of a unit name ("kPa" -> 1000, "mm" -> 0.001, "deg" -> 1); throws naming the
 /// unit when it is unknown or not of `dimension` ("length", "pressure", "force", ...).
@@ -94,6 +96,8 @@ Curve applyZero(const Curve &curve, const ZeroConvention &zero);
 /// The SI dimension an observable's name implies by its unit suffix ("pressure_Pa" ->
 /// "pressure", "sinkage_m" -> "length", "slip" -> "dimensionless").
 std::string dimensionOf(const std::string &si_name);
+/// The unit that suffix names ("pressure_Pa" -> "Pa", "torque_N_m" -> "N_m"); "" for none.
+std::string unitOf(const std::string &si_name);
 
 /// Turns a scatter of single points (x, y) into bin means: the feature for a scatter
 /// experiment is the mean of the points in each bin.
