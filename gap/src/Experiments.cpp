@@ -473,6 +473,13 @@ ExperimentSet loadExperiments(const std::string &directory) {
             data.finish();
         }
 
+        // A value of y with its `unit` (a threshold, a sigma), in the data's own terms: a force
+        // where the data give a plate's force.
+        const auto yValue = [&](const ConfigNode &parent, const std::string &key) {
+            return plate_area > 0.0
+                       ? siValue(parent, key, "unit", "force") / plate_area
+                       : siValue(parent, key, "unit", dimensionOf(e.observables.front()));
+        };
         if (const auto zero = node.optional("zero")) {
             const std::string method =
                 (*zero)["method"].choice({"as_recorded", "first_sample", "force_threshold"});
@@ -480,25 +487,15 @@ ExperimentSet loadExperiments(const std::string &directory) {
                 e.zero.method = ZeroConvention::Method::FirstSample;
             if (method == "force_threshold") {
                 e.zero.method = ZeroConvention::Method::ForceThreshold;
-                // In the data's own terms: a force when the data give the plate's force.
-                e.zero.threshold =
-                    plate_area > 0.0
-                        ? siValue(*zero, "threshold", "unit", "force") / plate_area
-                        : siValue(*zero, "threshold", "unit", dimensionOf(e.observables.front()));
+                e.zero.threshold = yValue(*zero, "threshold");
             }
             zero->finish();
         }
         if (const auto u = node.optional("uncertainty")) {
-            // In the data's own terms, as the zero's threshold.
-            const auto yValue = [&](const std::string &key) {
-                return plate_area > 0.0
-                           ? siValue(*u, key, "unit", "force") / plate_area
-                           : siValue(*u, key, "unit", dimensionOf(e.observables.front()));
-            };
             if (u->has("y_sigma"))
-                e.uncertainty.y_sigma = yValue("y_sigma");
+                e.uncertainty.y_sigma = yValue(*u, "y_sigma");
             if (u->has("y_systematic"))
-                e.uncertainty.y_systematic = yValue("y_systematic");
+                e.uncertainty.y_systematic = yValue(*u, "y_systematic");
             e.uncertainty.y_relative = u->number("y_relative", 0.0);
             if (u->has("x_zero_sigma"))
                 e.uncertainty.x_zero_sigma =
