@@ -1,5 +1,7 @@
 #include "grainlink/gap/Attribution.hpp"
 
+#include "NotANumber.hpp"
+
 #include <boost/math/distributions/students_t.hpp>
 
 #include <algorithm>
@@ -13,7 +15,6 @@ namespace grainlink::gap {
 namespace {
 
 constexpr int kGrid = 201;
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kDeltaChi2_95 = 3.841458820694124; // chi^2_1 at 95 %
 
 template <class F> double goldenMinimum(F f, double a, double b) {

@@ -1,5 +1,7 @@
 #include "grainlink/gap/Comparison.hpp"
 
+#include "NotANumber.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -7,8 +9,6 @@
 namespace grainlink::gap {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string slot(const std::string &id, const std::string &observable) {
     return id + "/" + observable;

@@ -1,5 +1,7 @@
 #include "grainlink/gap/Diagnosis.hpp"
 
+#include "NotANumber.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -10,8 +12,6 @@
 namespace grainlink::gap {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string fmt(double v, int digits = 3) {
     std::ostringstream s;

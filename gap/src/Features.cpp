@@ -1,15 +1,13 @@
 #include "grainlink/gap/Features.hpp"
 
+#include "NotANumber.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
 
 namespace grainlink::gap {
-
-namespace {
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-}
 
 std::optional<double> binMean(const Curve &curve, double a, double b) {
     const auto &x = curve.x;

@@ -1,5 +1,7 @@
 #include "grainlink/gap/StudySimulator.hpp"
 
+#include "NotANumber.hpp"
+
 #include "grainlink/config/ConfigNode.hpp"
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/LabSummary.hpp"
@@ -28,8 +30,6 @@ double roundUp2(double v) {
     const double step = std::pow(10.0, std::floor(std::log10(v)) - 1.0);
     return std::ceil(v / step * (1.0 - 1e-12)) * step;
 }
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// `over` merged into `target`: mappings key by key, anything else replaced; a key set to
 /// null (`walls: ~`) is removed.

@@ -1,5 +1,7 @@
 #include "grainlink/gap/Validation.hpp"
 
+#include "NotANumber.hpp"
+
 #include "grainlink/gap/Correlation.hpp"
 #include "grainlink/gap/Experiments.hpp"
 
@@ -18,10 +20,6 @@
 namespace grainlink::gap {
 
 namespace {
-
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-
-double sq(double v) { return v * v; }
 
 /// "pressure" from "pressure_Pa", "vertical load" from "vertical_load_N": the observable's name
 /// without its unit suffix, in words.

@@ -23,8 +23,6 @@ using dem::Vec3;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// Flat closed disc of radius R and thickness t, axis z, bottom face at z = 0.
 dem::TriangleMesh plateMesh(double radius_m, double thickness_m, int segments) {
     dem::TriangleMesh mesh = dem::makeCylinder(radius_m, thickness_m, segments);
@@ -154,7 +152,7 @@ PlateRun BevameterExperiment::run(const LabBed &bed, double radius,
         std::ceil((initial.position_m.z() - surface + t.max_sinkage_m) / (t.speed_m_s * dt)));
     const auto steps_per_sample =
         std::max<std::uint64_t>(1, std::llround(t.sample_interval_s / dt));
-    const double area = kPi * radius * radius;
+    const double area = M_PI * radius * radius;
     dem::Progress progress("bevameter R=" + mm(radius), progress_interval_s);
     std::uint64_t done = 0;
     while (done < total_steps) {

@@ -27,8 +27,7 @@ using dem::Vec3;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDeg = 180.0 / kPi;
+constexpr double kDeg = 180.0 / M_PI;
 
 /// Open rectangular frame [0, L] x [0, W] x [0, h] (four side walls, no floor or lid) plus a
 /// horizontal lip y in [0, W], x in [lip_x0, lip_x1] at z = lip_z: the lip stands in for the wall

@@ -10,8 +10,6 @@ namespace grainlink::lab {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// Throws naming the quantity if v is outside (lo, hi) (or [lo, hi] where `closed`).
 void requireRange(const std::string &what, double v, double lo, double hi, bool lo_closed,
                   bool hi_closed) {
@@ -140,7 +138,7 @@ SoilTestDescription loadSoilTestDescription(const std::string &path) {
 double worstContactForce(const SoilTestDescription &d, double radius_m) {
     // Reading of seed eq. 10, docs/physics.md §12.2: plate share plus the cubic column's weight.
     const double z_h = d.bed_height_m - d.expected_sinkage_m;
-    return 2.0 * kPi / 3.0 * radius_m * radius_m *
+    return 2.0 * M_PI / 3.0 * radius_m * radius_m *
            (d.expected_pressure_Pa * d.plate_radius_m / radius_m +
             z_h * d.grain_density_kg_m3 * d.gravity_m_s2);
 }
@@ -157,7 +155,7 @@ double rayleighTime(double youngs_modulus_Pa, double poisson_ratio, double densi
                     double radius_m) {
     // docs/physics.md §3.3, the same estimate DemSystem::stableTimeStepEstimate uses.
     const double shear = youngs_modulus_Pa / (2.0 * (1.0 + poisson_ratio));
-    return kPi * radius_m * std::sqrt(density_kg_m3 / shear) / (0.1631 * poisson_ratio + 0.8766);
+    return M_PI * radius_m * std::sqrt(density_kg_m3 / shear) / (0.1631 * poisson_ratio + 0.8766);
 }
 
 ParameterMatrix estimateParameters(const SoilTestDescription &d) {
@@ -173,8 +171,8 @@ ParameterMatrix estimateParameters(const SoilTestDescription &d) {
 
     // Minimum stiffness, seed eq. 10 as read in docs/physics.md §12.2.
     m.column_height_m = d.bed_height_m - d.expected_sinkage_m;
-    m.plate_force_share_N = 2.0 * kPi / 3.0 * d.expected_pressure_Pa * d.plate_radius_m * r;
-    m.column_weight_N = 2.0 * kPi / 3.0 * r * r * m.column_height_m * rho * d.gravity_m_s2;
+    m.plate_force_share_N = 2.0 * M_PI / 3.0 * d.expected_pressure_Pa * d.plate_radius_m * r;
+    m.column_weight_N = 2.0 * M_PI / 3.0 * r * r * m.column_height_m * rho * d.gravity_m_s2;
     m.worst_contact_force_N = worstContactForce(d, r);
     m.normal_stiffness_N_m = m.worst_contact_force_N / (a * r);
     // Equivalent linear stiffness: Hertz reaches F_max at delta = a r (secant stiffness c_n).
@@ -186,7 +184,7 @@ ParameterMatrix estimateParameters(const SoilTestDescription &d) {
 
     // Damping: a fraction of the critical damping of the stiffest pair, two smallest grains
     // under F_max: Hertz tangent stiffness dF/d(delta) = 3/2 F / delta.
-    const double mass_min = 4.0 / 3.0 * kPi * rho * r * r * r;
+    const double mass_min = 4.0 / 3.0 * M_PI * rho * r * r * r;
     m.stiffest_pair_mass_kg = 0.5 * mass_min;
     m.stiffest_pair_stiffness_N_m =
         1.5 * m.worst_contact_force_N / (m.overlap_ratio_at_worst_force * r);
@@ -198,10 +196,10 @@ ParameterMatrix estimateParameters(const SoilTestDescription &d) {
 
     // Inertia, seed eq. 12, of the largest grain.
     const double R = m.radius_max_m;
-    m.grain_mass_max_kg = 4.0 / 3.0 * kPi * rho * R * R * R;
+    m.grain_mass_max_kg = 4.0 / 3.0 * M_PI * rho * R * R * R;
     for (int i = 0; i < 3; ++i)
-        m.inertia_kg_m2[i] = kPi * rho * R * R * R * std::pow(R / d.aspect_ratios[i], 2) / 9.0;
-    m.solid_sphere_inertia_kg_m2 = 8.0 / 15.0 * kPi * rho * std::pow(R, 5);
+        m.inertia_kg_m2[i] = M_PI * rho * R * R * R * std::pow(R / d.aspect_ratios[i], 2) / 9.0;
+    m.solid_sphere_inertia_kg_m2 = 8.0 / 15.0 * M_PI * rho * std::pow(R, 5);
 
     // Time step (docs/physics.md §3.3 and §12.5).
     m.rayleigh_time_s = rayleighTime(m.youngs_modulus_Pa, nu, rho, r);
@@ -227,11 +225,11 @@ std::vector<DerivedValue> ParameterMatrix::values() const {
         {"aspect_ratio_x", "rotational", d.aspect_ratios.x(), "input (A_1, eq. 6)"},
         {"aspect_ratio_y", "rotational", d.aspect_ratios.y(), "input (A_2, eq. 6)"},
         {"aspect_ratio_z", "rotational", d.aspect_ratios.z(), "input (A_3, eq. 6)"},
-        {"aspect_ratio_angle_x_deg", "rotational", std::atan(d.aspect_ratios.x()) * 180.0 / kPi,
+        {"aspect_ratio_angle_x_deg", "rotational", std::atan(d.aspect_ratios.x()) * 180.0 / M_PI,
          "eq. 7: gamma = atan(A)"},
-        {"aspect_ratio_angle_y_deg", "rotational", std::atan(d.aspect_ratios.y()) * 180.0 / kPi,
+        {"aspect_ratio_angle_y_deg", "rotational", std::atan(d.aspect_ratios.y()) * 180.0 / M_PI,
          "eq. 7: gamma = atan(A)"},
-        {"aspect_ratio_angle_z_deg", "rotational", std::atan(d.aspect_ratios.z()) * 180.0 / kPi,
+        {"aspect_ratio_angle_z_deg", "rotational", std::atan(d.aspect_ratios.z()) * 180.0 / M_PI,
          "eq. 7: gamma = atan(A)"},
         // geometry
         {"particle_radius_max_m", "normal", radius_max_m, "eq. 11: L_min / (2 Gamma)"},
@@ -281,7 +279,7 @@ std::vector<DerivedValue> ParameterMatrix::values() const {
 }
 
 namespace {
-std::string number(double v) {
+std::string sixFigures(double v) {
     std::ostringstream out;
     out << std::setprecision(6) << v;
     return out.str();
@@ -295,11 +293,12 @@ std::string formatTable(const ParameterMatrix &m) {
            "rotational [0 | 0 | r | gamma | J]\n\n";
     for (const auto &v : m.values())
         out << "  " << std::left << std::setw(30) << v.key << std::right << std::setw(14)
-            << number(v.value) << "  " << std::left << std::setw(11) << v.row << v.source << "\n";
+            << sixFigures(v.value) << "  " << std::left << std::setw(11) << v.row << v.source
+            << "\n";
     if (m.input.youngs_modulus_Pa && *m.input.youngs_modulus_Pa < m.minimum_youngs_modulus_Pa)
         out << "\n  warning: the given E is below eq. 10's minimum: the worst-case overlap is "
-            << number(m.overlap_ratio_at_worst_force) << " r, above max_overlap_ratio "
-            << number(m.input.max_overlap_ratio) << "\n";
+            << sixFigures(m.overlap_ratio_at_worst_force) << " r, above max_overlap_ratio "
+            << sixFigures(m.input.max_overlap_ratio) << "\n";
     return out.str();
 }
 
@@ -326,8 +325,8 @@ std::string soilBlock(const ParameterMatrix &m) {
     const auto &d = m.input;
     std::ostringstream out;
     out << std::setprecision(6);
-    out << "# from grainlink params (" << d.name << "): grains of radius " << number(m.radius_min_m)
-        << " .. " << number(m.radius_max_m) << " m (eq. 11)\n";
+    out << "# from grainlink params (" << d.name << "): grains of radius "
+        << sixFigures(m.radius_min_m) << " .. " << sixFigures(m.radius_max_m) << " m (eq. 11)\n";
     out << "soil:\n";
     out << "  simulation:\n";
     out << "    time_step_s: " << m.recommended_time_step_s << "\n";

@@ -27,14 +27,12 @@ using dem::Vec3;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// Open tube (side wall only) of radius R and height H about the body z axis, bottom at z = 0.
 /// Mesh contacts are two-sided, so grains inside touch it.
 dem::TriangleMesh tubeMesh(double radius_m, double height_m, int segments) {
     dem::TriangleMesh mesh;
     for (int k = 0; k < segments; ++k) {
-        const double a = 2.0 * kPi * k / segments;
+        const double a = 2.0 * M_PI * k / segments;
         mesh.vertices_m.emplace_back(radius_m * std::cos(a), radius_m * std::sin(a), 0.0);
         mesh.vertices_m.emplace_back(radius_m * std::cos(a), radius_m * std::sin(a), height_m);
     }
@@ -142,10 +140,10 @@ void measureHeap(const std::vector<Eigen::Vector3d> &positions, const std::vecto
     }
     const dem::LineFit line = dem::fitLine(x, y);
     const double slope = line.slope, se = line.slope_se;
-    result.angle_deg = std::atan(-slope) * 180.0 / kPi;
+    result.angle_deg = std::atan(-slope) * 180.0 / M_PI;
     // d(atan s)/ds = 1 / (1 + s^2)
     result.angle_half_width_95_deg =
-        studentT975(int(x.size()) - 2) * se / (1.0 + slope * slope) * 180.0 / kPi;
+        studentT975(int(x.size()) - 2) * se / (1.0 + slope * slope) * 180.0 / M_PI;
 }
 
 namespace {
@@ -204,7 +202,7 @@ ReposeFill ReposeExperiment::prepareBed(double progress_interval_s) const {
     if (d.rolling)
         sys.setRolling(dem::contactLaws(scenario.soil));
     fill.summary = measureBed(sys, scenario.soil,
-                              {kPi * t.tube_radius_m * t.tube_radius_m, d.region_lower_m.z()});
+                              {M_PI * t.tube_radius_m * t.tube_radius_m, d.region_lower_m.z()});
     fill.summary.wall_s = secondsSince(start);
     return fill;
 }

@@ -26,8 +26,6 @@ using dem::Vec3;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// Appends the quad (a, b, c, d) as two triangles whose normals point along `outward`.
 void appendQuad(dem::TriangleMesh &mesh, int a, int b, int c, int d, const Vec3 &outward) {
     for (std::array<int, 3> t : {std::array<int, 3>{a, b, c}, std::array<int, 3>{a, c, d}}) {
@@ -89,12 +87,12 @@ struct AnnulusDrive {
 } // namespace
 
 double AnnulusGeometry::area_m2() const {
-    return kPi * (outer_radius_m * outer_radius_m - inner_radius_m * inner_radius_m);
+    return M_PI * (outer_radius_m * outer_radius_m - inner_radius_m * inner_radius_m);
 }
 
 double AnnulusGeometry::torqueFactor_m3() const {
     // tau uniform over the annulus: T = int tau r dA = 2 pi / 3 (R_o^3 - R_i^3) tau, §12.12.
-    return 2.0 * kPi / 3.0 * (std::pow(outer_radius_m, 3) - std::pow(inner_radius_m, 3));
+    return 2.0 * M_PI / 3.0 * (std::pow(outer_radius_m, 3) - std::pow(inner_radius_m, 3));
 }
 
 double AnnulusGeometry::meanRadius_m() const {
@@ -113,14 +111,14 @@ dem::TriangleMesh makeShearAnnulus(const AnnulusGeometry &g) {
     dem::TriangleMesh mesh;
     // Per segment k: inner bottom, outer bottom, inner top, outer top.
     for (int k = 0; k < n; ++k) {
-        const double a = 2.0 * kPi * k / n, c = std::cos(a), s = std::sin(a);
+        const double a = 2.0 * M_PI * k / n, c = std::cos(a), s = std::sin(a);
         for (double z : {0.0, thickness})
             for (double r : {g.inner_radius_m, g.outer_radius_m})
                 mesh.vertices_m.emplace_back(r * c, r * s, z);
     }
     for (int k = 0; k < n; ++k) {
         const int p = 4 * k, q = 4 * ((k + 1) % n);
-        const double a = 2.0 * kPi * (k + 0.5) / n;
+        const double a = 2.0 * M_PI * (k + 0.5) / n;
         const Vec3 radial(std::cos(a), std::sin(a), 0.0);
         appendQuad(mesh, p + 0, p + 1, q + 1, q + 0, -Vec3::UnitZ()); // bottom face
         appendQuad(mesh, p + 2, p + 3, q + 3, q + 2, Vec3::UnitZ());  // top face
@@ -133,7 +131,7 @@ dem::TriangleMesh makeShearAnnulus(const AnnulusGeometry &g) {
         // Each grouser reaches half the ring's thickness up into the ring: one closed union.
         const double top = 0.5 * thickness, bottom = -g.grouser_height_m;
         for (int k = 0; k < g.grouser_count; ++k) {
-            const double a = 2.0 * kPi * k / g.grouser_count;
+            const double a = 2.0 * M_PI * k / g.grouser_count;
             const Vec3 radial(std::cos(a), std::sin(a), 0.0),
                 tangential(-std::sin(a), std::cos(a), 0.0);
             appendBox(mesh, radial * g.meanRadius_m() + Vec3(0.0, 0.0, 0.5 * (top + bottom)),
@@ -147,7 +145,7 @@ dem::TriangleMesh makeShearAnnulus(const AnnulusGeometry &g) {
 
 double JanosiParameters::shearStress(double sigma, double j) const {
     // Janosi-Hanamoto, docs/physics.md §12.13.
-    const double tan_phi = std::tan(friction_angle_deg * kPi / 180.0);
+    const double tan_phi = std::tan(friction_angle_deg * M_PI / 180.0);
     return (cohesion_Pa + sigma * tan_phi) * (1.0 - std::exp(-j / shear_modulus_m));
 }
 
@@ -237,10 +235,10 @@ JanosiFit fitJanosi(const std::vector<ShearCurve> &curves) {
     fit.iterations = solution.iterations;
     fit.rms_residual_Pa = sigma_ref * std::sqrt(solution.rss / double(m));
     fit.parameters.cohesion_Pa = sigma_ref * x[0];
-    fit.parameters.friction_angle_deg = std::atan(x[1]) * 180.0 / kPi;
+    fit.parameters.friction_angle_deg = std::atan(x[1]) * 180.0 / M_PI;
     fit.parameters.shear_modulus_m = j_ref * x[2];
     // Delta method from theta to (c, phi [deg], K).
-    const Eigen::Vector3d scale(sigma_ref, 180.0 / kPi / (1.0 + x[1] * x[1]), j_ref);
+    const Eigen::Vector3d scale(sigma_ref, 180.0 / M_PI / (1.0 + x[1] * x[1]), j_ref);
     fit.covariance = scale.asDiagonal() * Eigen::Matrix3d(solution.covariance) * scale.asDiagonal();
     fit.standard_error = fit.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
     fit.half_width_95 = studentT975(std::max(1, fit.degrees_of_freedom)) * fit.standard_error;

@@ -1,5 +1,7 @@
 #include "grainlink/mbs/Mole.hpp"
 
+#include "JointFrames.hpp"
+
 #include "grainlink/dem/TriangleMesh.hpp"
 
 #include <algorithm>
@@ -13,7 +15,6 @@ namespace {
 
 using SimTK::Pi;
 
-const SimTK::Rotation kXToZ(-Pi / 2, SimTK::YAxis); // slider axis x -> hull axis z
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 constexpr double kInnerRadius_m = 0.0105; ///< [m] radius of the internal bodies (inertia only)
 constexpr double kHammerLength_m = 0.06;  ///< [m] (inertia and layout only)

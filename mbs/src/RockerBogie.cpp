@@ -1,5 +1,7 @@
 #include "grainlink/mbs/RockerBogie.hpp"
 
+#include "JointFrames.hpp"
+
 #include "grainlink/mbs/WheelTest.hpp" // parseWheelShape
 
 #include <cmath>
@@ -10,9 +12,6 @@ namespace grainlink::mbs {
 namespace {
 
 using SimTK::Pi;
-
-/// Pin axis z (Simbody's) onto the body's y axis; body frames stay parallel to the chassis.
-const SimTK::Rotation kZToY(-Pi / 2, SimTK::XAxis);
 
 Vec3 mirrored(const Vec3 &v, int side) {
     return side == 0 ? v : Vec3(v.x(), -v.y(), v.z());

@@ -1,5 +1,7 @@
 #include "grainlink/mbs/SingleWheelRig.hpp"
 
+#include "JointFrames.hpp"
+
 #include <cmath>
 #include <sstream>
 
@@ -8,11 +10,6 @@ namespace grainlink::mbs {
 namespace {
 
 using SimTK::Pi;
-
-/// Frames that turn a joint's axis (x for a slider, z for a pin) onto a Ground axis while the
-/// body frame stays parallel to Ground.
-const SimTK::Rotation kXToZ(-Pi / 2, SimTK::YAxis); // slider axis x -> Ground z
-const SimTK::Rotation kZToY(-Pi / 2, SimTK::XAxis); // pin axis z -> Ground y
 
 SimTK::Body::Rigid massless() {
     return SimTK::Body::Rigid(SimTK::MassProperties(0, SimTK::Vec3(0), SimTK::Inertia(0)));

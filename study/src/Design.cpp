@@ -26,7 +26,7 @@ struct Factor {
     std::vector<int> lines;
 };
 
-YAML::Node number(double v) {
+YAML::Node numberNode(double v) {
     char text[32];
     std::snprintf(text, sizeof text, "%.12g", v); // 28 + 3 * 0.1 reads 28.3, not 28.300000001
     return YAML::Node(std::string(text));
@@ -39,14 +39,14 @@ std::vector<YAML::Node> rangeValues(const ConfigNode &range) {
     if (range.has("count")) {
         const long long n = range["count"].integer(2, kMaxPoints); // from and to at least
         for (long long k = 0; k < n; ++k)
-            values.push_back(number(from + (to - from) * double(k) / double(n - 1)));
+            values.push_back(numberNode(from + (to - from) * double(k) / double(n - 1)));
     } else {
         const double step = range["step"].number();
         if (!(step > 0.0) || to < from)
             range["step"].fail("needs step > 0 and to >= from");
         const long long n = std::llround(std::floor((to - from) / step + 1e-9)) + 1;
         for (long long k = 0; k < n; ++k)
-            values.push_back(number(from + step * double(k)));
+            values.push_back(numberNode(from + step * double(k)));
     }
     range.finish();
     return values;
