@@ -4,28 +4,39 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
+#include <string>
 
 namespace grainlink::dem {
 
 void CellGrid::bin(const std::vector<Vec3> &positions, double min_cell_size_m) {
+    if (!(min_cell_size_m > 0.0 && std::isfinite(min_cell_size_m)))
+        throw std::logic_error("CellGrid: cell size " + std::to_string(min_cell_size_m));
     const std::size_t n = positions.size();
+    // The box of the finite positions. A grain whose position overflowed in this step's drift
+    // goes to an edge cell, and the step's end reports it (SimulationError, "not finite").
     Vec3 lo = Vec3::Constant(0.0), hi = Vec3::Constant(0.0);
-    if (n > 0) {
-        lo = hi = positions[0];
-        for (const Vec3 &p : positions) {
-            lo = lo.cwiseMin(p);
-            hi = hi.cwiseMax(p);
-        }
+    bool first = true;
+    for (const Vec3 &p : positions) {
+        if (!p.allFinite())
+            continue;
+        lo = first ? p : lo.cwiseMin(p);
+        hi = first ? p : hi.cwiseMax(p);
+        first = false;
     }
     cell_size_ = min_cell_size_m;
-    // A stray particle must not blow up the grid: cap the cell count near 2 per particle.
+    // A stray particle must not blow up the grid: cap the cell count near 2 per particle. The
+    // counts stay doubles until they fit: a grain 1e200 m away (a damaged state) would overflow
+    // an int, and a span past the largest double is taken as that.
     const double max_cells = std::max<double>(64.0, 2.0 * double(n));
+    const Vec3 span = (hi - lo).cwiseMin(std::numeric_limits<double>::max());
     for (;;) {
-        const Vec3 extent = (hi - lo) / cell_size_;
-        dims_ = Eigen::Vector3i(int(extent.x()) + 1, int(extent.y()) + 1, int(extent.z()) + 1);
-        if (double(dims_.x()) * dims_.y() * dims_.z() <= max_cells)
+        const Eigen::Array3d cells = (span / cell_size_).array().floor() + 1.0;
+        if (cells.prod() <= max_cells) {
+            dims_ = cells.cast<int>().matrix();
             break;
+        }
         cell_size_ *= 1.25;
     }
     origin_ = lo;
@@ -47,7 +58,9 @@ void CellGrid::bin(const std::vector<Vec3> &positions, double min_cell_size_m) {
 Eigen::Vector3i CellGrid::cellCoords(const Vec3 &p) const {
     Eigen::Vector3i c;
     for (int d = 0; d < 3; ++d)
-        c[d] = std::clamp(int(std::floor((p[d] - origin_[d]) / cell_size_)), 0, dims_[d] - 1);
+        // fmin/fmax, not clamp: a NaN coordinate goes to the last cell, not into an int cast.
+        c[d] = int(std::fmax(
+            0.0, std::fmin(std::floor((p[d] - origin_[d]) / cell_size_), double(dims_[d] - 1))));
     return c;
 }
 
