@@ -454,6 +454,9 @@ YAML::Node applyEffect(const Effect &effect, double s, const YAML::Node &scenari
         if (absent) {
             if (ed.op == EffectEdit::Op::Scale)
                 continue; // nothing there to scale
+            // Decided before the key is made: a skipped edit must not leave an empty key behind.
+            if (ed.when && evaluate(*ed.when, s, ed.fallback.value_or(std::nan(""))) == 0.0)
+                continue;
             nodes = findNodes(out, ed.key, true);
         }
         for (YAML::Node n : nodes) {

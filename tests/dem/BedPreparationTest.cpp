@@ -219,33 +219,44 @@ TEST_CASE("crust: the grains whose tops lie within the thickness of the surface,
 }
 
 TEST_CASE("crust: the Hertz force between a crust grain and a soil grain follows E* of the two "
-          "materials",
+          "materials, for a stiff crust and a soft surface layer",
           "[dem][preparation]") {
-    DemScenario s =
-        parsed(scenarioText("  crust: {thickness_m: 0.001, youngs_modulus_factor: 10}\n"));
-    s.settings.gravity_m_s2.setZero();
-    s.law.damping = DampingRestitution{1.0}; // no dashpot: the force is Hertz's alone
-    s.settings.time_step_s = 1e-9; // the grains barely move in the step that evaluates the force
-    auto sys = makeSystem(s);
-    const double r = 0.0025, overlap = 2e-5;
-    sys->particles().add(sphere(Vec3(0.015, 0.015, 0.02), r, 2400.0));
-    sys->particles().add(sphere(Vec3(0.015, 0.015, 0.02 + 2.0 * r - overlap), r, 2400.0));
-    // Tops at 22.5 and 27.48 mm, the surface the upper one's: only it is within 1 mm.
-    REQUIRE(applyCrust(*sys, *s.deposition.crust) == 1);
-    REQUIRE(sys->particles().material == std::vector<int>{0, 1});
-    sys->step();
-    const ParticleStore &p = sys->particles();
-    const double delta = 2.0 * r - (p.position[1] - p.position[0]).norm();
-    // 1/E* = (1 - nu^2)/E + (1 - nu^2)/(10 E) (Hertz, docs/physics.md §2.1)
-    const double nu = 0.2, e = 3.0e6;
-    const double mixed = 1.0 / ((1.0 - nu * nu) / e + (1.0 - nu * nu) / (10.0 * e));
-    const auto hertz = [&](double e_star) {
-        return 4.0 / 3.0 * e_star * std::sqrt(0.5 * r) * std::pow(delta, 1.5);
-    };
-    CHECK(-p.force[0].z() == Approx(hertz(mixed)).epsilon(1e-6));
-    CHECK(p.force[1].z() == Approx(hertz(mixed)).epsilon(1e-6));
-    // Neither grain's own pair: soil-soil E* is 0.55 of the mixed one, crust-crust 5.5 times.
-    CHECK(-p.force[0].z() > 1.5 * hertz(e / (2.0 * (1.0 - nu * nu))));
+    // 10: the self-test's crust; 0.2: the catalogue's soft_surface_layer (data/effects.yaml).
+    for (const double factor : {10.0, 0.2}) {
+        INFO("youngs_modulus_factor " << factor);
+        DemScenario s =
+            parsed(scenarioText("  crust: {thickness_m: 0.001, youngs_modulus_factor: " +
+                                std::to_string(factor) + "}\n"));
+        s.settings.gravity_m_s2.setZero();
+        s.law.damping = DampingRestitution{1.0}; // no dashpot: the force is Hertz's alone
+        s.settings.time_step_s =
+            1e-9; // the grains barely move in the step that evaluates the force
+        auto sys = makeSystem(s);
+        const double r = 0.0025, overlap = 2e-5;
+        sys->particles().add(sphere(Vec3(0.015, 0.015, 0.02), r, 2400.0));
+        sys->particles().add(sphere(Vec3(0.015, 0.015, 0.02 + 2.0 * r - overlap), r, 2400.0));
+        // Tops at 22.5 and 27.48 mm, the surface the upper one's: only it is within 1 mm.
+        REQUIRE(applyCrust(*sys, *s.deposition.crust) == 1);
+        REQUIRE(sys->particles().material == std::vector<int>{0, 1});
+        sys->step();
+        const ParticleStore &p = sys->particles();
+        const double delta = 2.0 * r - (p.position[1] - p.position[0]).norm();
+        // 1/E* = (1 - nu^2)/E + (1 - nu^2)/(f E) (Hertz, docs/physics.md §2.1)
+        const double nu = 0.2, e = 3.0e6;
+        const double mixed = 1.0 / ((1.0 - nu * nu) / e + (1.0 - nu * nu) / (factor * e));
+        const auto hertz = [&](double e_star) {
+            return 4.0 / 3.0 * e_star * std::sqrt(0.5 * r) * std::pow(delta, 1.5);
+        };
+        CHECK(-p.force[0].z() == Approx(hertz(mixed)).epsilon(1e-6));
+        CHECK(p.force[1].z() == Approx(hertz(mixed)).epsilon(1e-6));
+        // Neither grain's own pair: against soil-soil E* the mixed one is 1.82 times (f = 10)
+        // or a third (f = 0.2).
+        const double soil_soil = hertz(e / (2.0 * (1.0 - nu * nu)));
+        if (factor > 1.0)
+            CHECK(-p.force[0].z() > 1.5 * soil_soil);
+        else
+            CHECK(-p.force[0].z() == Approx(soil_soil / 3.0).epsilon(1e-6));
+    }
 }
 
 TEST_CASE("preparation keys are read strictly and refused where they would change nothing",

@@ -36,9 +36,10 @@ EffectCatalogue catalogue() { return loadEffects(GRAINLINK_SOURCE_DIR "/data/eff
 TEST_CASE("the default catalogue holds the issue's effects, each with a prior and a signature",
           "[gap][effects]") {
     const EffectCatalogue c = catalogue();
-    for (const char *name : {"rolling_resistance", "grain_shape", "cohesion", "polydispersity",
-                             "grain_stiffness", "grain_density", "wall_friction", "domain_size",
-                             "tool_friction", "rig_compliance", "sensor_zero_offset"}) {
+    for (const char *name :
+         {"rolling_resistance", "grain_shape", "cohesion", "polydispersity", "grain_stiffness",
+          "grain_density", "wall_friction", "domain_size", "tool_friction", "rig_compliance",
+          "sensor_zero_offset", "packing_density", "soft_surface_layer"}) {
         INFO(name);
         const Effect &e = c.find(name);
         CHECK(e.signature.size() >= 2);
@@ -80,6 +81,11 @@ TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off"
     // Grain-grain only: walls and tools get no cohesion (docs/scenario.md, contact_wall).
     CHECK(coh["soil"]["contact_wall"]["cohesion"]["energy_density_J_m3"].as<double>() == 0.0);
     CHECK(coh["soil"]["contact_tool"]["cohesion"]["energy_density_J_m3"].as<double>() == 0.0);
+    // Off, the edits that only apply when on leave no empty keys behind.
+    const YAML::Node coh_off =
+        applyEffect(c.find("cohesion"), 0.0, base, ExperimentType::PlateSinkage);
+    CHECK_FALSE(coh_off["soil"]["contact_wall"]);
+    CHECK_FALSE(coh_off["soil"]["contact_tool"]);
 
     const YAML::Node none = applyEffect(c.find("rolling_resistance"), 0.0, base, ExperimentType::PlateSinkage);
     CHECK(none["soil"]["contact"]["rolling"]["model"].as<std::string>() == "none");
@@ -105,6 +111,23 @@ TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off"
     CHECK(tool_m["soil"]["contact_tool"]["tangential"]["friction_coefficient"].as<double>() == 0.5);
     CHECK_FALSE(tool_m["soil"]["contact_tool"]["tangential"]["stick_angle_deg"]);
     CHECK_FALSE(tool["soil"]["contact_wall"]);
+}
+
+TEST_CASE("a soft surface layer is a crust of softer grains in the prepared beds only",
+          "[gap][effects]") {
+    const YAML::Node base = YAML::Load(kScenario);
+    const EffectCatalogue c = catalogue();
+    const Effect &layer = c.find("soft_surface_layer");
+    CHECK(resolveAgainst(layer, base).prior.off == 1.0);
+    const YAML::Node soft = applyEffect(layer, 0.2, base, ExperimentType::PlateSinkage);
+    CHECK(soft["soil"]["deposition"]["crust"]["thickness_m"].as<double>() == 0.015);
+    CHECK(soft["soil"]["deposition"]["crust"]["youngs_modulus_factor"].as<double>() == Approx(0.2));
+    // Off is the bed itself (a crust of factor 1 is refused by the scenario), and the repose
+    // test's fill is poured into its tube, never prepared.
+    const YAML::Node off = applyEffect(layer, 1.0, base, ExperimentType::PlateSinkage);
+    CHECK_FALSE(off["soil"]["deposition"]["crust"]);
+    const YAML::Node poured = applyEffect(layer, 0.2, base, ExperimentType::AngleOfRepose);
+    CHECK_FALSE(poured["soil"]["deposition"]["crust"]);
 }
 
 TEST_CASE("polydispersity keeps the mean radius and the solid volume; domain size the depth",
