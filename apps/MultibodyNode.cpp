@@ -141,9 +141,10 @@ public:
     void start(const coupling::RunInfo &run) override {
         implicit_ = run.scheme == coupling::SchemeKind::Implicit;
         std::filesystem::create_directories(options_.output_directory);
-        series_.emplace(options_.output_directory + "/" + report_.series_file, report_.header,
-                        run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
-                                    : std::nullopt);
+        series_.emplace(
+            options_.output_directory + "/" + report_.series_file, report_.header,
+            run.restore ? std::optional(dem::SeriesRestart{double(run.restore->tick) * run.tick_s})
+                        : std::nullopt);
     }
 
     coupling::WindowOutputs advance(const coupling::WindowInputs &in) override {
@@ -199,7 +200,7 @@ private:
     NodeOptions options_;
     std::vector<mbs::BodyDescription> bodies_;
     std::vector<mbs::Wrench> soil_; ///< the soil's wrenches of the current window
-    std::optional<Series> series_;
+    std::optional<dem::Series> series_;
     int exit_status_ = 0;
     bool implicit_ = false; ///< implicit coupling: windows may be repeated
 };

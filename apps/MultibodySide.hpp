@@ -3,8 +3,8 @@
 // configuration (its coupled bodies' descriptions need no translation: the model's are the
 // handshake's).
 #include "Nodes.hpp"
-#include "Series.hpp"
 #include "grainlink/coupling/Types.hpp"
+#include "grainlink/dem/Series.hpp"
 #include "grainlink/mbs/MultibodyModel.hpp"
 
 #include <fstream>

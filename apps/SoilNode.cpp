@@ -1,13 +1,13 @@
 // The soil participant: the DEM bed (settled once, cached) with the coupled bodies' meshes moved
 // along each window's motion, returning the window-averaged wrench (impulse / window).
 #include "Nodes.hpp"
-#include "Series.hpp"
 #include "SoilSide.hpp"
 #include "grainlink/coupling/ParticipantNode.hpp"
 #include "grainlink/coupling/WindowLoads.hpp"
 #include "grainlink/dem/Checkpoint.hpp"
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/dem/Series.hpp"
 #include "grainlink/dem/VtkWriter.hpp"
 
 #include <algorithm>
@@ -56,10 +56,11 @@ public:
         resumed_ = run.restore.has_value();
         end_s_ = run.end_tick * run.tick_s;
         std::filesystem::create_directories(options_.output_directory);
-        series_.emplace(options_.output_directory + "/" + options_.section + ".csv",
-                        "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts",
-                        run.restore ? std::optional(double(run.restore->tick) * run.tick_s)
-                                    : std::nullopt);
+        series_.emplace(
+            options_.output_directory + "/" + options_.section + ".csv",
+            "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts",
+            run.restore ? std::optional(dem::SeriesRestart{double(run.restore->tick) * run.tick_s})
+                        : std::nullopt);
         first_step_ = sys_->stepCount();
         implicit_ = run.scheme == coupling::SchemeKind::Implicit;
     }
@@ -228,7 +229,7 @@ private:
     bool resumed_ = false;
     double end_s_ = 0.0; ///< [s] the run's end, for the progress line
     dem::VtkWriter vtk_;
-    std::optional<Series> series_;
+    std::optional<dem::Series> series_;
     dem::Progress progress_;
     std::uint64_t first_step_ = 0;
     bool implicit_ = false; ///< implicit coupling: windows may be repeated

@@ -2,6 +2,7 @@
 
 #include "grainlink/dem/Checkpoint.hpp"
 #include "grainlink/dem/Progress.hpp"
+#include "grainlink/dem/Series.hpp"
 #include "grainlink/dem/VtkWriter.hpp"
 
 #include <nlohmann/json.hpp>
@@ -236,32 +237,6 @@ std::string seriesRow(DemSystem &sys, double run_time_s, std::vector<BodyLoad> &
     return row.str();
 }
 
-/// Keeps the header and the rows up to `last_step` (rows after a checkpoint are redone).
-void truncateSeries(const std::string &path, std::uint64_t last_step) {
-    std::ifstream in(path);
-    if (!in)
-        return;
-    std::vector<std::string> keep;
-    std::string line;
-    while (std::getline(in, line)) {
-        if (keep.empty()) {
-            keep.push_back(line);
-            continue;
-        }
-        std::istringstream fields(line);
-        std::string t, rt, step;
-        std::getline(fields, t, ',');
-        std::getline(fields, rt, ',');
-        std::getline(fields, step, ',');
-        if (!step.empty() && std::stoull(step) <= last_step)
-            keep.push_back(line);
-    }
-    in.close();
-    std::ofstream out(path, std::ios::trunc);
-    for (const std::string &l : keep)
-        out << l << '\n';
-}
-
 void addBody(DemSystem &sys, const BodySpec &spec, const RigidBodyState &start,
              double run_start_s) {
     MeshBody body(spec.name, spec.mesh, start);
@@ -394,19 +369,31 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
     const std::uint64_t first_step = sys->stepCount();
 
     VtkWriter vtk(out.string());
+    // Resumed: the whole rows up to the checkpoint's step are kept, rows after it redone.
+    Series series(series_path, seriesHeader(*sys),
+                  options.resume ? std::optional(SeriesRestart{double(sys->stepCount()), 2})
+                                 : std::nullopt);
     if (options.resume) {
-        truncateSeries(series_path, sys->stepCount());
         std::vector<double> times;
         for (int k = 0; k < int(extra(extras, "snapshots", checkpoint)); ++k)
             times.push_back(extra(extras, "snapshot" + std::to_string(k) + "_s", checkpoint));
         vtk.resumeAt(int(times.size()), times);
     }
     std::vector<BodyLoad> loads;
-    std::ofstream series(series_path, std::ios::app);
-    if (!series)
-        throw std::runtime_error("cannot write '" + series_path + "'");
+    // A full disk stops the run with the last complete checkpoint, never "finished" with a
+    // series cut short.
+    const auto writeRow = [&](const std::string &row) {
+        series.rows() << row << '\n';
+        try {
+            series.write();
+        } catch (const std::runtime_error &e) {
+            throw std::runtime_error(e.what() + (fs::exists(latest)
+                                                     ? "; resume from " + latest + " with --resume"
+                                                     : std::string()));
+        }
+    };
     if (!options.resume)
-        series << seriesHeader(*sys) << '\n' << seriesRow(*sys, 0.0, loads) << '\n';
+        writeRow(seriesRow(*sys, 0.0, loads));
     if (!options.resume && steps_per_snapshot)
         vtk.write(*sys, 0.0);
 
@@ -430,15 +417,7 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
             sys->step();
             const std::uint64_t done = sys->stepCount() - run_start_step;
             if (done % steps_per_row == 0) {
-                series << seriesRow(*sys, double(done) * dt, loads) << '\n';
-                series.flush();
-                // A full disk: stop with the last complete checkpoint, never end "finished"
-                // with a series cut short.
-                if (!series)
-                    throw std::runtime_error(
-                        "cannot write '" + series_path + "': " + std::strerror(errno) +
-                        (fs::exists(latest) ? "; resume from " + latest + " with --resume"
-                                            : std::string()));
+                writeRow(seriesRow(*sys, double(done) * dt, loads));
                 ++rows;
                 if (rows_per_checkpoint && rows % rows_per_checkpoint == 0)
                     saveCheckpoint();
@@ -449,8 +428,8 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
                             (sys->stepCount() - first_step) * sys->particles().size());
         }
     } catch (const SimulationError &e) {
-        // Keep what is readable: the series so far, and the last finite particle state.
-        series.flush();
+        // Keep what is readable: the series so far (every row is on disk), and the last
+        // finite particle state.
         const std::string snapshot = (out / "failure_particles.vtu").string();
         VtkWriter::writeParticles(sys->particles(), snapshot);
         std::ostringstream msg;

@@ -298,8 +298,10 @@ TEST_CASE("an interrupted scenario run resumes to the same series as an uninterr
     RunOptions broken{(dir / "broken").string(), false, 1e9};
     const RunSummary partial = runScenario(smallScenario(dir, 0.15), broken);
     CHECK(partial.packing_from_cache); // same soil setup: the packing is reused
-    // A crash after the last checkpoint leaves rows the resumed run must not duplicate.
-    std::ofstream(dir / "broken" / "series.csv", std::ios::app) << "0.2,0.2,99999999,junk\n";
+    // A crash after the last checkpoint leaves rows the resumed run must not duplicate, and a
+    // last row cut inside its step count ("12" of 1200: a step before the checkpoint's).
+    std::ofstream(dir / "broken" / "series.csv", std::ios::app)
+        << "0.2,0.2,99999999,junk\n0.31,0.31,12";
     broken.resume = true;
     runScenario(smallScenario(dir, 0.3), broken);
 

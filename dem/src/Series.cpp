@@ -1,5 +1,6 @@
-#include "Series.hpp"
+#include "grainlink/dem/Series.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -9,7 +10,7 @@
 #include <stdexcept>
 #include <unistd.h>
 
-namespace grainlink::apps {
+namespace grainlink::dem {
 
 namespace {
 
@@ -37,8 +38,9 @@ std::size_t cells(const std::string &line) {
     return n;
 }
 
-/// The header and the whole rows of the series at `path` up to `restart_s`, as a file's text.
-std::string keptPrefix(const std::string &path, const std::string &header, double restart_s) {
+/// The header and the whole rows of the series at `path` up to the restart, as a file's text.
+std::string keptPrefix(const std::string &path, const std::string &header,
+                       const SeriesRestart &restart) {
     std::string kept = header + '\n';
     std::ifstream in(path);
     std::string line;
@@ -51,12 +53,16 @@ std::string keptPrefix(const std::string &path, const std::string &header, doubl
     while (std::getline(in, line)) {
         if (in.eof())
             break; // no line end: a row cut by the crash
-        const std::string first = line.substr(0, line.find(','));
+        if (cells(line) != columns)
+            continue;
+        std::size_t start = 0;
+        for (std::size_t c = 0; c < restart.column; ++c)
+            start = line.find(',', start) + 1;
+        const std::string cell = line.substr(start, line.find(',', start) - start);
         char *end = nullptr;
-        const double time_s = std::strtod(first.c_str(), &end);
-        const bool whole =
-            !first.empty() && *end == '\0' && std::isfinite(time_s) && cells(line) == columns;
-        if (whole && time_s <= restart_s + 1e-12)
+        const double value = std::strtod(cell.c_str(), &end);
+        const bool whole = !cell.empty() && *end == '\0' && std::isfinite(value);
+        if (whole && value <= restart.last + 1e-12 * std::max(1.0, std::abs(restart.last)))
             kept += line + '\n';
     }
     return kept;
@@ -64,9 +70,11 @@ std::string keptPrefix(const std::string &path, const std::string &header, doubl
 
 } // namespace
 
-Series::Series(std::string path, const std::string &header, std::optional<double> restart_s)
+Series::Series(std::string path, const std::string &header, std::optional<SeriesRestart> restart)
     : path_(std::move(path)) {
-    const std::string prefix = restart_s ? keptPrefix(path_, header, *restart_s) : header + '\n';
+    if (restart && restart->column >= cells(header))
+        throw std::logic_error("Series: restart column beyond the header of " + path_);
+    const std::string prefix = restart ? keptPrefix(path_, header, *restart) : header + '\n';
     const std::string partial = path_ + ".partial";
     const int fd = ::open(partial.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd < 0)
@@ -101,4 +109,4 @@ void Series::write() {
     rows_.str(std::string());
 }
 
-} // namespace grainlink::apps
+} // namespace grainlink::dem
