@@ -19,21 +19,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// A fresh folder for one test, removed afterwards. Per process: two test runs at once (two
-/// build trees) must not share files.
-struct Scratch {
-    explicit Scratch(const std::string &name)
-        : dir(fs::temp_directory_path() /
-              ("grainlink-test-" + name + "-" + std::to_string(::getpid()))) {
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-    }
-    ~Scratch() { fs::remove_all(dir); }
-    Scratch(const Scratch &) = delete;
-    Scratch &operator=(const Scratch &) = delete;
-    fs::path dir;
-};
-
 /// A falling, colliding bed in a box with a cylinder ploughing through it: every kind of
 /// history (pairs, planes, mesh) is active when the checkpoint is taken. Enough grains, packed
 /// enough, that with two threads the contact pass's split between them (estimated at each

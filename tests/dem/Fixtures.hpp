@@ -2,9 +2,13 @@
 // Small builders shared by the DEM tests.
 #include "grainlink/dem/DemSystem.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <random>
+#include <string>
 
 namespace grainlink::dem::testing {
 
@@ -218,5 +222,20 @@ inline double kineticEnergy(const DemSystem& sys) {
              0.5 * p.inertia[i].x() * p.angular_velocity[i].squaredNorm();
     return e;
 }
+
+/// A fresh folder for one test, removed afterwards. Per process: two test runs at once (two
+/// build trees) must not share files.
+struct Scratch {
+    explicit Scratch(const std::string &name)
+        : dir(std::filesystem::temp_directory_path() /
+              ("grainlink-test-" + name + "-" + std::to_string(::getpid()))) {
+        std::filesystem::remove_all(dir);
+        std::filesystem::create_directories(dir);
+    }
+    ~Scratch() { std::filesystem::remove_all(dir); }
+    Scratch(const Scratch &) = delete;
+    Scratch &operator=(const Scratch &) = delete;
+    std::filesystem::path dir;
+};
 
 } // namespace grainlink::dem::testing

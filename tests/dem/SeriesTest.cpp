@@ -4,35 +4,22 @@
 // soil.csv to a crash right after a resume, and kept a cut row `0.3` as a row).
 #include "grainlink/dem/Series.hpp"
 
+#include "Fixtures.hpp"
+
 #include <catch2/catch.hpp>
 
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-#include <unistd.h>
 
 using grainlink::dem::Series;
 using grainlink::dem::SeriesRestart;
+using grainlink::dem::testing::Scratch;
 namespace fs = std::filesystem;
 
 namespace {
 
 const std::string kHeader = "time_s,body,Fz_N";
-
-/// A fresh folder for one test, removed afterwards (per process: two build trees may test at
-/// once).
-struct Scratch {
-    explicit Scratch(const std::string &name)
-        : dir(fs::temp_directory_path() /
-              ("grainlink-test-" + name + "-" + std::to_string(::getpid()))) {
-        fs::remove_all(dir);
-        fs::create_directories(dir);
-    }
-    ~Scratch() { fs::remove_all(dir); }
-    Scratch(const Scratch &) = delete;
-    Scratch &operator=(const Scratch &) = delete;
-    fs::path dir;
-};
 
 /// What is on disk now (what a crash at this moment would leave).
 std::string onDisk(const fs::path &path) {
