@@ -52,9 +52,20 @@ std::vector<YAML::Node> rangeValues(const ConfigNode &range) {
     return values;
 }
 
+/// A dotted path of keys and list indices ("contact.tangential.stick_angle_deg",
+/// "bodies.0.motion.0.velocity_m_s"): no empty step anywhere.
+std::string dottedPath(const ConfigNode &node) {
+    const std::string path = node.text();
+    if (path.empty() || path.front() == '.' || path.back() == '.' ||
+        path.find("..") != std::string::npos)
+        node.fail("'" + path +
+                  "' is not a dotted path of keys (e.g. contact.tangential.stick_angle_deg)");
+    return path;
+}
+
 Factor parseFactor(const ConfigNode &node) {
     Factor f;
-    f.key = node["key"].text();
+    f.key = dottedPath(node["key"]);
     if (const auto list = node.optional("values")) {
         for (const ConfigNode &v : list->items()) {
             f.values.push_back(v.yaml());
@@ -181,7 +192,8 @@ Study loadStudy(const std::string &path, const std::string &directory,
                 replicates = int(r.integer(1, kMaxReplicates));
             } else {
                 replicates = int(r["count"].integer(1, kMaxReplicates));
-                seed_key = r.text("key", seed_key);
+                if (r.has("key"))
+                    seed_key = dottedPath(r["key"]);
                 first_seed = r.has("first") ? r["first"].integer() : 1;
                 r.finish();
             }

@@ -104,6 +104,28 @@ TEST_CASE("a zipped design pairs the i-th values, and lists of unequal length ar
                                      "'deposition.seed' has 3"));
 }
 
+TEST_CASE("a varied or replicate key that is not a dotted path is refused with its line",
+          "[study][design]") {
+    TempFolder folder("not-a-path");
+    // An empty key (the fuzzer's: a YAML tag where the key was) crashed the labels' naming.
+    for (const std::string key : {"\"\"", "!odies.0.motion", ".seed", "deposition.", "a..b"}) {
+        INFO(key);
+        const std::string bad = studyFile(folder, "bad_key",
+                                          "design:\n"
+                                          "  vary:\n"
+                                          "    - {key: " +
+                                              key + ", values: [1, 2]}\n");
+        CHECK_THAT(errorOf([&] { loadStudy(bad, folder / "out"); }),
+                   Catch::Contains(bad + ":5: key 'design.vary[0].key': '") &&
+                       Catch::Contains("' is not a dotted path of keys"));
+    }
+    const std::string seed = studyFile(folder, "bad_seed",
+                                       "design:\n"
+                                       "  replicates: {count: 2, key: \"\"}\n");
+    CHECK_THAT(errorOf([&] { loadStudy(seed, folder / "out"); }),
+               Catch::Contains(seed + ":4: key 'design.replicates.key': '' is not a dotted path"));
+}
+
 TEST_CASE("list items are reached by index, and a path the base lacks names the study file, the "
           "line and what is there",
           "[study][design]") {
