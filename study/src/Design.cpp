@@ -56,10 +56,12 @@ std::vector<YAML::Node> rangeValues(const ConfigNode &range) {
 /// "bodies.0.motion.0.velocity_m_s"): no empty step anywhere.
 std::string dottedPath(const ConfigNode &node) {
     const std::string path = node.text();
-    if (path.empty() || path.front() == '.' || path.back() == '.' ||
-        path.find("..") != std::string::npos)
+    try {
+        pathSteps(path);
+    } catch (const std::invalid_argument &) {
         node.fail("'" + path +
                   "' is not a dotted path of keys (e.g. contact.tangential.stick_angle_deg)");
+    }
     return path;
 }
 

@@ -9,20 +9,6 @@ namespace grainlink::study {
 
 namespace {
 
-std::vector<std::string> split(const std::string &key) {
-    std::vector<std::string> steps;
-    std::string step;
-    std::istringstream in(key);
-    while (std::getline(in, step, '.')) {
-        if (step.empty())
-            throw std::invalid_argument("key '" + key + "' has an empty step");
-        steps.push_back(step);
-    }
-    if (steps.empty())
-        throw std::invalid_argument("empty key");
-    return steps;
-}
-
 bool isIndex(const std::string &step) {
     return !step.empty() && step.find_first_not_of("0123456789") == std::string::npos;
 }
@@ -55,10 +41,26 @@ YAML::Node child(const YAML::Node &node, const std::string &step, std::string &w
 
 } // namespace
 
+std::vector<std::string> pathSteps(const std::string &key) {
+    if (key.empty())
+        throw std::invalid_argument("empty key");
+    if (key.back() == '.')
+        throw std::invalid_argument("key '" + key + "' has an empty step");
+    std::vector<std::string> steps;
+    std::string step;
+    std::istringstream in(key);
+    while (std::getline(in, step, '.')) {
+        if (step.empty())
+            throw std::invalid_argument("key '" + key + "' has an empty step");
+        steps.push_back(step);
+    }
+    return steps;
+}
+
 YAML::Node findAtPath(const YAML::Node &root, const std::string &key) {
     YAML::Node node = root;
     std::string what;
-    for (const std::string &step : split(key)) {
+    for (const std::string &step : pathSteps(key)) {
         YAML::Node next = child(node, step, what);
         if (!next.IsDefined())
             return next;
@@ -68,7 +70,7 @@ YAML::Node findAtPath(const YAML::Node &root, const std::string &key) {
 }
 
 void setAtPath(YAML::Node &root, const std::string &key, const YAML::Node &value) {
-    const std::vector<std::string> steps = split(key);
+    const std::vector<std::string> steps = pathSteps(key);
     YAML::Node node = root;
     std::string done, what;
     for (std::size_t k = 0; k + 1 < steps.size(); ++k) {

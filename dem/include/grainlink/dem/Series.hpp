@@ -40,7 +40,6 @@ public:
     /// Drops the rows given since the last write (a window repeated by implicit coupling: its
     /// rejected try's rows never reach the file).
     void discard() { rows_.str(std::string()); }
-    const std::string &path() const { return path_; }
 
 private:
     std::string path_;

@@ -5,8 +5,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include <string>
+#include <vector>
 
 namespace grainlink::study {
+
+/// The steps of a dotted path ("walls.0.upper_m" -> walls, 0, upper_m). Throws
+/// std::invalid_argument for an empty path or an empty step (a leading, doubled or trailing dot).
+std::vector<std::string> pathSteps(const std::string &key);
 
 /// Sets `key` to `value` in `root` (a clone the caller owns). Every step but the last must
 /// exist; the last may be a new key of a mapping (the run's strict reader then judges it).
