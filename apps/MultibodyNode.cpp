@@ -3,12 +3,13 @@
 // other model (rover, mole, a user's URDF mechanism) runs to the end time and writes mbs.csv,
 // its observables and the soil's wrench on each of its coupled bodies.
 #include "MultibodySide.hpp"
+#include "Nodes.hpp"
 #include "SoilSide.hpp"
+#include "grainlink/coupling/ParticipantNode.hpp"
 #include "grainlink/dem/BedPreparation.hpp"
+#include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/RigidFloor.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
-#include "Nodes.hpp"
-#include "grainlink/coupling/ParticipantNode.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
 
 #include <cstdio>
@@ -39,6 +40,8 @@ struct Report {
     /// model run to its end time.
     std::function<void()> save_state = [] {};
     std::function<void()> restore_state = [] {};
+    /// What the progress line adds to the simulated time (the rig: its phase and slip).
+    std::function<std::string()> progress_note = [] { return std::string(); };
 };
 
 /// The seed's single-wheel procedure (mbs/WheelTest): rig.csv, the steady-state report
@@ -74,6 +77,12 @@ Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
     };
     r.read_checkpoint = [test](const std::string &directory) {
         test->readCheckpoint(directory + "/wheel_test.txt");
+    };
+    r.progress_note = [test, &rig] {
+        char note[64];
+        std::snprintf(note, sizeof note, "phase %s  slip %.3f", test->phaseName().c_str(),
+                      rig.observables().at("slip"));
+        return std::string(note);
     };
     auto saved = std::make_shared<std::optional<mbs::WheelTest>>();
     r.save_state = [test, saved] { *saved = *test; };
@@ -136,10 +145,12 @@ class MultibodyNode final : public coupling::ParticipantNode {
 public:
     MultibodyNode(mbs::MultibodyModel &model, Report report, const NodeOptions &options)
         : model_(model), report_(std::move(report)), options_(options),
-          bodies_(model.coupledBodies()), soil_(bodies_.size()) {}
+          bodies_(model.coupledBodies()), soil_(bodies_.size()),
+          progress_(options.name, options.progress_interval_s) {}
 
     void start(const coupling::RunInfo &run) override {
         implicit_ = run.scheme == coupling::SchemeKind::Implicit;
+        end_s_ = double(run.end_tick) * run.tick_s;
         std::filesystem::create_directories(options_.output_directory);
         series_.emplace(
             options_.output_directory + "/" + report_.series_file, report_.header,
@@ -162,6 +173,7 @@ public:
             out.work.push_back({bodies_[b].name, work[b]});
         }
         out.suggested_macro_step_s = model_.suggestedMacroStep_s();
+        progress_.update(in.end_s, in.end_s / end_s_, 0, report_.progress_note());
         return out;
     }
 
@@ -203,6 +215,8 @@ private:
     std::optional<dem::Series> series_;
     int exit_status_ = 0;
     bool implicit_ = false; ///< implicit coupling: windows may be repeated
+    double end_s_ = 0.0;    ///< [s] the run's end, for the progress line
+    dem::Progress progress_;
 };
 
 int runWindows(const config::ConfigNode &root, mbs::MultibodyModel &model, Report report,

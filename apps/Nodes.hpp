@@ -20,7 +20,7 @@ struct NodeOptions {
     std::vector<std::string> bodies; ///< soil node: the bodies it consumes
     std::string section = "soil";    ///< soil node: the scenario section of its bed
     std::string keys_directory;      ///< CURVE keys (<name>.key, coordinator.pub)
-    double progress_interval_s = 10.0; ///< [s] soil node: wall time between progress lines
+    double progress_interval_s = 10.0; ///< [s] wall time between progress lines; 0: none
 };
 
 /// How long a node waits for the coordinator's Welcome: the scenario's

@@ -142,8 +142,12 @@ int main(int argc, char **argv) {
         command->add_option("--out", node.output_directory, "output directory")->required();
         command->add_option("--keys", node.keys_directory, "CURVE keys directory");
     }
-    dem_node->add_option("--progress-interval", node.progress_interval_s,
-                         "seconds between progress lines (settling and the run)");
+    // Every node prints progress lines; `grainlink run --progress-interval` reaches the nodes it
+    // starts through GRAINLINK_PROGRESS_INTERVAL, which a node's own flag overrides.
+    for (auto *command : {mbs_node, dem_node, floor_node})
+        command->add_option("--progress-interval", node.progress_interval_s,
+                            "seconds between progress lines (default: the run's "
+                            "--progress-interval, else 10; 0: none)");
     for (auto *command : {dem_node, floor_node})
         command->add_option("--bodies", node.bodies, "the coupled bodies it loads (comma separated)")
             ->delimiter(',')
@@ -167,6 +171,13 @@ int main(int argc, char **argv) {
     CLI11_PARSE(app, argc, argv);
     if (threads > 0)
         ::setenv("GRAINLINK_THREADS", std::to_string(threads).c_str(), 1);
+    if (run->count("--progress-interval") > 0)
+        ::setenv("GRAINLINK_PROGRESS_INTERVAL", std::to_string(coupled.progress_interval_s).c_str(),
+                 1);
+    for (auto *command : {mbs_node, dem_node, floor_node})
+        if (command->parsed() && command->count("--progress-interval") == 0)
+            if (const char *inherited = std::getenv("GRAINLINK_PROGRESS_INTERVAL"))
+                node.progress_interval_s = std::strtod(inherited, nullptr);
     try {
         if (dem->parsed()) {
             const auto scenario = grainlink::dem::loadScenario(scenario_path);

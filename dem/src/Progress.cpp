@@ -20,15 +20,18 @@ double Progress::rate(std::uint64_t particle_steps) const {
 void Progress::update(double sim_time_s, double fraction, std::uint64_t particle_steps,
                       const std::string &extra) {
     const auto now = std::chrono::steady_clock::now();
-    if (std::chrono::duration<double>(now - last_).count() < interval_s_)
+    if (interval_s_ <= 0.0 || std::chrono::duration<double>(now - last_).count() < interval_s_)
         return;
     last_ = now;
     const double wall = wallSeconds();
     const double eta = fraction > 1e-9 ? wall * (1.0 - fraction) / fraction : NAN;
-    std::fprintf(stream_,
-                 "[%s] t = %.4f s (%5.1f %%)  wall %s  ETA %s  %.2f M particle-steps/s%s%s\n",
-                 label_.c_str(), sim_time_s, 100.0 * fraction, formatDuration(wall).c_str(),
-                 std::isfinite(eta) ? formatDuration(eta).c_str() : "?", rate(particle_steps) / 1e6,
+    char rate_text[48] = ""; // none for a process without grains (a multibody node)
+    if (particle_steps > 0)
+        std::snprintf(rate_text, sizeof rate_text, "  %.2f M particle-steps/s",
+                      rate(particle_steps) / 1e6);
+    std::fprintf(stream_, "[%s] t = %.4f s (%5.1f %%)  wall %s  ETA %s%s%s%s\n", label_.c_str(),
+                 sim_time_s, 100.0 * fraction, formatDuration(wall).c_str(),
+                 std::isfinite(eta) ? formatDuration(eta).c_str() : "?", rate_text,
                  extra.empty() ? "" : "  ", extra.c_str());
     std::fflush(stream_);
 }

@@ -9,9 +9,11 @@ namespace grainlink::dem {
 
 class Progress {
 public:
-    /// `label` prefixes each line; lines go to `stream` at most every `interval_s` of wall time.
+    /// `label` prefixes each line; lines go to `stream` at most every `interval_s` of wall time
+    /// (none when it is 0).
     explicit Progress(std::string label, double interval_s = 5.0, std::FILE *stream = stderr);
-    /// Reports if due. `fraction` of the phase done, `particle_steps` since construction.
+    /// Reports if due. `fraction` of the phase done, `particle_steps` since construction (0: a
+    /// process without grains, the line has no rate).
     void update(double sim_time_s, double fraction, std::uint64_t particle_steps,
                 const std::string &extra = "");
     double wallSeconds() const;
