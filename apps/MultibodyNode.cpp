@@ -56,8 +56,11 @@ Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
     Report r;
     r.checkpoint_file = "rig.txt";
     r.series_file = "rig.csv";
-    r.header = "time_s,phase,x_m,z_m,vx_m_s,vz_m_s,omega_rad_s,slip,motor_torque_N_m,soil_Fx_N,"
-               "soil_Fy_N,soil_Fz_N,soil_Ty_N_m,travel_m";
+    // The rig's own quantities unprefixed, the soil's load on the wheel as <wheel>.<quantity>
+    // (docs/scenario.md, "Output files").
+    const std::string wheel = rig.settings().wheel_name + ".";
+    r.header = "time_s,phase,x_m,z_m,vx_m_s,vz_m_s,omega_rad_s,slip,motor_torque_N_m," + wheel +
+               "Fx_N," + wheel + "Fy_N," + wheel + "Fz_N," + wheel + "Ty_N_m,travel_m";
     r.after_window = [test, &rig, x0](std::ostream &series, const std::vector<mbs::Wrench> &soil) {
         const bool done = test->afterWindow(rig, soil[0]);
         const auto o = rig.observables();
@@ -116,7 +119,7 @@ Report observablesReport(const mbs::MultibodyModel &model, const NodeOptions &op
         r.header += "," + name;
     for (const auto &body : model.coupledBodies())
         for (const char *c : {"Fx_N", "Fy_N", "Fz_N", "Tx_N_m", "Ty_N_m", "Tz_N_m"})
-            r.header += "," + body.name + "_" + c;
+            r.header += "," + body.name + "." + c;
     r.after_window = [names, &model](std::ostream &series, const std::vector<mbs::Wrench> &soil) {
         const auto observed = model.observables();
         series << model.time();

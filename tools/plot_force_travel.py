@@ -20,15 +20,15 @@ def main():
     body = sys.argv[2] if len(sys.argv) > 2 else "wheel"
     with open(f"{run_dir}/series.csv") as f:
         rows = list(csv.DictReader(f))
-    if not rows or f"{body}_x_m" not in rows[0]:
+    if not rows or f"{body}.x_m" not in rows[0]:
         sys.exit(f"{run_dir}/series.csv has no body '{body}'")
-    x0 = float(rows[0][f"{body}_x_m"])
-    travel = [float(r[f"{body}_x_m"]) - x0 for r in rows]
+    x0 = float(rows[0][f"{body}.x_m"])
+    travel = [float(r[f"{body}.x_m"]) - x0 for r in rows]
     time = [float(r["run_time_s"]) for r in rows]
-    fx = [float(r[f"{body}_Fx_N"]) for r in rows]
-    fz = [float(r[f"{body}_Fz_N"]) for r in rows]
-    ty = [float(r[f"{body}_Ty_N_m"]) for r in rows]
-    sinkage = [float(rows[0][f"{body}_z_m"]) - float(r[f"{body}_z_m"]) for r in rows]
+    fx = [float(r[f"{body}.Fx_N"]) for r in rows]
+    fz = [float(r[f"{body}.Fz_N"]) for r in rows]
+    ty = [float(r[f"{body}.Ty_N_m"]) for r in rows]
+    sinkage = [float(rows[0][f"{body}.z_m"]) - float(r[f"{body}.z_m"]) for r in rows]
 
     fig, (ax1, ax2) = plt.subplots(2, 1, figsize=(8, 7), sharex=False)
     moving = [i for i, t in enumerate(travel) if t > 1e-6]

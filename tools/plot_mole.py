@@ -28,7 +28,7 @@ def main():
         sys.exit(f"{run_dir}/mbs.csv has no windows")
     t = [float(r["time_s"]) for r in rows]
     depth = [1000 * float(r["penetration_m"]) for r in rows]
-    fz = [float(r[f"{hull}_Fz_N"]) for r in rows]
+    fz = [float(r[f"{hull}.Fz_N"]) for r in rows]
     stroke = [int(float(r["stroke_count"])) for r in rows]
 
     # Stroke k spans the windows from its release (stroke_count becomes k) to the next one.

@@ -34,6 +34,8 @@ def main():
     if not rig or not soil:
         sys.exit(f"{run_dir}: rig.csv or soil.csv is empty")
     col = lambda rows, name: [float(r[name]) for r in rows]
+    # The soil's load on the wheel is <wheel>.Fx_N, ... whatever the rig names its wheel.
+    wheel = next(key for key in rig[0] if key.endswith(".Fx_N"))[: -len(".Fx_N")]
     t = col(rig, "time_s")
     drive = [r for r in rig if r["phase"] != "drop"]
     t_drive = drive[0]["time_s"] if drive else None
@@ -44,8 +46,8 @@ def main():
 
     fig, axes = plt.subplots(4, 1, figsize=(8, 11))
     if drive:
-        axes[0].plot(col(drive, "travel_m"), col(drive, "soil_Fx_N"), lw=0.6, label="F_x (traction)")
-        axes[0].plot(col(drive, "travel_m"), col(drive, "soil_Fz_N"), lw=0.6, label="F_z (support)")
+        axes[0].plot(col(drive, "travel_m"), col(drive, wheel + ".Fx_N"), lw=0.6, label="F_x (traction)")
+        axes[0].plot(col(drive, "travel_m"), col(drive, wheel + ".Fz_N"), lw=0.6, label="F_z (support)")
     if "normal_load_N" in summary:
         load = summary["normal_load_N"]
         axes[0].axhline(load, color="k", ls=":", lw=0.8, label=f"normal load (weight) {load:.1f} N")

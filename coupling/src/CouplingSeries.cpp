@@ -22,7 +22,7 @@ std::string header(const std::vector<std::string> &bodies) {
     for (const auto &b : bodies)
         for (const char *column :
              {"x_m", "y_m", "z_m", "qw", "qx", "qy", "qz", "vx_m_s", "vy_m_s", "vz_m_s", "wx_rad_s",
-              "wy_rad_s", "wz_rad_s", "fx_N", "fy_N", "fz_N", "tx_N_m", "ty_N_m", "tz_N_m"})
+              "wy_rad_s", "wz_rad_s", "Fx_N", "Fy_N", "Fz_N", "Tx_N_m", "Ty_N_m", "Tz_N_m"})
             h += "," + b + "." + column;
     return h;
 }

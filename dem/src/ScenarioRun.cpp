@@ -199,7 +199,7 @@ std::string seriesHeader(const DemSystem &sys) {
         const std::string &n = sys.body(b).name();
         for (const char *c : {"x_m", "y_m", "z_m", "vx_m_s", "vz_m_s", "wy_rad_s", "Fx_N", "Fy_N",
                               "Fz_N", "Tx_N_m", "Ty_N_m", "Tz_N_m"})
-            h += "," + n + "_" + c;
+            h += "," + n + "." + c; // docs/scenario.md, "Output files"
     }
     return h;
 }

@@ -21,7 +21,7 @@ def column(name, start, end=1e9):
 failures = []
 load = 3.0 * 9.81
 for label, start, end in (("resting", 0.2, 0.5), ("rolling", 0.6, 1e9)):
-    fz = column("soil_Fz_N", start, end)
+    fz = column("wheel.Fz_N", start, end)
     mean = sum(fz) / len(fz)
     print(f"{label}: mean vertical floor force {mean:.3f} N over {len(fz)} windows "
           f"(normal load {load:.3f} N, tolerance 1 %)")

@@ -15,7 +15,7 @@ rows = list(csv.DictReader(open(f"{run}/mbs.csv")))
 impulse, previous = 0.0, 0.0
 for r in rows:
     t = float(r["time_s"])
-    impulse += float(r["mole_Fz_N"]) * (t - previous)
+    impulse += float(r["mole.Fz_N"]) * (t - previous)
     previous = t
 mean_force = impulse / previous
 steps = [float(r["macro_step_s"]) for r in csv.DictReader(open(f"{run}/coupling.csv"))]

@@ -20,7 +20,7 @@ def mean(column):
 failures = []
 expected = {"lf": 182.36, "lm": 187.07, "lr": 187.07, "rf": 182.36, "rm": 187.07, "rr": 187.07}
 for wheel, load in expected.items():
-    value = mean(f"wheel_{wheel}_Fz_N")
+    value = mean(f"wheel_{wheel}.Fz_N")
     print(f"wheel_{wheel}: mean vertical load {value:.2f} N (hand calculation {load} N)")
     if abs(value - load) > 0.01 * load:
         failures.append(f"wheel_{wheel} load")

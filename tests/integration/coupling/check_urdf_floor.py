@@ -15,7 +15,7 @@ def mean(column):
     return sum(float(r[column]) for r in rows) / len(rows)
 
 
-speed, load = mean("carriage_x_speed_m_s"), mean("wheel_Fz_N")
+speed, load = mean("carriage_x_speed_m_s"), mean("wheel.Fz_N")
 print(f"mean carriage speed {speed:.5f} m/s (ω r = 0.375), mean vertical floor force "
       f"{load:.3f} N (load 81.717 N) over {len(rows)} windows")
 ok = abs(speed - 0.375) <= 0.005 * 0.375 and abs(load - 81.7173) <= 0.01 * 81.7173

@@ -27,7 +27,7 @@ def blocks(path, column):
 
 
 failures = []
-for column in ("soil_Fx_N", "soil_Fz_N", "soil_Ty_N_m", "motor_torque_N_m", "z_m", "slip"):
+for column in ("wheel.Fx_N", "wheel.Fz_N", "wheel.Ty_N_m", "motor_torque_N_m", "z_m", "slip"):
     (full, se_full), (half, se_half) = blocks(sys.argv[1], column), blocks(sys.argv[2], column)
     allowed = 3.0 * math.hypot(se_full, se_half)
     verdict = "ok" if abs(half - full) <= allowed else "DIFFERENT"
@@ -35,7 +35,7 @@ for column in ("soil_Fx_N", "soil_Fz_N", "soil_Ty_N_m", "motor_torque_N_m", "z_m
           f"|difference| {abs(half - full):.4f} (allowed {allowed:.4f}) {verdict}")
     if verdict != "ok":
         failures.append(column)
-    if column == "soil_Fz_N":
+    if column == "wheel.Fz_N":
         for name, value in (("full", full), ("half", half)):
             if abs(value - 9.81) > 0.05 * 9.81:
                 failures.append(f"{name} model's vertical force {value:.3f} N is not the load")

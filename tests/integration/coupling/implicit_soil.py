@@ -37,7 +37,7 @@ for name in ("rig.csv", "soil.csv"):
     if len(times) != len(coupling) or any(b <= a for a, b in zip(times, times[1:])):
         failures.append(f"{name}: {len(times)} rows for {len(coupling)} windows, or times "
                         "not increasing")
-fz = [float(r["soil_Fz_N"]) for r in csv.DictReader(open(os.path.join(out, "rig.csv")))
+fz = [float(r["wheel.Fz_N"]) for r in csv.DictReader(open(os.path.join(out, "rig.csv")))
       if float(r["time_s"]) >= 0.3]
 mean = sum(fz) / len(fz)
 sd = (sum((f - mean) ** 2 for f in fz) / len(fz)) ** 0.5
