@@ -1,10 +1,15 @@
 #include "CheckpointFiles.hpp"
 
 #include "Codec.hpp"
+#include "grainlink/config/Checksum.hpp"
 
+#include <spdlog/spdlog.h>
+
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 namespace grainlink::coupling {
 
@@ -27,6 +32,76 @@ fs::path latestFile(const std::string &output_directory) {
     return fs::path(output_directory) / "checkpoints" / "latest";
 }
 
+constexpr const char *kManifest = "manifest.txt";
+
+/// A file's checksum and size; false when it cannot be read.
+bool checksumOf(const fs::path &path, std::uint64_t &sum, std::uintmax_t &size) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in)
+        return false;
+    config::Checksum c;
+    char buffer[1 << 16];
+    size = 0;
+    while (in.read(buffer, sizeof buffer) || in.gcount() > 0) {
+        c.add(buffer, std::size_t(in.gcount()));
+        size += std::uintmax_t(in.gcount());
+    }
+    sum = c.value;
+    return !in.bad();
+}
+
+/// Every participant's file in a checkpoint, with its checksum and size (manifest.txt), so that
+/// a damaged one is found before any participant believes it.
+void writeManifest(const fs::path &directory) {
+    std::vector<fs::path> files;
+    for (const auto &entry : fs::recursive_directory_iterator(directory))
+        if (entry.is_regular_file() && entry.path().filename() != kManifest &&
+            entry.path().filename() != "coordinator.pb")
+            files.push_back(entry.path());
+    std::sort(files.begin(), files.end());
+    std::ostringstream text;
+    for (const fs::path &file : files) {
+        std::uint64_t sum = 0;
+        std::uintmax_t size = 0;
+        if (!checksumOf(file, sum, size))
+            throw CouplingError("cannot read " + file.string() + " to checksum it");
+        char line[48];
+        std::snprintf(line, sizeof line, "%016llx %llu ", static_cast<unsigned long long>(sum),
+                      static_cast<unsigned long long>(size));
+        text << line << fs::relative(file, directory).string() << '\n';
+    }
+    writeAtomically(directory / kManifest, text.str());
+}
+
+/// What is wrong with a checkpoint folder; empty when it is whole. One written before the
+/// manifest existed is checked by its coordinator.pb alone.
+std::string damage(const fs::path &folder, codec::pb::CoordinatorCheckpoint &state) {
+    std::ifstream state_file(folder / "coordinator.pb", std::ios::binary);
+    if (!state_file || !state.ParseFromIstream(&state_file))
+        return "coordinator.pb is missing or unreadable";
+    std::ifstream manifest(folder / kManifest);
+    if (!manifest)
+        return fs::exists(folder / kManifest) ? "manifest.txt is unreadable" : "";
+    std::string line;
+    while (std::getline(manifest, line)) {
+        std::istringstream cells(line);
+        std::string hex, name;
+        std::uintmax_t size = 0;
+        if (!(cells >> hex >> size) || !std::getline(cells >> std::ws, name))
+            return "manifest.txt has a damaged line '" + line + "'";
+        std::uint64_t sum = 0;
+        std::uintmax_t actual = 0;
+        if (!checksumOf(folder / name, sum, actual))
+            return name + " is missing or unreadable";
+        if (actual != size)
+            return name + " has " + std::to_string(actual) + " bytes, " + std::to_string(size) +
+                   " when it was written";
+        if (std::strtoull(hex.c_str(), nullptr, 16) != sum)
+            return name + " does not match its checksum (it changed after it was written)";
+    }
+    return "";
+}
+
 } // namespace
 
 std::string checkpointDirectory(const std::string &output_directory, std::uint64_t window) {
@@ -45,6 +120,7 @@ void commitCheckpoint(const std::string &output_directory, const std::string &di
     codec::toWire(snapshot.states, snapshot.tick, state.mutable_states());
     codec::toWire(snapshot.wrenches, snapshot.tick, snapshot.tick, state.mutable_wrenches());
     state.set_cumulative_mismatch_j(snapshot.cumulative_mismatch_J);
+    writeManifest(directory);
     writeAtomically(fs::path(directory) / "coordinator.pb", state.SerializeAsString());
     writeAtomically(latestFile(output_directory), fs::path(directory).filename().string() + "\n");
 }
@@ -57,12 +133,31 @@ CoordinatorSnapshot readLatestCheckpoint(const std::string &output_directory,
     if (!(in >> name))
         throw CouplingError("cannot resume: no complete checkpoint (" + latest.string() +
                             " is missing)");
-    const fs::path folder = fs::absolute(latest.parent_path() / name);
-    std::ifstream state_file(folder / "coordinator.pb", std::ios::binary);
+    // The latest first, then the ones before it, newest first: a damaged checkpoint is passed
+    // over, never believed.
+    std::vector<std::string> names;
+    for (const auto &entry : fs::directory_iterator(latest.parent_path()))
+        if (entry.is_directory() && entry.path().filename().string().rfind("window_", 0) == 0 &&
+            entry.path().filename().string() < name)
+            names.push_back(entry.path().filename().string());
+    std::sort(names.rbegin(), names.rend());
+    names.insert(names.begin(), name);
     codec::pb::CoordinatorCheckpoint state;
-    if (!state.ParseFromIstream(&state_file))
-        throw CouplingError("cannot resume: " + (folder / "coordinator.pb").string() +
-                            " is unreadable");
+    std::string problems;
+    for (const std::string &candidate : names) {
+        const fs::path folder = fs::absolute(latest.parent_path() / candidate);
+        const std::string problem = damage(folder, state);
+        if (problem.empty()) {
+            directory = folder.string();
+            break;
+        }
+        spdlog::warn("coordinator: checkpoint {} is damaged: {}; trying the one before it",
+                     folder.string(), problem);
+        problems += "; " + candidate + ": " + problem;
+    }
+    if (directory.empty())
+        throw CouplingError("cannot resume: every checkpoint in " + latest.parent_path().string() +
+                            " is damaged" + problems);
     CoordinatorSnapshot snapshot;
     snapshot.run_id = state.run_id();
     snapshot.window = state.window();
@@ -71,7 +166,6 @@ CoordinatorSnapshot readLatestCheckpoint(const std::string &output_directory,
     snapshot.states = codec::fromWire(state.states());
     snapshot.wrenches = codec::fromWire(state.wrenches());
     snapshot.cumulative_mismatch_J = state.cumulative_mismatch_j();
-    directory = folder.string();
     return snapshot;
 }
 

@@ -23,14 +23,16 @@ struct CoordinatorSnapshot {
 /// started from another folder writes to the same place.
 std::string checkpointDirectory(const std::string &output_directory, std::uint64_t window);
 
-/// Writes coordinator.pb into `directory` (the participants' parts are there already), then moves
-/// <output_directory>/checkpoints/latest to it, each by an atomic rename: a checkpoint is
+/// Writes manifest.txt (every participant's file in `directory` with its FNV-1a checksum and
+/// size) and coordinator.pb into `directory` (the participants' parts are there already), then
+/// moves <output_directory>/checkpoints/latest to it, each by an atomic rename: a checkpoint is
 /// complete or it does not exist.
 void commitCheckpoint(const std::string &output_directory, const std::string &directory,
                       const CoordinatorSnapshot &snapshot);
 
-/// The last complete checkpoint's snapshot; `directory` receives its folder. Throws CouplingError
-/// when there is none or it is unreadable.
+/// The last complete checkpoint that is whole (its coordinator.pb readable, every file its
+/// manifest lists unchanged), passing over damaged ones newest first with a warning naming the
+/// file; `directory` receives its folder. Throws CouplingError when there is none.
 CoordinatorSnapshot readLatestCheckpoint(const std::string &output_directory,
                                          std::string &directory);
 

@@ -1,5 +1,7 @@
 #include "grainlink/dem/Checkpoint.hpp"
 
+#include "grainlink/config/Checksum.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -20,14 +22,7 @@ constexpr char kMagicVersion3[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '3'};
 constexpr char kMagicVersion2[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '2'};
 constexpr char kMagicVersion1[8] = {'G', 'L', 'D', 'E', 'M', 'C', 'K', '1'};
 
-/// FNV-1a, 64 bit: a flipped bit anywhere changes it (not a defence against a forger).
-struct Checksum {
-    std::uint64_t value = 14695981039346656037ull;
-    void add(const char *bytes, std::size_t n) {
-        for (std::size_t k = 0; k < n; ++k)
-            value = (value ^ std::uint8_t(bytes[k])) * 1099511628211ull;
-    }
-};
+using config::Checksum;
 
 class Writer {
 public:
