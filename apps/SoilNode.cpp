@@ -104,6 +104,8 @@ public:
                                               std::to_string(1000.0 * (surface_ - lowestPoint(b))) +
                                               " mm inside the settled bed (surface at z = " +
                                               std::to_string(surface_) + " m): start it higher");
+            if (in.window == 0 && !resumed_)
+                refuseStartingOverlap(b);
         }
         coupling::WindowLoads loads(options_.bodies);
         for (std::uint64_t k = 0; k < steps; ++k) {
@@ -207,6 +209,27 @@ private:
             throw coupling::CouplingError(text);
         }
     }
+    /// A grain standing above the bed surface (its 98th percentile) can still be cut deep by a
+    /// body placed above that surface: the first step would push it out at once, or stop at the
+    /// overlap limit with a message about the time step. Said before the first step instead.
+    void refuseStartingOverlap(std::size_t b) const {
+        const auto &p = sys_->particles();
+        const auto deepest = dem::deepestGrainOverlap(
+            p.position, p.radius, sys_->body(int(b)).worldVertices(), sys_->body(int(b)).mesh());
+        if (deepest.ratio <= 0.5 * scenario_.settings.max_overlap_ratio)
+            return;
+        char text[256];
+        std::snprintf(
+            text, sizeof text,
+            "body '%s' starts cutting %.2f of grain %zu's radius (%.2f mm; the grain's "
+            "top is %.2f mm above the bed surface): start it at least %.1f mm higher",
+            options_.bodies[b].c_str(), deepest.ratio, deepest.particle,
+            1000.0 * deepest.ratio * p.radius[deepest.particle],
+            1000.0 * (p.position[deepest.particle].z() + p.radius[deepest.particle] - surface_),
+            1000.0 * (deepest.ratio * p.radius[deepest.particle]) + 0.1);
+        throw coupling::CouplingError(text);
+    }
+
     double lowestPoint(std::size_t b) const {
         double lowest = 1e300;
         for (const auto &v : sys_->body(int(b)).worldVertices())

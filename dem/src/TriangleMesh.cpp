@@ -235,6 +235,37 @@ void writeStlBinary(const TriangleMesh &mesh, const std::string &path) {
     }
 }
 
+GrainOverlap deepestGrainOverlap(const std::vector<Vec3> &centres_m,
+                                 const std::vector<double> &radii_m,
+                                 const std::vector<Vec3> &world_vertices_m,
+                                 const TriangleMesh &mesh) {
+    GrainOverlap deepest;
+    if (world_vertices_m.empty())
+        return deepest;
+    Vec3 lo = world_vertices_m.front(), hi = lo;
+    for (const Vec3 &v : world_vertices_m) {
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+    }
+    for (std::size_t i = 0; i < centres_m.size(); ++i) {
+        const Vec3 &x = centres_m[i];
+        const double r = radii_m[i];
+        if ((x.array() < lo.array() - r).any() || (x.array() > hi.array() + r).any())
+            continue; // cannot reach the mesh
+        double d2 = r * r;
+        for (const auto &t : mesh.triangles) {
+            const Vec3 q = closestPointOnTriangle(x, world_vertices_m[std::size_t(t[0])],
+                                                  world_vertices_m[std::size_t(t[1])],
+                                                  world_vertices_m[std::size_t(t[2])]);
+            d2 = std::min(d2, (q - x).squaredNorm());
+        }
+        const double ratio = (r - std::sqrt(d2)) / r;
+        if (ratio > deepest.ratio)
+            deepest = {i, ratio};
+    }
+    return deepest;
+}
+
 Vec3 closestPointOnTriangle(const Vec3 &p, const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     const Vec3 ab = b - a, ac = c - a, ap = p - a;
     const double d1 = ab.dot(ap), d2 = ac.dot(ap);

@@ -103,3 +103,25 @@ TEST_CASE("A malformed STL names the file and the line", "[dem][stl]") {
     CHECK_THROWS_WITH(readStl(file.path), Catch::Contains(file.path));
     CHECK_THROWS_WITH(readStl(file.path + ".missing"), Catch::Contains("cannot open"));
 }
+
+TEST_CASE("the grain cutting deepest into a placed mesh is found with its overlap") {
+    // A 40 mm square in the plane z = 0.1 m; grains of radius 2 mm below and beside it.
+    const TriangleMesh square = makeRectangle(0.04, 0.04, 4, 4);
+    std::vector<Vec3> world;
+    for (const Vec3 &v : square.vertices_m)
+        world.push_back(v + Vec3(0.0, 0.0, 0.1));
+    const std::vector<double> radii(4, 0.002);
+    std::vector<Vec3> centres{
+        {0.0, 0.0, 0.099},    // 1 mm below the face: overlap (2 - 1) / 2 = 0.5
+        {0.005, 0.0, 0.0985}, // 1.5 mm below: 0.25
+        {0.0215, 0.0, 0.1},   // 1.5 mm beyond the edge, in its plane: 0.25
+        {0.0, 0.0, 0.095},    // 5 mm below: untouched
+    };
+    const GrainOverlap deepest = deepestGrainOverlap(centres, radii, world, square);
+    CHECK(deepest.particle == 0);
+    CHECK(deepest.ratio == Approx(0.5).margin(1e-12));
+    centres.erase(centres.begin());
+    CHECK(deepestGrainOverlap(centres, {0.002, 0.002, 0.002}, world, square).ratio ==
+          Approx(0.25).margin(1e-12));
+    CHECK(deepestGrainOverlap({{0.0, 0.0, 0.095}}, {0.002}, world, square).ratio == 0.0);
+}

@@ -42,6 +42,18 @@ void writeStlBinary(const TriangleMesh &mesh, const std::string &path);
 /// Closest point of triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5).
 Vec3 closestPointOnTriangle(const Vec3 &p, const Vec3 &a, const Vec3 &b, const Vec3 &c);
 
+/// The grain that cuts deepest into a placed mesh (vertices in the world frame): its index and
+/// its overlap as a share of its radius, r - d over r with d its centre's distance from the
+/// surface; ratio 0 when no grain touches. A body placed this way starts with that contact.
+struct GrainOverlap {
+    std::size_t particle = 0;
+    double ratio = 0.0;
+};
+GrainOverlap deepestGrainOverlap(const std::vector<Vec3> &centres_m,
+                                 const std::vector<double> &radii_m,
+                                 const std::vector<Vec3> &world_vertices_m,
+                                 const TriangleMesh &mesh);
+
 /// The most facets around a parametric body (wheel, plate, ring, tube) a scenario may ask for:
 /// far beyond any grain-resolved need, and small enough that a typo cannot exhaust memory.
 constexpr int kMaxMeshSegments = 100000;
