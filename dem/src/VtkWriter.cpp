@@ -9,6 +9,8 @@
 #include <type_traits>
 #include <vector>
 
+#include <zlib.h>
+
 namespace grainlink::dem {
 
 namespace {
@@ -29,9 +31,33 @@ void commit(std::ofstream &out, const std::string &path) {
         throw std::runtime_error("cannot rename '" + path + ".partial' to '" + path + "'");
 }
 
-/// One .vtu file: its arrays are collected, then written as VTK XML with the data appended raw
-/// (binary, little-endian, each array a UInt64 byte count and its bytes): a 62,000-grain
-/// snapshot takes about a third of the ASCII size and keeps every number to the bit.
+/// One array's bytes as VTK's zlib compressor writes them (vtkZLibDataCompressor, header_type
+/// UInt64): the block count, the block size, the last block's size (0 when it is full) and each
+/// block's compressed size, then the compressed blocks. Lossless: every number keeps its bits.
+std::string zlibBlocks(const std::vector<char> &bytes) {
+    constexpr std::size_t kBlock = 1 << 16;
+    const std::size_t blocks = (bytes.size() + kBlock - 1) / kBlock;
+    std::vector<std::uint64_t> header{blocks, kBlock, bytes.size() % kBlock};
+    std::string data;
+    for (std::size_t b = 0; b < blocks; ++b) {
+        const std::size_t n = std::min(kBlock, bytes.size() - b * kBlock);
+        uLongf size = compressBound(uLong(n));
+        std::string block(size, '\0');
+        if (compress2(reinterpret_cast<Bytef *>(block.data()), &size,
+                      reinterpret_cast<const Bytef *>(bytes.data() + b * kBlock), uLong(n),
+                      Z_DEFAULT_COMPRESSION) != Z_OK)
+            throw std::runtime_error("zlib could not compress a snapshot array");
+        header.push_back(size);
+        data.append(block.data(), size);
+    }
+    return std::string(reinterpret_cast<const char *>(header.data()),
+                       header.size() * sizeof(std::uint64_t)) +
+           data;
+}
+
+/// One .vtu file: its arrays are collected, then written as VTK XML, binary, little-endian,
+/// appended and zlib-compressed as ParaView's own files are (a 62,000-grain snapshot raw took
+/// about a third of the ASCII size; radii, ids and cell arrays compress far further).
 class VtuFile {
 public:
     enum class Section { Points, PointData, CellData, Cells };
@@ -59,10 +85,18 @@ public:
         std::ofstream out(path + ".partial", std::ios::binary);
         if (!out)
             throw std::runtime_error("cannot write snapshot '" + path + "'");
+        std::vector<std::string> blocks; // each array compressed, in the order written below
+        for (const Section which :
+             {Section::Points, Section::PointData, Section::CellData, Section::Cells})
+            for (const Array &a : arrays_)
+                if (a.section == which)
+                    blocks.push_back(zlibBlocks(a.bytes));
         out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" "
-               "byte_order=\"LittleEndian\" header_type=\"UInt64\">\n<UnstructuredGrid>\n"
+               "byte_order=\"LittleEndian\" header_type=\"UInt64\" "
+               "compressor=\"vtkZLibDataCompressor\">\n<UnstructuredGrid>\n"
             << "<Piece NumberOfPoints=\"" << points << "\" NumberOfCells=\"" << cells << "\">\n";
         std::uint64_t offset = 0;
+        std::size_t next = 0; // the next array's compressed block
         const auto section = [&](Section which, const std::string &open, const std::string &close) {
             bool any = false;
             for (const Array &a : arrays_)
@@ -75,7 +109,7 @@ public:
                     out << "<DataArray type=\"" << a.type << "\" Name=\"" << a.name
                         << "\" NumberOfComponents=\"" << a.components
                         << "\" format=\"appended\" offset=\"" << offset << "\"/>\n";
-                    offset += sizeof(std::uint64_t) + a.bytes.size();
+                    offset += blocks[next++].size();
                 }
             out << close;
         };
@@ -87,14 +121,8 @@ public:
         section(Section::CellData, "<CellData>\n", "</CellData>\n");
         section(Section::Cells, "<Cells>\n", "</Cells>\n");
         out << "</Piece>\n</UnstructuredGrid>\n<AppendedData encoding=\"raw\">\n_";
-        for (const Section which :
-             {Section::Points, Section::PointData, Section::CellData, Section::Cells})
-            for (const Array &a : arrays_)
-                if (a.section == which) {
-                    const std::uint64_t size = a.bytes.size();
-                    out.write(reinterpret_cast<const char *>(&size), sizeof size);
-                    out.write(a.bytes.data(), std::streamsize(a.bytes.size()));
-                }
+        for (const std::string &b : blocks)
+            out.write(b.data(), std::streamsize(b.size()));
         out << "\n</AppendedData>\n</VTKFile>\n";
         commit(out, path);
     }

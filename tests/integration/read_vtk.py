@@ -6,8 +6,9 @@
   radius, velocity and force
   arrays, and vtkGeometryFilter — what ParaView's default Surface view runs — turns it into one
   vertex per grain (a snapshot without cells shows nothing there);
-- the binary (appended raw) numbers decode to what the scenario allows: every radius within
-  tiny.yaml's 3.5-4.5 mm, every grain centre inside its 60 x 60 mm bin;
+- every file is binary, appended and zlib-compressed (vtkZLibDataCompressor), and its numbers
+  decode to what the scenario allows: every radius within tiny.yaml's 3.5-4.5 mm, every grain
+  centre inside its 60 x 60 mm bin, ids 0 to n - 1 each once;
 - each plate snapshot holds the plate's triangles (24 facets: 96 triangles) and their loads.
 Usage: read_vtk.py GRAINLINK SCENARIO WORK"""
 import os
@@ -43,6 +44,10 @@ def collection(name):
 
 
 def read(path):
+    with open(path, "rb") as f:
+        head = f.read(400)
+    if b'compressor="vtkZLibDataCompressor"' not in head or b'format="appended"' not in head:
+        failures.append(f"{path}: not appended and zlib-compressed: {head[:300]!r}")
     reader = vtk.vtkXMLUnstructuredGridReader()
     reader.SetFileName(path)
     reader.Update()
@@ -66,6 +71,9 @@ for path in particles:
     if not {"radius_m", "velocity_m_s", "force_N", "id"} <= arrays:
         failures.append(f"{path}: point arrays {arrays}")
         continue
+    ids = grid.GetPointData().GetArray("id")
+    if sorted(int(ids.GetValue(k)) for k in range(n)) != list(range(n)):
+        failures.append(f"{path}: ids are not 0 to {n - 1} each once")
     radius = grid.GetPointData().GetArray("radius_m").GetRange()
     bounds = grid.GetBounds()
     if not (0.0035 <= radius[0] <= radius[1] <= 0.0045):
