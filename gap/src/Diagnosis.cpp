@@ -66,6 +66,19 @@ Eigen::MatrixXd firstRows(const Eigen::MatrixXd &rows, int n) {
 
 } // namespace
 
+ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidates) {
+    ClosestCandidates c;
+    for (const CandidateResult &R : candidates) {
+        if (!R.confirmed)
+            continue;
+        if (!c.by_gap || R.held_out.gap < c.by_gap->held_out.gap)
+            c.by_gap = &R;
+        if (!c.by_p_value || R.p_value < c.by_p_value->p_value)
+            c.by_p_value = &R;
+    }
+    return c;
+}
+
 const char *outcomeName(Diagnosis::Outcome outcome) {
     switch (outcome) {
     case Diagnosis::Outcome::NoGap:
@@ -623,10 +636,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             else
                 claim << "unexplained: no catalogued effect, alone or in a pair, predicts the "
                          "held-out experiments better than the null model and leaves no gap";
-            const CandidateResult *best = nullptr;
-            for (const CandidateResult &R : D.candidates)
-                if (R.confirmed && (!best || R.held_out.gap < best->held_out.gap))
-                    best = &R;
+            const ClosestCandidates closest = closestCandidates(D.candidates);
+            const CandidateResult *best = closest.by_gap;
             if (best) {
                 D.best_model = best->name;
                 D.best_model_mean = best->confirmed_mean;
@@ -642,6 +653,14 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                           : best->fit.at_prior_edge ? ", at its prior's edge: not claimed"
                                                     : "")
                       << ")";
+            if (const CandidateResult *nearest = closest.by_p_value; nearest && nearest != best) {
+                D.nearest_to_claim = nearest->name;
+                claim << "; nearest to a claim: " << nearest->name << " at "
+                      << strengthText(nearest->effect, nearest->fit.strength) << " (held-out gap "
+                      << fmt(100.0 * nearest->held_out.gap, 2)
+                      << " %, p = " << fmt(nearest->p_value, 3) << " against the level "
+                      << fmt(level, 3) << ")";
+            }
         }
     }
     D.claim = claim.str() + notCompared();

@@ -73,6 +73,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     j["numerical_warning"] = d.numerical_warning;
     j["explained_by"] = d.explained_by;
     j["best_model"] = d.best_model;
+    j["nearest_to_claim"] = d.nearest_to_claim;
     j["where"] = Json::array();
     for (const RegimeFinding &f : d.findings)
         j["where"].push_back({{"kind", f.kind},

@@ -440,3 +440,30 @@ TEST_CASE("diagnosis: a candidate whose confirming runs failed is replaced by th
     CHECK(d.explained_by != "cohesion");
     CHECK(confirmed(d) == confirmed(before) + 1);
 }
+
+TEST_CASE("when nothing is claimed the closest by held-out gap and the nearest to a claim are "
+          "both named",
+          "[gap][diagnosis]") {
+    // The CMU box split's case: grain stiffness leaves the smaller held-out gap, grain shape is
+    // nearer to a claim (smaller p); an unconfirmed candidate with p 0 counts for neither.
+    const auto candidate = [](const char *name, bool confirmed, double gap, double p) {
+        CandidateResult R;
+        R.name = name;
+        R.confirmed = confirmed;
+        R.held_out.gap = gap;
+        R.p_value = p;
+        return R;
+    };
+    const std::vector<CandidateResult> candidates{candidate("rig_compliance", true, 1.20, 0.82),
+                                                  candidate("grain_stiffness", true, 0.0, 0.14),
+                                                  candidate("grain_shape", true, 0.43, 0.017),
+                                                  candidate("cohesion", false, 0.0, 0.0)};
+    const ClosestCandidates c = closestCandidates(candidates);
+    REQUIRE(c.by_gap != nullptr);
+    REQUIRE(c.by_p_value != nullptr);
+    CHECK(c.by_gap->name == "grain_stiffness");
+    CHECK(c.by_p_value->name == "grain_shape");
+    const ClosestCandidates none = closestCandidates({candidate("cohesion", false, 0.0, 0.0)});
+    CHECK(none.by_gap == nullptr);
+    CHECK(none.by_p_value == nullptr);
+}

@@ -132,11 +132,23 @@ struct Diagnosis {
     std::string best_model;
     Eigen::VectorXd best_model_mean; ///< its confirming runs' features (empty with no model)
     std::string explained_by; ///< best_model when the outcome is an explanation, else empty
+    /// Unexplained: the confirmed candidate nearest to a claim by its p value against the null,
+    /// when that is not best_model (the closest by held-out gap); else empty.
+    std::string nearest_to_claim;
     std::string claim;        ///< one sentence: the result (and what was not compared)
     std::string unexplained;  ///< what remains (features still flagged after the best model)
     int simulations = 0;      ///< variant x seed runs requested
 };
 const char *outcomeName(Diagnosis::Outcome outcome);
+
+/// When nothing is claimed, two confirmed candidates come closest: the one whose added effect
+/// leaves the smallest held-out gap, and the one nearest to a claim (the smallest p against the
+/// null). Either is null when nothing was confirmed; they may be the same.
+struct ClosestCandidates {
+    const CandidateResult *by_gap = nullptr;
+    const CandidateResult *by_p_value = nullptr;
+};
+ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidates);
 
 /// The calibration / held-out split by experiment id (docs/gap.md): `held_out` when given;
 /// otherwise, for every experiment type with two or more experiments, the experiments of its
