@@ -1,7 +1,18 @@
 """Shared by the command-line checks that run variants of a coupled scenario: write the variant
 beside the others and run it through `grainlink run`."""
 import os
+import shutil
 import subprocess
+import sys
+
+
+def arguments(count):
+    """The script's first `count` arguments as absolute paths; the last, its work folder, is
+    emptied."""
+    paths = [os.path.abspath(a) for a in sys.argv[1:count + 1]]
+    shutil.rmtree(paths[-1], ignore_errors=True)
+    os.makedirs(paths[-1])
+    return paths
 
 
 def run_variant(grainlink, work, name, text, *extra, progress="0"):

@@ -11,15 +11,12 @@ finds the wheel's lowest point that far above it.
    centre starts at 0.075 + 0.005 = 0.0800 m, the start wheel_floor.yaml gives by hand.
 Usage: clearance.py GRAINLINK STATIC_YAML FLOOR_YAML WORK"""
 import os
-import shutil
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from coupled_runs import run_variant  # noqa: E402
+from coupled_runs import arguments, run_variant  # noqa: E402
 
-grainlink, static, floor, work = map(os.path.abspath, sys.argv[1:5])
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
+grainlink, static, floor, work = arguments(4)
 failures = []
 
 

@@ -13,15 +13,12 @@ Usage: guard.py GRAINLINK CONFIG WORK"""
 import csv
 import os
 import re
-import shutil
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from coupled_runs import run_variant  # noqa: E402
+from coupled_runs import arguments, run_variant  # noqa: E402
 
-grainlink, config, work = map(os.path.abspath, sys.argv[1:4])
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
+grainlink, config, work = arguments(3)
 failures = []
 
 

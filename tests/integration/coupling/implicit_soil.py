@@ -9,15 +9,12 @@
 Usage: implicit_soil.py GRAINLINK STATIC_YAML WORK"""
 import csv
 import os
-import shutil
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from coupled_runs import run_variant  # noqa: E402
+from coupled_runs import arguments, run_variant  # noqa: E402
 
-grainlink, static, work = map(os.path.abspath, sys.argv[1:4])
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
+grainlink, static, work = arguments(3)
 text = open(static).read().replace(
     "  scheme: explicit-serial",
     "  scheme: implicit\n  implicit: {relative_tolerance: 1.0e-3, acceleration: iqn-ils, "

@@ -10,15 +10,12 @@ Simbody rig and the rigid floor):
 Usage: progress.py GRAINLINK FLOOR_YAML WORK"""
 import os
 import re
-import shutil
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from coupled_runs import run_variant  # noqa: E402
+from coupled_runs import arguments, run_variant  # noqa: E402
 
-grainlink, floor, work = map(os.path.abspath, sys.argv[1:4])
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
+grainlink, floor, work = arguments(3)
 failures = []
 LINE = re.compile(r"^\[(\w+)\] t = ([0-9.]+) s \(\s*([0-9.]+) %\)  wall \S+  ETA \S+(.*)$")
 

@@ -10,15 +10,12 @@ variants of wheel_floor.yaml, whose torque-driven wheel rolls without slip:
 Usage: wheel_verdict.py GRAINLINK FLOOR_YAML WORK"""
 import json
 import os
-import shutil
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
-from coupled_runs import run_variant  # noqa: E402
+from coupled_runs import arguments, run_variant  # noqa: E402
 
-grainlink, config, work = map(os.path.abspath, sys.argv[1:4])
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
+grainlink, config, work = arguments(3)
 base = open(config).read()
 failures = []
 
