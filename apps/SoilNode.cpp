@@ -30,7 +30,8 @@ public:
           snapshot_directory_(options.output_directory + (options.section == "soil"
                                                               ? "/snapshots"
                                                               : "/snapshots_" + options.section)),
-          vtk_(snapshot_directory_), progress_(options.name, options.progress_interval_s) {
+          vtk_(snapshot_directory_, scenario_.output.contact_network),
+          progress_(options.name, options.progress_interval_s) {
         sys_ = dem::prepareSoil(scenario_, options.progress_interval_s);
         surface_ = dem::bedSurface(sys_->particles());
         std::fprintf(stderr, "[%s] %zu particles, bed surface at z = %.4f m\n",

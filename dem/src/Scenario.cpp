@@ -506,6 +506,7 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
         s.output.series_interval_s = out->number("series_interval_s", 0.01);
         s.output.snapshot_interval_s = out->number("snapshot_interval_s", 0.0);
         s.output.checkpoint_interval_s = out->number("checkpoint_interval_s", 0.0);
+        s.output.contact_network = out->boolean("contact_network", false);
         out->finish();
         if (!(s.output.series_interval_s > 0.0))
             (*out)["series_interval_s"].fail("must be > 0");

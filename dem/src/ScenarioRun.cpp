@@ -367,7 +367,7 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
     const auto run_steps = std::uint64_t(std::llround(scenario.duration_s / dt));
     const std::uint64_t first_step = sys->stepCount();
 
-    VtkWriter vtk(out.string());
+    VtkWriter vtk(out.string(), scenario.output.contact_network);
     // Resumed: the whole rows up to the checkpoint's step are kept, rows after it redone.
     Series series(series_path, seriesHeader(*sys),
                   options.resume ? std::optional(SeriesRestart{double(sys->stepCount()), 2})

@@ -156,9 +156,30 @@ void writeMesh(const MeshBody &body, const std::string &path) {
     file.write(path, body.worldVertices().size(), t.size());
 }
 
+/// The force chains: the grain centres as points, a line cell per touching pair.
+void writeContacts(const DemSystem &system, const std::string &path) {
+    const auto network = system.contactNetwork();
+    VtuFile file;
+    file.vectors(VtuFile::Section::Points, "position_m", system.particles().position);
+    std::vector<std::int64_t> connectivity, offsets;
+    std::vector<double> force;
+    for (const PairForce &c : network) {
+        connectivity.insert(connectivity.end(), {std::int64_t(c.i), std::int64_t(c.j)});
+        offsets.push_back(std::int64_t(connectivity.size()));
+        force.push_back(c.normal_force_N);
+    }
+    file.add(VtuFile::Section::CellData, "Float64", "normal_force_N", 1, force);
+    file.add(VtuFile::Section::Cells, "Int64", "connectivity", 1, connectivity);
+    file.add(VtuFile::Section::Cells, "Int64", "offsets", 1, offsets);
+    file.add(VtuFile::Section::Cells, "UInt8", "types", 1,
+             std::vector<std::uint8_t>(network.size(), 3)); // VTK_LINE
+    file.write(path, system.particles().size(), network.size());
+}
+
 } // namespace
 
-VtkWriter::VtkWriter(std::string directory) : directory_(std::move(directory)) {}
+VtkWriter::VtkWriter(std::string directory, bool contact_network)
+    : directory_(std::move(directory)), contact_network_(contact_network) {}
 
 void VtkWriter::writeParticles(const ParticleStore &p, const std::string &path) {
     const std::size_t n = p.size();
@@ -186,6 +207,8 @@ void VtkWriter::writeParticles(const ParticleStore &p, const std::string &path) 
 void VtkWriter::write(const DemSystem &system, double time_s) {
     const int index = int(times_.size());
     writeParticles(system.particles(), directory_ + "/" + numbered("particles", index));
+    if (contact_network_)
+        writeContacts(system, directory_ + "/" + numbered("contacts", index));
     body_names_.clear();
     for (int b = 0; b < system.bodyCount(); ++b) {
         const std::string prefix = "body_" + system.body(b).name();
@@ -194,6 +217,8 @@ void VtkWriter::write(const DemSystem &system, double time_s) {
     }
     times_.push_back(time_s);
     writeCollection("particles.pvd", "particles");
+    if (contact_network_)
+        writeCollection("contacts.pvd", "contacts");
     for (const std::string &name : body_names_)
         writeCollection("body_" + name + ".pvd", "body_" + name);
 }

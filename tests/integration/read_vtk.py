@@ -9,12 +9,17 @@
 - every file is binary, appended and zlib-compressed (vtkZLibDataCompressor), and its numbers
   decode to what the scenario allows: every radius within tiny.yaml's 3.5-4.5 mm, every grain
   centre inside its 60 x 60 mm bin, ids 0 to n - 1 each once;
-- each plate snapshot holds the plate's triangles (24 facets: 96 triangles) and their loads.
+- each plate snapshot holds the plate's triangles (24 facets: 96 triangles) and their loads;
+- with `output.contact_network`, each contacts snapshot holds a line per touching grain pair, as
+  many as series.csv counts at that time, and each line's normal_force_N is Hertz's
+  4/3 E* sqrt(R*) delta^(3/2) recomputed here from the particle snapshot's centres and radii
+  (E* = E / (2 (1 - nu^2)) for tiny.yaml's one material).
 Usage: read_vtk.py GRAINLINK SCENARIO WORK"""
 import os
 import shutil
 import subprocess
 import sys
+import csv
 import json
 import xml.etree.ElementTree as ET
 
@@ -23,8 +28,13 @@ import vtk
 grainlink, scenario, work = map(os.path.abspath, sys.argv[1:4])
 shutil.rmtree(work, ignore_errors=True)
 os.makedirs(work)
-done = subprocess.run([grainlink, "dem", scenario, "--out", os.path.join(work, "out")], cwd=work,
-                      capture_output=True, text=True)
+# tiny.yaml with the force chains written beside every particle snapshot.
+text = open(scenario).read()
+assert "snapshot_interval_s: 0.05}" in text
+with open(os.path.join(work, "tiny.yaml"), "w") as f:
+    f.write(text.replace("snapshot_interval_s: 0.05}", "snapshot_interval_s: 0.05, contact_network: true}"))
+done = subprocess.run([grainlink, "dem", os.path.join(work, "tiny.yaml"), "--out",
+                       os.path.join(work, "out")], cwd=work, capture_output=True, text=True)
 if done.returncode != 0:
     sys.exit("FAILED: the run failed:\n" + done.stderr[-2000:])
 folder = os.path.join(work, "out")
@@ -90,5 +100,39 @@ for path in plates:
             grid.GetCellData().GetArray("force_N") is None:
         failures.append(f"{path}: {grid.GetNumberOfCells()} cells of types {types}")
 print(f"{len(plates)} plate snapshots: 96 triangles each")
+
+E, NU = 3.0e6, 0.2
+E_STAR = E / (2.0 * (1.0 - NU * NU))
+with open(os.path.join(folder, "series.csv")) as f:
+    counted = {round(float(r["run_time_s"]), 6): int(r["contacts"]) for r in csv.DictReader(f)}
+times = [float(e.get("timestep")) for e in ET.parse(os.path.join(folder, "contacts.pvd")).getroot().iter("DataSet")]
+networks = collection("contacts.pvd")
+worst, compared = 0.0, 0
+for time, path, grains_path in zip(times, networks, particles):
+    grid, grains = read(path), read(grains_path)
+    lines = grid.GetNumberOfCells()
+    types = {grid.GetCellType(k) for k in range(lines)}
+    force = grid.GetCellData().GetArray("normal_force_N")
+    radius = grains.GetPointData().GetArray("radius_m")
+    if types - {vtk.VTK_LINE} or force is None or lines == 0:
+        failures.append(f"{path}: {lines} cells of types {types}")
+        continue
+    expected = counted.get(round(time, 6))
+    compared += expected is not None
+    if expected is not None and expected != lines:
+        failures.append(f"{path}: {lines} lines, series.csv counts {expected} contacts at t = {time}")
+    for k in range(lines):
+        i, j = (grid.GetCell(k).GetPointId(n) for n in (0, 1))
+        xi, xj = grains.GetPoint(i), grains.GetPoint(j)
+        ri, rj = radius.GetValue(i), radius.GetValue(j)
+        delta = ri + rj - sum((a - b) ** 2 for a, b in zip(xi, xj)) ** 0.5
+        hertz = 4.0 / 3.0 * E_STAR * (ri * rj / (ri + rj)) ** 0.5 * max(delta, 0.0) ** 1.5
+        worst = max(worst, abs(force.GetValue(k) - hertz) / hertz if hertz > 0 else 1.0)
+if compared == 0:
+    failures.append(f"no contacts snapshot at a time of series.csv (times {times})")
+if worst > 1e-9:
+    failures.append(f"a contact's normal_force_N differs from Hertz by {worst:.3g} (relative)")
+print(f"{len(networks)} contact networks ({compared} at a series.csv time, as many lines as it counts "
+      f"contacts), forces Hertz's within {worst:.2g}")
 if failures:
     sys.exit("FAILED:\n" + "\n".join(failures))

@@ -114,6 +114,8 @@ public:
     double stableTimeStepEstimate() const;
     Energies energies() const;
     std::size_t contactCount() const;     ///< particle-particle contacts
+    /// The grain-grain contact network now: each touching pair and its elastic normal force.
+    std::vector<PairForce> contactNetwork() const { return pairs_.touchingPairs(particles_); }
     std::size_t wallContactCount() const; ///< particle-plane and particle-mesh contacts
     std::size_t neighbourPairs() const { return pairs_.list().pairCount(); }
     std::uint64_t neighbourBuilds() const { return pairs_.list().buildCount(); }

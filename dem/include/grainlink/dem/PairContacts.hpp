@@ -15,6 +15,12 @@
 
 namespace grainlink::dem {
 
+/// One grain-grain contact of the contact network.
+struct PairForce {
+    std::size_t i = 0, j = 0;
+    double normal_force_N = 0.0;
+};
+
 class PairContacts {
 public:
     /// Material-pair properties under `law` and per-thread buffers; `law` decides whether the
@@ -83,6 +89,9 @@ public:
     std::size_t contactCount(const ParticleStore &p) const;
     /// Adds the stored elastic energy of the contacts to `energy_J`.
     void addElasticEnergy(const ParticleStore &p, const ContactLaw &law, double &energy_J) const;
+    /// Every touching pair (i < j by storage index) with its Hertz elastic normal force
+    /// 4/3 E* sqrt(R*) delta^(3/2): the force chains of a snapshot.
+    std::vector<PairForce> touchingPairs(const ParticleStore &p) const;
 
 private:
     /// Reaction on a particle owned by a later thread, added after the pair loop.

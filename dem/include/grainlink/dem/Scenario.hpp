@@ -30,6 +30,7 @@ struct OutputSpec {
     double series_interval_s = 0.01;
     double snapshot_interval_s = 0.0;   ///< 0: no snapshots
     double checkpoint_interval_s = 0.0; ///< 0: no periodic checkpoints
+    bool contact_network = false;       ///< force chains beside every particle snapshot
 };
 
 /// The slots a contact type sets for itself in `contact_wall` or `contact_tool`; the others are

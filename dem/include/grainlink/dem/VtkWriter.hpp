@@ -11,8 +11,10 @@ namespace grainlink::dem {
 
 class VtkWriter {
 public:
-    /// Snapshots go to `directory`/particles_NNNNNN.vtu (and body_<name>_NNNNNN.vtu).
-    explicit VtkWriter(std::string directory);
+    /// Snapshots go to `directory`/particles_NNNNNN.vtu (and body_<name>_NNNNNN.vtu; with
+    /// `contact_network`, the force chains as contacts_NNNNNN.vtu: a line between the centres
+    /// of each touching pair, its cell data the elastic normal force `normal_force_N`).
+    explicit VtkWriter(std::string directory, bool contact_network = false);
     /// Writes one snapshot; the .pvd collections are rewritten so they are valid after each call.
     void write(const DemSystem &system, double time_s);
     /// Writes particles only, to an explicit path (failure snapshots).
@@ -25,6 +27,7 @@ public:
 private:
     void writeCollection(const std::string &name, const std::string &prefix) const;
     std::string directory_;
+    bool contact_network_ = false;
     std::vector<double> times_;
     std::vector<std::string> body_names_;
 };
