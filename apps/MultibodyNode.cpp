@@ -176,7 +176,8 @@ public:
             out.work.push_back({bodies_[b].name, work[b]});
         }
         out.suggested_macro_step_s = model_.suggestedMacroStep_s();
-        progress_.update(in.end_s, in.end_s / end_s_, 0, report_.progress_note());
+        if (progress_.due()) // the note reads the rig's observables: only when printed
+            progress_.update(in.end_s, in.end_s / end_s_, 0, report_.progress_note());
         return out;
     }
 

@@ -9,6 +9,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -62,8 +63,10 @@ int main(int argc, char **argv) {
         command->add_option("--endpoint", coupled.endpoint, "overrides coupling.endpoint");
         command->add_flag("--insecure", coupled.insecure,
                           "allow a non-loopback endpoint without CURVE keys");
-        command->add_option("--progress-interval", coupled.progress_interval_s,
-                            "seconds between progress lines (0: none)");
+        command
+            ->add_option("--progress-interval", coupled.progress_interval_s,
+                         "seconds between progress lines (0: none)")
+            ->check(CLI::NonNegativeNumber);
     }
     auto *keygen = app.add_subcommand("keygen", "make CURVE keys for a run across machines");
     std::string key_directory;
@@ -145,9 +148,11 @@ int main(int argc, char **argv) {
     // Every node prints progress lines; `grainlink run --progress-interval` reaches the nodes it
     // starts through GRAINLINK_PROGRESS_INTERVAL, which a node's own flag overrides.
     for (auto *command : {mbs_node, dem_node, floor_node})
-        command->add_option("--progress-interval", node.progress_interval_s,
-                            "seconds between progress lines (default: the run's "
-                            "--progress-interval, else 10; 0: none)");
+        command
+            ->add_option("--progress-interval", node.progress_interval_s,
+                         "seconds between progress lines (default: the run's "
+                         "--progress-interval, else 10; 0: none)")
+            ->check(CLI::NonNegativeNumber);
     for (auto *command : {dem_node, floor_node})
         command->add_option("--bodies", node.bodies, "the coupled bodies it loads (comma separated)")
             ->delimiter(',')
@@ -171,13 +176,25 @@ int main(int argc, char **argv) {
     CLI11_PARSE(app, argc, argv);
     if (threads > 0)
         ::setenv("GRAINLINK_THREADS", std::to_string(threads).c_str(), 1);
-    if (run->count("--progress-interval") > 0)
-        ::setenv("GRAINLINK_PROGRESS_INTERVAL", std::to_string(coupled.progress_interval_s).c_str(),
-                 1);
+    if (run->count("--progress-interval") > 0) {
+        char value[32];
+        std::snprintf(value, sizeof value, "%.17g", coupled.progress_interval_s);
+        ::setenv("GRAINLINK_PROGRESS_INTERVAL", value, 1);
+    }
     for (auto *command : {mbs_node, dem_node, floor_node})
         if (command->parsed() && command->count("--progress-interval") == 0)
-            if (const char *inherited = std::getenv("GRAINLINK_PROGRESS_INTERVAL"))
-                node.progress_interval_s = std::strtod(inherited, nullptr);
+            if (const char *inherited = std::getenv("GRAINLINK_PROGRESS_INTERVAL")) {
+                char *end = nullptr;
+                node.progress_interval_s = std::strtod(inherited, &end);
+                if (end == inherited || *end != '\0' || !std::isfinite(node.progress_interval_s) ||
+                    node.progress_interval_s < 0.0) {
+                    std::fprintf(stderr,
+                                 "%s: error: GRAINLINK_PROGRESS_INTERVAL = '%s' is not a number of "
+                                 "seconds >= 0\n",
+                                 node.name.c_str(), inherited);
+                    return 1;
+                }
+            }
     try {
         if (dem->parsed()) {
             const auto scenario = grainlink::dem::loadScenario(scenario_path);

@@ -5,6 +5,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -17,14 +19,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
+/// Written aside, synced to the disk, and renamed over `path`: whole or absent after a crash.
 void writeAtomically(const fs::path &path, const std::string &bytes) {
     const std::string temporary = path.string() + ".tmp";
-    {
-        std::ofstream out(temporary, std::ios::binary | std::ios::trunc);
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-        if (!out.flush())
-            throw CouplingError("cannot write " + temporary);
-    }
+    std::FILE *out = std::fopen(temporary.c_str(), "wb");
+    const bool written = out && std::fwrite(bytes.data(), 1, bytes.size(), out) == bytes.size() &&
+                         std::fflush(out) == 0 && ::fsync(::fileno(out)) == 0;
+    if (out)
+        std::fclose(out);
+    if (!written)
+        throw CouplingError("cannot write " + temporary);
     fs::rename(temporary, path);
 }
 
@@ -50,27 +54,47 @@ bool checksumOf(const fs::path &path, std::uint64_t &sum, std::uintmax_t &size) 
     return !in.bad();
 }
 
-/// Every participant's file in a checkpoint, with its checksum and size (manifest.txt), so that
-/// a damaged one is found before any participant believes it.
-void writeManifest(const fs::path &directory) {
+/// The manifest's last line: how many files it lists and the checksum of the lines above, so
+/// that a manifest cut short (or emptied) is itself found damaged.
+std::string manifestEnd(const std::string &lines, std::size_t files) {
+    config::Checksum c;
+    c.add(lines.data(), lines.size());
+    char end[64];
+    std::snprintf(end, sizeof end, "end %zu %016llx\n", files,
+                  static_cast<unsigned long long>(c.value));
+    return end;
+}
+
+std::string manifestLine(std::uint64_t sum, std::uintmax_t size, const std::string &name) {
+    char line[48];
+    std::snprintf(line, sizeof line, "%016llx %llu ", static_cast<unsigned long long>(sum),
+                  static_cast<unsigned long long>(size));
+    return line + name + '\n';
+}
+
+/// Every participant's file in a checkpoint and the coordinator.pb about to be written, each
+/// with its checksum and size (manifest.txt), so that a damaged one is found before any
+/// participant believes it. Written before coordinator.pb: a crash between the two leaves a
+/// checkpoint without its coordinator.pb, which is refused.
+void writeManifest(const fs::path &directory, const std::string &coordinator_pb) {
     std::vector<fs::path> files;
     for (const auto &entry : fs::recursive_directory_iterator(directory))
         if (entry.is_regular_file() && entry.path().filename() != kManifest &&
             entry.path().filename() != "coordinator.pb")
             files.push_back(entry.path());
     std::sort(files.begin(), files.end());
-    std::ostringstream text;
+    std::string text;
     for (const fs::path &file : files) {
         std::uint64_t sum = 0;
         std::uintmax_t size = 0;
         if (!checksumOf(file, sum, size))
             throw CouplingError("cannot read " + file.string() + " to checksum it");
-        char line[48];
-        std::snprintf(line, sizeof line, "%016llx %llu ", static_cast<unsigned long long>(sum),
-                      static_cast<unsigned long long>(size));
-        text << line << fs::relative(file, directory).string() << '\n';
+        text += manifestLine(sum, size, fs::relative(file, directory).string());
     }
-    writeAtomically(directory / kManifest, text.str());
+    config::Checksum c;
+    c.add(coordinator_pb.data(), coordinator_pb.size());
+    text += manifestLine(c.value, coordinator_pb.size(), "coordinator.pb");
+    writeAtomically(directory / kManifest, text + manifestEnd(text, files.size() + 1));
 }
 
 /// What is wrong with a checkpoint folder; empty when it is whole. One written before the
@@ -82,8 +106,16 @@ std::string damage(const fs::path &folder, codec::pb::CoordinatorCheckpoint &sta
     std::ifstream manifest(folder / kManifest);
     if (!manifest)
         return fs::exists(folder / kManifest) ? "manifest.txt is unreadable" : "";
-    std::string line;
-    while (std::getline(manifest, line)) {
+    std::vector<std::string> lines;
+    for (std::string line; std::getline(manifest, line);)
+        lines.push_back(line);
+    std::string listed;
+    for (std::size_t k = 0; k + 1 < lines.size(); ++k)
+        listed += lines[k] + '\n';
+    if (lines.empty() || lines.back() + '\n' != manifestEnd(listed, lines.size() - 1))
+        return "manifest.txt is cut short or changed (its end line does not match)";
+    lines.pop_back();
+    for (const std::string &line : lines) {
         std::istringstream cells(line);
         std::string hex, name;
         std::uintmax_t size = 0;
@@ -120,8 +152,9 @@ void commitCheckpoint(const std::string &output_directory, const std::string &di
     codec::toWire(snapshot.states, snapshot.tick, state.mutable_states());
     codec::toWire(snapshot.wrenches, snapshot.tick, snapshot.tick, state.mutable_wrenches());
     state.set_cumulative_mismatch_j(snapshot.cumulative_mismatch_J);
-    writeManifest(directory);
-    writeAtomically(fs::path(directory) / "coordinator.pb", state.SerializeAsString());
+    const std::string bytes = state.SerializeAsString();
+    writeManifest(directory, bytes);
+    writeAtomically(fs::path(directory) / "coordinator.pb", bytes);
     writeAtomically(latestFile(output_directory), fs::path(directory).filename().string() + "\n");
 }
 

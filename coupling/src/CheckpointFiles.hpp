@@ -23,10 +23,11 @@ struct CoordinatorSnapshot {
 /// started from another folder writes to the same place.
 std::string checkpointDirectory(const std::string &output_directory, std::uint64_t window);
 
-/// Writes manifest.txt (every participant's file in `directory` with its FNV-1a checksum and
-/// size) and coordinator.pb into `directory` (the participants' parts are there already), then
-/// moves <output_directory>/checkpoints/latest to it, each by an atomic rename: a checkpoint is
-/// complete or it does not exist.
+/// Writes manifest.txt (every file in `directory` and the coordinator.pb to come, with its
+/// FNV-1a checksum and size, and an end line with their count and the checksum of the list),
+/// then coordinator.pb, into `directory` (the participants' parts are there already), then
+/// moves <output_directory>/checkpoints/latest to it, each synced and renamed into place: a
+/// checkpoint is complete or it does not exist.
 void commitCheckpoint(const std::string &output_directory, const std::string &directory,
                       const CoordinatorSnapshot &snapshot);
 

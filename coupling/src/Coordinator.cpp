@@ -533,6 +533,9 @@ struct Coordinator::Impl {
 
     void writeCheckpoint() {
         const std::string directory = checkpointDirectory(config.output_directory, run.window);
+        // A run resumed from an earlier checkpoint writes this window's again: nothing of the
+        // folder it left (a damaged file, a stale manifest) may mix with the new one.
+        fs::remove_all(directory);
         fs::create_directories(directory);
         PeerSet all(peers.size());
         for (std::size_t p = 0; p < peers.size(); ++p) {

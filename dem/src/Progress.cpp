@@ -17,11 +17,17 @@ double Progress::rate(std::uint64_t particle_steps) const {
     return wall > 0.0 ? double(particle_steps) / wall : 0.0;
 }
 
+bool Progress::due() const {
+    return interval_s_ > 0.0 &&
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - last_).count() >=
+               interval_s_;
+}
+
 void Progress::update(double sim_time_s, double fraction, std::uint64_t particle_steps,
                       const std::string &extra) {
-    const auto now = std::chrono::steady_clock::now();
-    if (interval_s_ <= 0.0 || std::chrono::duration<double>(now - last_).count() < interval_s_)
+    if (!due())
         return;
+    const auto now = std::chrono::steady_clock::now();
     last_ = now;
     const double wall = wallSeconds();
     const double eta = fraction > 1e-9 ? wall * (1.0 - fraction) / fraction : NAN;

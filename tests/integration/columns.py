@@ -10,13 +10,12 @@ Usage: columns.py GRAINLINK TINY_YAML WHEEL_FLOOR_YAML WORK"""
 import csv
 import os
 import re
-import shutil
 import subprocess
 import sys
 
-grainlink, tiny, wheel_floor, work = map(os.path.abspath, sys.argv[1:5])
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
+from coupled_runs import arguments
+
+grainlink, tiny, wheel_floor, work = arguments(4)
 failures = []
 
 UNITLESS = {"phase", "slip", "step", "window", "body", "contacts", "wall_contacts", "iterations",

@@ -5,18 +5,18 @@ problem, 50 windows, a checkpoint every 10):
 1. a finished run's latest checkpoint (window 40) has one byte of a participant's state changed:
    `--resume` names the checkpoint and the file, resumes from window 30, and ends with
    coupling.csv (without its wall-time column) row for row the uninterrupted run's;
-2. with window 40's soil state deleted and every earlier checkpoint's coordinator.pb cut short,
-   `--resume` fails with one error naming each checkpoint and what is wrong with it, and the
-   run's coupling.csv is left as it was.
+2. with window 40's soil state deleted, window 30's manifest cut before its end line and the
+   earlier checkpoints' coordinator.pb cut short, `--resume` fails with one error naming each
+   checkpoint and what is wrong with it, and the run's coupling.csv is left as it was.
 Usage: resume_fallback.py GRAINLINK CONFIG WORK"""
 import os
-import shutil
 import subprocess
 import sys
 
-grainlink, config, work = map(os.path.abspath, sys.argv[1:4])
-shutil.rmtree(work, ignore_errors=True)
-os.makedirs(work)
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from coupled_runs import arguments  # noqa: E402
+
+grainlink, config, work = arguments(3)
 failures = []
 
 
@@ -58,7 +58,12 @@ if rows("damaged") != rows("straight"):
     failures.append("coupling.csv after resuming from window 30 differs from the uninterrupted run's")
 
 os.remove(state)
-for window in (10, 20, 30):
+manifest = os.path.join(checkpoint("damaged", 30), "manifest.txt")
+with open(manifest) as f:
+    lines = f.readlines()
+with open(manifest, "w") as f:
+    f.writelines(lines[:-1])
+for window in (10, 20):
     with open(os.path.join(checkpoint("damaged", window), "coordinator.pb"), "r+b") as f:
         f.truncate(5)
 before = rows("damaged")
@@ -68,6 +73,7 @@ print(last)
 if code == 0:
     failures.append("a resume with every checkpoint damaged succeeded")
 for expected in ("every checkpoint in", "window_000000040: soil/soil.state is missing",
+                 "window_000000030: manifest.txt is cut short",
                  "window_000000010: coordinator.pb is missing or unreadable"):
     if expected not in last:
         failures.append(f"the error does not say '{expected}': {last}")

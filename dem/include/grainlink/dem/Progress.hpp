@@ -16,6 +16,8 @@ public:
     /// process without grains, the line has no rate).
     void update(double sim_time_s, double fraction, std::uint64_t particle_steps,
                 const std::string &extra = "");
+    /// Whether the next update() prints: a caller whose line costs something asks first.
+    bool due() const;
     double wallSeconds() const;
     double rate(std::uint64_t particle_steps) const; ///< particle-steps per wall second
 
