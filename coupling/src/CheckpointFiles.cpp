@@ -37,6 +37,7 @@ fs::path latestFile(const std::string &output_directory) {
 }
 
 constexpr const char *kManifest = "manifest.txt";
+constexpr std::size_t kCheckpointsKept = 3; ///< the latest and the two before it
 
 /// A file's checksum and size; false when it cannot be read.
 bool checksumOf(const fs::path &path, std::uint64_t &sum, std::uintmax_t &size) {
@@ -155,7 +156,18 @@ void commitCheckpoint(const std::string &output_directory, const std::string &di
     const std::string bytes = state.SerializeAsString();
     writeManifest(directory, bytes);
     writeAtomically(fs::path(directory) / "coordinator.pb", bytes);
-    writeAtomically(latestFile(output_directory), fs::path(directory).filename().string() + "\n");
+    const std::string name = fs::path(directory).filename().string();
+    writeAtomically(latestFile(output_directory), name + "\n");
+    // Two earlier checkpoints stay for a resume to fall back on; older ones go, so that a long
+    // run does not fill the disk (the demo's are 27 MB each).
+    std::vector<std::string> earlier;
+    for (const auto &entry : fs::directory_iterator(fs::path(directory).parent_path()))
+        if (entry.is_directory() && entry.path().filename().string().rfind("window_", 0) == 0 &&
+            entry.path().filename().string() < name)
+            earlier.push_back(entry.path().filename().string());
+    std::sort(earlier.begin(), earlier.end());
+    for (std::size_t k = 0; k + kCheckpointsKept - 1 < earlier.size(); ++k)
+        fs::remove_all(fs::path(directory).parent_path() / earlier[k]);
 }
 
 CoordinatorSnapshot readLatestCheckpoint(const std::string &output_directory,

@@ -27,7 +27,8 @@ std::string checkpointDirectory(const std::string &output_directory, std::uint64
 /// FNV-1a checksum and size, and an end line with their count and the checksum of the list),
 /// then coordinator.pb, into `directory` (the participants' parts are there already), then
 /// moves <output_directory>/checkpoints/latest to it, each synced and renamed into place: a
-/// checkpoint is complete or it does not exist.
+/// checkpoint is complete or it does not exist. The two checkpoints before it stay, older ones
+/// are removed.
 void commitCheckpoint(const std::string &output_directory, const std::string &directory,
                       const CoordinatorSnapshot &snapshot);
 

@@ -2,11 +2,12 @@
 """A coupled run resumes past a damaged checkpoint (resume_good.yaml: the implicit two-mass
 problem, 50 windows, a checkpoint every 10):
 
+0. a run keeps its last three checkpoints (windows 20, 30, 40), the older ones removed;
 1. a finished run's latest checkpoint (window 40) has one byte of a participant's state changed:
    `--resume` names the checkpoint and the file, resumes from window 30, and ends with
    coupling.csv (without its wall-time column) row for row the uninterrupted run's;
-2. with window 40's soil state deleted, window 30's manifest cut before its end line and the
-   earlier checkpoints' coordinator.pb cut short, `--resume` fails with one error naming each
+2. with window 40's soil state deleted, window 30's manifest cut before its end line and window
+   20's coordinator.pb cut short, `--resume` fails with one error naming each
    checkpoint and what is wrong with it, and the run's coupling.csv is left as it was.
 Usage: resume_fallback.py GRAINLINK CONFIG WORK"""
 import os
@@ -42,6 +43,11 @@ for out in ("straight", "damaged"):
     if code != 0:
         sys.exit(f"{out}: the run failed:\n{output[-2000:]}")
 
+kept = sorted(os.listdir(os.path.join(work, "damaged", "checkpoints")))
+print("checkpoints kept:", kept)
+if kept != ["latest", "window_000000020", "window_000000030", "window_000000040"]:
+    failures.append(f"the run kept the checkpoints {kept}, not the last three")
+
 state = os.path.join(checkpoint("damaged", 40), "soil", "soil.state")
 with open(state, "r+b") as f:
     f.seek(3)
@@ -63,7 +69,7 @@ with open(manifest) as f:
     lines = f.readlines()
 with open(manifest, "w") as f:
     f.writelines(lines[:-1])
-for window in (10, 20):
+for window in (20,):
     with open(os.path.join(checkpoint("damaged", window), "coordinator.pb"), "r+b") as f:
         f.truncate(5)
 before = rows("damaged")
@@ -74,7 +80,7 @@ if code == 0:
     failures.append("a resume with every checkpoint damaged succeeded")
 for expected in ("every checkpoint in", "window_000000040: soil/soil.state is missing",
                  "window_000000030: manifest.txt is cut short",
-                 "window_000000010: coordinator.pb is missing or unreadable"):
+                 "window_000000020: coordinator.pb is missing or unreadable"):
     if expected not in last:
         failures.append(f"the error does not say '{expected}': {last}")
 if rows("damaged") != before:
