@@ -13,7 +13,7 @@ import re
 import subprocess
 import sys
 
-from coupled_runs import arguments
+from coupled_runs import arguments, run_variant
 
 grainlink, tiny, wheel_floor, work = arguments(4)
 failures = []
@@ -60,7 +60,12 @@ series = check(os.path.join(work, "dem", "series.csv"), {"plate"})
 if "plate.Fz_N" not in series:
     failures.append("series.csv has no plate.Fz_N")
 
-run("run", wheel_floor, "--out", "wheel", "--progress-interval", "0")
+# The headers are all that is checked: 0.05 s of the run (cheap under ASan).
+text = open(wheel_floor).read()
+assert "end_time_s: 1.5" in text
+done, output = run_variant(grainlink, work, "wheel", text.replace("end_time_s: 1.5", "end_time_s: 0.05"))
+if done.returncode != 0:
+    failures.append(f"the wheel run failed:\n{output[-2000:]}")
 rig = check(os.path.join(work, "wheel", "rig.csv"), {"wheel"})
 check(os.path.join(work, "wheel", "floor.csv"), {"wheel"})
 coupling = check(os.path.join(work, "wheel", "coupling.csv"), {"wheel"})
