@@ -93,34 +93,34 @@ std::size_t PairContacts::contactCount(const ParticleStore &p) const {
     return count;
 }
 
-void PairContacts::addElasticEnergy(const ParticleStore &p, const ContactLaw &law,
-                                    double &energy_J) const {
+template <class Visit>
+void PairContacts::forEachTouching(const ParticleStore &p, Visit &&visit) const {
     for (std::size_t i = 0; i + 1 < list_.first.size(); ++i)
         for (std::size_t k = list_.first[i]; k < list_.first[i + 1]; ++k) {
             const std::size_t j = std::size_t(list_.neighbour[k]);
             const double r_sum = p.radius[i] + p.radius[j];
             const double overlap = r_sum - (p.position[i] - p.position[j]).norm();
-            if (overlap <= 0.0)
-                continue;
-            const double r_eff = p.radius[i] * p.radius[j] / r_sum;
+            if (overlap > 0.0)
+                visit(i, j, k, p.radius[i] * p.radius[j] / r_sum, overlap);
+        }
+}
+
+void PairContacts::addElasticEnergy(const ParticleStore &p, const ContactLaw &law,
+                                    double &energy_J) const {
+    forEachTouching(
+        p, [&](std::size_t i, std::size_t j, std::size_t k, double r_eff, double overlap) {
             energy_J += contactElasticEnergy(law, properties(p.material[i], p.material[j]), r_eff,
                                              overlap, list_.history(k));
-        }
+        });
 }
 
 std::vector<PairForce> PairContacts::touchingPairs(const ParticleStore &p) const {
     std::vector<PairForce> out;
-    for (std::size_t i = 0; i + 1 < list_.first.size(); ++i)
-        for (std::size_t k = list_.first[i]; k < list_.first[i + 1]; ++k) {
-            const std::size_t j = std::size_t(list_.neighbour[k]);
-            const double r_sum = p.radius[i] + p.radius[j];
-            const double overlap = r_sum - (p.position[i] - p.position[j]).norm();
-            if (overlap <= 0.0)
-                continue;
-            const double r_eff = p.radius[i] * p.radius[j] / r_sum;
+    forEachTouching(
+        p, [&](std::size_t i, std::size_t j, std::size_t, double r_eff, double overlap) {
             const double e_star = properties(p.material[i], p.material[j]).effective_modulus_Pa;
             out.push_back({i, j, 4.0 / 3.0 * e_star * std::sqrt(r_eff) * std::pow(overlap, 1.5)});
-        }
+        });
     return out;
 }
 

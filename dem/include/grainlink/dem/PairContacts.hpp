@@ -94,6 +94,8 @@ public:
     std::vector<PairForce> touchingPairs(const ParticleStore &p) const;
 
 private:
+    /// visit(i, j, entry, R*, overlap) for every listed pair that overlaps now.
+    template <class Visit> void forEachTouching(const ParticleStore &p, Visit &&visit) const;
     /// Reaction on a particle owned by a later thread, added after the pair loop.
     struct SideContribution {
         std::size_t particle;
