@@ -5,7 +5,6 @@
 #include "SoilSide.hpp"
 #include "grainlink/coupling/ParticipantNode.hpp"
 #include "grainlink/coupling/WindowLoads.hpp"
-#include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/RigidFloor.hpp"
 
 #include <cmath>
@@ -19,11 +18,10 @@ namespace {
 class FloorNode final : public coupling::ParticipantNode {
 public:
     FloorNode(const NodeOptions &options, const config::ConfigNode &root)
-        : options_(options), floor_(dem::parseRigidFloor(root["floor"])),
-          progress_(options.name, options.progress_interval_s) {}
+        : options_(options), floor_(dem::parseRigidFloor(root["floor"])), progress_(options) {}
 
     void start(const coupling::RunInfo &run) override {
-        end_s_ = double(run.end_tick) * run.tick_s;
+        progress_.start(run);
         for (const auto &name : options_.bodies)
             floors_.emplace_back(floor_, meshOf(describedBody(run, name)));
         std::filesystem::create_directories(options_.output_directory);
@@ -56,7 +54,7 @@ public:
                     << ',' << w.torque_N_m.z() << ',' << floors_[b].touching() << ','
                     << floors_[b].penetration_m() << '\n';
         }
-        progress_.update(in.end_s, in.end_s / end_s_, 0);
+        progress_.update(in.end_s);
         return out;
     }
 
@@ -67,8 +65,7 @@ private:
     dem::RigidFloorSettings floor_;
     std::vector<dem::RigidFloor> floors_;
     std::ofstream series_;
-    double end_s_ = 0.0; ///< [s] the run's end, for the progress line
-    dem::Progress progress_;
+    NodeProgress progress_;
 };
 
 } // namespace

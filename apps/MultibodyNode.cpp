@@ -7,7 +7,6 @@
 #include "SoilSide.hpp"
 #include "grainlink/coupling/ParticipantNode.hpp"
 #include "grainlink/dem/BedPreparation.hpp"
-#include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/RigidFloor.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
@@ -148,12 +147,11 @@ class MultibodyNode final : public coupling::ParticipantNode {
 public:
     MultibodyNode(mbs::MultibodyModel &model, Report report, const NodeOptions &options)
         : model_(model), report_(std::move(report)), options_(options),
-          bodies_(model.coupledBodies()), soil_(bodies_.size()),
-          progress_(options.name, options.progress_interval_s) {}
+          bodies_(model.coupledBodies()), soil_(bodies_.size()), progress_(options) {}
 
     void start(const coupling::RunInfo &run) override {
         implicit_ = run.scheme == coupling::SchemeKind::Implicit;
-        end_s_ = double(run.end_tick) * run.tick_s;
+        progress_.start(run);
         std::filesystem::create_directories(options_.output_directory);
         series_.emplace(
             options_.output_directory + "/" + report_.series_file, report_.header,
@@ -177,7 +175,7 @@ public:
         }
         out.suggested_macro_step_s = model_.suggestedMacroStep_s();
         if (progress_.due()) // the note reads the rig's observables: only when printed
-            progress_.update(in.end_s, in.end_s / end_s_, 0, report_.progress_note());
+            progress_.update(in.end_s, 0, report_.progress_note());
         return out;
     }
 
@@ -219,8 +217,7 @@ private:
     std::optional<dem::Series> series_;
     int exit_status_ = 0;
     bool implicit_ = false; ///< implicit coupling: windows may be repeated
-    double end_s_ = 0.0;    ///< [s] the run's end, for the progress line
-    dem::Progress progress_;
+    NodeProgress progress_;
 };
 
 int runWindows(const config::ConfigNode &root, mbs::MultibodyModel &model, Report report,

@@ -4,6 +4,7 @@
 // participant commands.
 #include "grainlink/config/ConfigNode.hpp"
 #include "grainlink/coupling/Participant.hpp"
+#include "grainlink/dem/Progress.hpp"
 #include "grainlink/mbs/MultibodyModel.hpp"
 
 #include <memory>
@@ -21,6 +22,23 @@ struct NodeOptions {
     std::string section = "soil";    ///< soil node: the scenario section of its bed
     std::string keys_directory;      ///< CURVE keys (<name>.key, coordinator.pub)
     double progress_interval_s = 10.0; ///< [s] wall time between progress lines; 0: none
+};
+
+/// A node's progress line over the coupled run, whose end the handshake gives (start()).
+class NodeProgress {
+public:
+    explicit NodeProgress(const NodeOptions &options)
+        : progress_(options.name, options.progress_interval_s) {}
+    void start(const coupling::RunInfo &run) { end_s_ = double(run.end_tick) * run.tick_s; }
+    /// Whether update() prints now: a node whose note costs something asks first.
+    bool due() const { return progress_.due(); }
+    void update(double time_s, std::uint64_t particle_steps = 0, const std::string &note = "") {
+        progress_.update(time_s, end_s_ > 0.0 ? time_s / end_s_ : 0.0, particle_steps, note);
+    }
+
+private:
+    dem::Progress progress_;
+    double end_s_ = 0.0; ///< [s] the run's end
 };
 
 /// How long a node waits for the coordinator's Welcome: the scenario's

@@ -5,7 +5,6 @@
 #include "grainlink/coupling/ParticipantNode.hpp"
 #include "grainlink/coupling/WindowLoads.hpp"
 #include "grainlink/dem/Checkpoint.hpp"
-#include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/dem/Series.hpp"
 #include "grainlink/dem/VtkWriter.hpp"
@@ -30,8 +29,7 @@ public:
           snapshot_directory_(options.output_directory + (options.section == "soil"
                                                               ? "/snapshots"
                                                               : "/snapshots_" + options.section)),
-          vtk_(snapshot_directory_, scenario_.output.contact_network),
-          progress_(options.name, options.progress_interval_s) {
+          vtk_(snapshot_directory_, scenario_.output.contact_network), progress_(options) {
         sys_ = dem::prepareSoil(scenario_, options.progress_interval_s);
         surface_ = dem::bedSurface(sys_->particles());
         std::fprintf(stderr, "[%s] %zu particles, bed surface at z = %.4f m\n",
@@ -55,7 +53,7 @@ public:
         }
         dem_offset_s_ = sys_->time() - run.start_tick * run.tick_s; // DEM time - coupling time
         resumed_ = run.restore.has_value();
-        end_s_ = run.end_tick * run.tick_s;
+        progress_.start(run);
         std::filesystem::create_directories(options_.output_directory);
         series_.emplace(
             options_.output_directory + "/" + options_.section + ".csv",
@@ -140,8 +138,8 @@ public:
             std::filesystem::create_directories(snapshot_directory_);
             vtk_.write(*sys_, in.end_s);
         }
-        progress_.update(in.end_s, in.end_s / end_s_,
-                         (sys_->stepCount() - first_step_) * sys_->particles().size(), "");
+        progress_.update(in.end_s, (sys_->stepCount() - first_step_) * sys_->particles().size(),
+                         "");
         return out;
     }
 
@@ -251,10 +249,9 @@ private:
     } closest_; ///< the closest approach of any body to a wall so far
     double dem_offset_s_ = 0.0; ///< [s] DEM time - coupling time
     bool resumed_ = false;
-    double end_s_ = 0.0; ///< [s] the run's end, for the progress line
     dem::VtkWriter vtk_;
     std::optional<dem::Series> series_;
-    dem::Progress progress_;
+    NodeProgress progress_;
     std::uint64_t first_step_ = 0;
     bool implicit_ = false; ///< implicit coupling: windows may be repeated
     struct Saved {
