@@ -6,10 +6,13 @@ Simbody rig and the rigid floor):
    simulated time rising to the run's end and an ETA; the rig's line names its phase and slip;
 2. a node's own --progress-interval in the scenario's command overrides the run's (the floor's
    0: no line from it, the rig's go on);
-3. --progress-interval 0 silences the coordinator and every node.
+3. --progress-interval 0 silences the coordinator and every node;
+4. an inherited GRAINLINK_PROGRESS_INTERVAL that is not seconds >= 0 stops a node at once,
+   naming the variable and the value.
 Usage: progress.py GRAINLINK FLOOR_YAML WORK"""
 import os
 import re
+import subprocess
 import sys
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
@@ -62,6 +65,16 @@ print(f"--progress-interval 0: {sum(map(len, lines.values()))} node lines, "
       f"{len(coordinator)} coordinator lines")
 if lines or coordinator:
     failures.append(f"--progress-interval 0 still printed progress:\n{output[-2000:]}")
+
+for bad in ("abc", "-1", "nan"):
+    done = subprocess.run([grainlink, "floor-node", floor, "--name", "floor", "--endpoint",
+                           "tcp://127.0.0.1:1", "--out", work, "--bodies", "wheel"],
+                          env={**os.environ, "GRAINLINK_PROGRESS_INTERVAL": bad},
+                          capture_output=True, text=True, timeout=30)
+    expected = f"floor: error: GRAINLINK_PROGRESS_INTERVAL = '{bad}' is not a number of seconds >= 0"
+    if done.returncode == 0 or expected not in done.stderr:
+        failures.append(f"GRAINLINK_PROGRESS_INTERVAL={bad}: exit {done.returncode}, {done.stderr[-500:]}")
+print("a bad GRAINLINK_PROGRESS_INTERVAL stops the node naming it")
 
 if failures:
     sys.exit("FAILED:\n" + "\n\n".join(failures))
