@@ -489,8 +489,8 @@ struct Coordinator::Impl {
     /// with coupling.guard.shorten the coordinator shortens the nominal macro step itself,
     /// within coupling.adaptive's bounds.
     void watch(double work_multibody, double work_soil, Ticks step, CoordinatorSummary &summary) {
-        const auto warning =
-            guard.afterWindow(work_multibody, work_soil, scheme->wrenches(), step * config.tick_s);
+        const auto warning = guard.afterWindow(work_multibody, work_soil, scheme->wrenches(),
+                                               scheme->states(), step * config.tick_s);
         if (!warning)
             return;
         std::string message = warning->message;

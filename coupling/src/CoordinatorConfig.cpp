@@ -67,6 +67,10 @@ CoordinatorConfig coordinatorConfigFrom(const ConfigNode &root) {
             guard->number("oscillation_autocorrelation", g.oscillation_autocorrelation);
         if (!(g.oscillation_autocorrelation > -1.0 && g.oscillation_autocorrelation < 1.0))
             (*guard)["oscillation_autocorrelation"].fail("must lie in (-1, 1)");
+        if (guard->has("bounce_energy_share"))
+            g.bounce_energy_share = (*guard)["bounce_energy_share"].positive();
+        if (guard->has("bounce_spans"))
+            g.bounce_spans = count((*guard)["bounce_spans"], 1);
         if (guard->has("span_windows"))
             g.span_windows = count((*guard)["span_windows"], 3);
         g.shorten = guard->boolean("shorten", false);

@@ -36,13 +36,13 @@ TEST_CASE("coupling guard: energy mismatch past the threshold warns once", "[cou
     // Soil work 0.1 J per window; mismatch 1 % of it: never a warning.
     CouplingGuard quiet(settings);
     for (int k = 0; k < 100; ++k)
-        CHECK_FALSE(quiet.afterWindow(0.101, 0.1, force(1.0), 1e-3));
+        CHECK_FALSE(quiet.afterWindow(0.101, 0.1, force(1.0), {}, 1e-3));
     // Mismatch 10 %: a warning once the span is full, once; the advice scales the macro step
     // to the 5 % threshold with a 0.8 margin: 1 ms x 0.8 x 5/10 = 0.4 ms.
     CouplingGuard loud(settings);
     int warnings = 0;
     for (int k = 0; k < 100; ++k)
-        if (const auto w = loud.afterWindow(0.11, 0.1, force(1.0), 1e-3)) {
+        if (const auto w = loud.afterWindow(0.11, 0.1, force(1.0), {}, 1e-3)) {
             ++warnings;
             CHECK(k == 9);
             CHECK(w->kind == GuardWarning::Kind::Energy);
@@ -58,16 +58,16 @@ TEST_CASE("coupling guard: energy mismatch past the threshold warns once", "[cou
     // After a change of step the span starts over and may warn again.
     loud.restart();
     for (int k = 0; k < 10; ++k)
-        warnings += bool(loud.afterWindow(0.11, 0.1, force(1.0), 1e-3));
+        warnings += bool(loud.afterWindow(0.11, 0.1, force(1.0), {}, 1e-3));
     CHECK(warnings == 2);
     // A quiet span after a busy one is judged against the run's mean exchange per span: the
     // body at rest (soil work 1e-6 J per window, mismatch 1e-7 J) is not "10 %".
     CouplingGuard resting(settings);
     int resting_warnings = 0;
     for (int k = 0; k < 10; ++k)
-        resting_warnings += bool(resting.afterWindow(0.101, 0.1, force(1.0), 1e-3));
+        resting_warnings += bool(resting.afterWindow(0.101, 0.1, force(1.0), {}, 1e-3));
     for (int k = 0; k < 90; ++k)
-        resting_warnings += bool(resting.afterWindow(1.1e-6, 1e-6, force(1.0), 1e-3));
+        resting_warnings += bool(resting.afterWindow(1.1e-6, 1e-6, force(1.0), {}, 1e-3));
     CHECK(resting_warnings == 0);
 }
 
@@ -81,7 +81,8 @@ TEST_CASE("coupling guard: a force flipping every window warns", "[coupling][gua
     std::normal_distribution<double> normal;
     int flips = 0, others = 0;
     for (int k = 0; k < 400; ++k) {
-        if (const auto w = flipping.afterWindow(0.1, 0.1, force(5.0 + (k % 2 ? 2.0 : -2.0)), 1e-3)) {
+        if (const auto w =
+                flipping.afterWindow(0.1, 0.1, force(5.0 + (k % 2 ? 2.0 : -2.0)), {}, 1e-3)) {
             ++flips;
             CHECK(w->kind == GuardWarning::Kind::Oscillation);
             CHECK(w->measured == Approx(-199.0 / 200.0));
@@ -90,8 +91,9 @@ TEST_CASE("coupling guard: a force flipping every window warns", "[coupling][gua
                                    "window: lag-1 autocorrelation -0.99",
                                    0) == 0);
         }
-        others += bool(noisy.afterWindow(0.1, 0.1, force(5.0 + normal(random)), 1e-3));
-        others += bool(smooth.afterWindow(0.1, 0.1, force(5.0 + std::sin(2 * M_PI * k / 50)), 1e-3));
+        others += bool(noisy.afterWindow(0.1, 0.1, force(5.0 + normal(random)), {}, 1e-3));
+        others +=
+            bool(smooth.afterWindow(0.1, 0.1, force(5.0 + std::sin(2 * M_PI * k / 50)), {}, 1e-3));
     }
     CHECK(flips == 1);
     CHECK(others == 0);
@@ -99,5 +101,87 @@ TEST_CASE("coupling guard: a force flipping every window warns", "[coupling][gua
     settings.enabled = false;
     CouplingGuard off(settings);
     for (int k = 0; k < 400; ++k)
-        CHECK_FALSE(off.afterWindow(1.0, 0.1, force(k % 2 ? 1.0 : -1.0), 1e-3));
+        CHECK_FALSE(off.afterWindow(1.0, 0.1, force(k % 2 ? 1.0 : -1.0), {}, 1e-3));
+}
+
+namespace {
+
+// A wheel bouncing vertically at 8 Hz (125 windows of 1 ms a period): height A sin ωt, the soil's
+// vertical force F0 − k A sin ωt. Over whole periods the fluctuating force does
+// Σ |k A sin · A ω cos| H = k A² ω H Σ |sin cos| ≈ k A² ω H n / π on the fluctuating motion.
+struct Bounce {
+    double amplitude_m = 1e-3, stiffness_N_m = 8000.0, omega = 2 * M_PI * 8.0, step_s = 1e-3;
+    double decay_per_s = 0.0;
+    std::vector<Wrench> wrench(int k) const {
+        Wrench w;
+        w.body = "wheel";
+        w.force_N = Vec3(0.0, 0.0, 30.0 - stiffness_N_m * height(k));
+        return {w};
+    }
+    std::vector<BodyState> state(int k) const {
+        BodyState s;
+        s.body = "wheel";
+        const double t = k * step_s;
+        s.linear_velocity_m_s.z() =
+            amplitude_m * std::exp(-decay_per_s * t) *
+            (omega * std::cos(omega * t) - decay_per_s * std::sin(omega * t));
+        return {s};
+    }
+    double height(int k) const {
+        const double t = k * step_s;
+        return amplitude_m * std::exp(-decay_per_s * t) * std::sin(omega * t);
+    }
+    /// The work of the fluctuation over a span of n windows, by the closed form above.
+    double spanWork(int n) const {
+        return stiffness_N_m * amplitude_m * amplitude_m * omega * step_s * n / M_PI;
+    }
+};
+
+} // namespace
+
+TEST_CASE("coupling guard: a bounce the coupling feeds warns and one dying down does not",
+          "[coupling][guard]") {
+    GuardSettings settings; // span 500 windows, share 6 %, 3 spans
+    const Bounce bounce;
+    const double work = bounce.spanWork(500); // 0.064 J
+    // The coupling creates 8 % of it per span, spread evenly; the soil's work 0.1 J a window
+    // keeps the energy check (1e-4 of it) quiet.
+    const double feeding = 0.08 * work / 500;
+    CouplingGuard fed(settings);
+    int warnings = 0;
+    for (int k = 0; k < 3000; ++k)
+        if (const auto w =
+                fed.afterWindow(0.1 + feeding, 0.1, bounce.wrench(k), bounce.state(k), 1e-3)) {
+            ++warnings;
+            CHECK(k == 1499); // the third span in a row
+            CHECK(w->kind == GuardWarning::Kind::Bounce);
+            CHECK(w->measured == Approx(0.08).epsilon(0.01));
+            CHECK(w->suggested_step_s == Approx(0.8e-3 * 0.06 / 0.08).epsilon(0.01));
+            CHECK(w->message.rfind("the coupling feeds a bounce: for 3 spans of 500 windows it "
+                                   "created 8.0 %",
+                                   0) == 0);
+        }
+    CHECK(warnings == 1);
+
+    // Half of it (4 %): quiet. 8 % for two spans, then 4 %: quiet (it must persist).
+    CouplingGuard half(settings), brief(settings);
+    int others = 0;
+    for (int k = 0; k < 3000; ++k) {
+        others +=
+            bool(half.afterWindow(0.1 + feeding / 2, 0.1, bounce.wrench(k), bounce.state(k), 1e-3));
+        others += bool(brief.afterWindow(0.1 + (k < 1000 ? feeding : feeding / 2), 0.1,
+                                         bounce.wrench(k), bounce.state(k), 1e-3));
+    }
+    CHECK(others == 0);
+
+    // A bounce dying down (amplitude e^(−3t): its work falls by e^(−2) over a span's two thirds)
+    // is damped by the soil whatever the coupling creates: quiet, while the same created energy
+    // on the steady bounce (8 %) warns above.
+    Bounce dying = bounce;
+    dying.decay_per_s = 3.0;
+    CouplingGuard damped(settings);
+    for (int k = 0; k < 3000; ++k)
+        others +=
+            bool(damped.afterWindow(0.1 + feeding, 0.1, dying.wrench(k), dying.state(k), 1e-3));
+    CHECK(others == 0);
 }
