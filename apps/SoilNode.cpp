@@ -4,6 +4,7 @@
 #include "SoilSide.hpp"
 #include "grainlink/coupling/ParticipantNode.hpp"
 #include "grainlink/coupling/WindowLoads.hpp"
+#include "grainlink/dem/BedPreparation.hpp"
 #include "grainlink/dem/Checkpoint.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/dem/Series.hpp"
@@ -208,25 +209,12 @@ private:
             throw coupling::CouplingError(text);
         }
     }
-    /// A grain standing above the bed surface (its 98th percentile) can still be cut deep by a
-    /// body placed above that surface: the first step would push it out at once, or stop at the
-    /// overlap limit with a message about the time step. Said before the first step instead.
+    /// Said before the first step rather than as an overlap failure in it (dem::BedPreparation).
     void refuseStartingOverlap(std::size_t b) const {
-        const auto &p = sys_->particles();
-        const auto deepest = dem::deepestGrainOverlap(
-            p.position, p.radius, sys_->body(int(b)).worldVertices(), sys_->body(int(b)).mesh());
-        if (deepest.ratio <= 0.5 * scenario_.settings.max_overlap_ratio)
-            return;
-        char text[256];
-        std::snprintf(
-            text, sizeof text,
-            "body '%s' starts cutting %.2f of grain %zu's radius (%.2f mm; the grain's "
-            "top is %.2f mm above the bed surface): start it at least %.1f mm higher",
-            options_.bodies[b].c_str(), deepest.ratio, deepest.particle,
-            1000.0 * deepest.ratio * p.radius[deepest.particle],
-            1000.0 * (p.position[deepest.particle].z() + p.radius[deepest.particle] - surface_),
-            1000.0 * (deepest.ratio * p.radius[deepest.particle]) + 0.1);
-        throw coupling::CouplingError(text);
+        const std::string error =
+            dem::startingOverlapError(*sys_, int(b), 0.5 * scenario_.settings.max_overlap_ratio);
+        if (!error.empty())
+            throw coupling::CouplingError(error);
     }
 
     double lowestPoint(std::size_t b) const {

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
@@ -70,6 +71,24 @@ double bedSurface(const ParticleStore &p) {
     const std::size_t k = std::min(p.size() - 1, std::size_t(0.98 * double(p.size())));
     std::nth_element(tops.begin(), tops.begin() + std::ptrdiff_t(k), tops.end());
     return tops[k];
+}
+
+std::string startingOverlapError(const DemSystem &system, int body, double overlap_limit) {
+    const ParticleStore &p = system.particles();
+    const MeshBody &mesh_body = system.body(body);
+    const GrainOverlap deepest =
+        deepestGrainOverlap(p.position, p.radius, mesh_body.worldVertices(), mesh_body.mesh());
+    if (deepest.ratio <= overlap_limit)
+        return "";
+    const std::size_t i = deepest.particle;
+    char text[320];
+    std::snprintf(text, sizeof text,
+                  "body '%s' starts cutting %.2f of grain %zu's radius (%.2f mm; the grain's top "
+                  "is %.2f mm above the bed surface): start it at least %.1f mm higher",
+                  mesh_body.name().c_str(), deepest.ratio, i, 1000.0 * deepest.ratio * p.radius[i],
+                  1000.0 * (p.position[i].z() + p.radius[i] - bedSurface(p)),
+                  1000.0 * deepest.ratio * p.radius[i] + 0.1);
+    return text;
 }
 
 double packingFraction(const ParticleStore &p, double footprint_area_m2) {

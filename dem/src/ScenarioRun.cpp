@@ -1,5 +1,6 @@
 #include "grainlink/dem/ScenarioRun.hpp"
 
+#include "grainlink/dem/BedPreparation.hpp"
 #include "grainlink/dem/Checkpoint.hpp"
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/Series.hpp"

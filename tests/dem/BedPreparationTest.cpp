@@ -339,3 +339,34 @@ TEST_CASE("a prepared bed is cached with its crust and read back as it was settl
     CHECK(cached->particles().position == p.position);
     std::filesystem::remove_all(cache);
 }
+
+TEST_CASE("a body placed cutting the highest grain is refused naming the grain and the height to "
+          "add; one above it starts",
+          "[bed]") {
+    // A 1 mm square plate centred over the grain whose top is highest, its face half that
+    // grain's radius above the grain's centre: that grain is cut by 0.5 of its radius.
+    auto sys = copyOfSettledBed();
+    const ParticleStore &p = sys->particles();
+    std::size_t top = 0;
+    for (std::size_t i = 0; i < p.size(); ++i)
+        if (p.position[i].z() + p.radius[i] > p.position[top].z() + p.radius[top])
+            top = i;
+    const double r = p.radius[top];
+    RigidBodyState cutting;
+    cutting.position_m = p.position[top] + Vec3(0.0, 0.0, 0.5 * r);
+    sys->addBody(MeshBody("plate", makeRectangle(0.001, 0.001, 1, 1), cutting));
+    const std::string error = startingOverlapError(*sys, 0, 0.2);
+    char expected[160];
+    std::snprintf(expected, sizeof expected,
+                  "body 'plate' starts cutting 0.50 of grain %zu's radius (%.2f mm;", top,
+                  500.0 * r);
+    CHECK_THAT(error, Catch::StartsWith(expected));
+    std::snprintf(expected, sizeof expected, "start it at least %.1f mm higher", 500.0 * r + 0.1);
+    CHECK_THAT(error, Catch::EndsWith(expected));
+    // Half a radius is within a limit of 0.6, and 1 mm above the grain's top nothing is cut.
+    CHECK(startingOverlapError(*sys, 0, 0.6).empty());
+    RigidBodyState above;
+    above.position_m = p.position[top] + Vec3(0.0, 0.0, r + 0.001);
+    sys->addBody(MeshBody("above", makeRectangle(0.001, 0.001, 1, 1), above));
+    CHECK(startingOverlapError(*sys, 1, 0.2).empty());
+}
