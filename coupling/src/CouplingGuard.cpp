@@ -6,6 +6,16 @@
 
 namespace grainlink::coupling {
 
+namespace {
+
+/// A figure first order in the macro step (an explicit coupling's mismatch, §7.6) brought from
+/// `measured` under `threshold` by scaling the step down, with a margin.
+double firstOrderStep(double macro_step_s, double threshold, double measured) {
+    return 0.8 * macro_step_s * threshold / measured;
+}
+
+} // namespace
+
 double lagOneAutocorrelation(const std::vector<double> &values) {
     const double n = double(values.size());
     if (values.size() < 3)
@@ -82,9 +92,7 @@ std::optional<GuardWarning> CouplingGuard::energy(double macro_step_s) {
     if (ratio <= settings_.energy_ratio)
         return std::nullopt;
     energy_warned_ = true;
-    // An explicit coupling's mismatch is first order in the macro step (§7.6): scale it down to
-    // the threshold, with a margin.
-    const double step = 0.8 * macro_step_s * settings_.energy_ratio / ratio;
+    const double step = firstOrderStep(macro_step_s, settings_.energy_ratio, ratio);
     char text[512];
     std::snprintf(text, sizeof text,
                   "the energy mismatch over the last %u windows, %.3g J, is %.1f %% of the %.3g J "
@@ -162,8 +170,8 @@ std::optional<GuardWarning> CouplingGuard::bounce(double macro_step_s) {
     if (bounce_run_ < settings_.bounce_spans)
         return std::nullopt;
     bounce_warned_ = true;
-    // The share is about (π/2) ω H for a bounce of angular frequency ω: first order in H.
-    const double step = 0.8 * macro_step_s * settings_.bounce_energy_share / share;
+    // The share is about (π/2) ω H for a bounce of angular frequency ω: first order in H too.
+    const double step = firstOrderStep(macro_step_s, settings_.bounce_energy_share, share);
     char text[512];
     std::snprintf(text, sizeof text,
                   "the coupling feeds a bounce: for %u spans of %u windows it created %.1f %% of "
