@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <utility>
 
 namespace grainlink::coupling {
 
@@ -39,6 +40,7 @@ void CouplingGuard::restart() {
     span_.clear();
     energy_warned_ = oscillation_warned_ = bounce_warned_ = false;
     bounce_run_ = 0;
+    pending_.reset();
 }
 
 std::optional<GuardWarning> CouplingGuard::afterWindow(double work_multibody_J, double work_soil_J,
@@ -69,11 +71,18 @@ std::optional<GuardWarning> CouplingGuard::afterWindow(double work_multibody_J, 
         span_.pop_front();
     if (span_.size() < settings_.span_windows)
         return std::nullopt;
-    if (auto warning = energy(macro_step_s))
+    std::optional<GuardWarning> warning = energy(macro_step_s);
+    if (!warning)
+        warning = oscillation(wrenches, macro_step_s);
+    // The bounce is judged at every span's end, whatever else fired; its warning waits for a
+    // window without another one.
+    auto bounced = bounce(macro_step_s);
+    if (warning) {
+        if (bounced)
+            pending_ = std::move(bounced);
         return warning;
-    if (auto warning = oscillation(wrenches, macro_step_s))
-        return warning;
-    return bounce(macro_step_s);
+    }
+    return bounced ? bounced : std::exchange(pending_, std::nullopt);
 }
 
 std::optional<GuardWarning> CouplingGuard::energy(double macro_step_s) {

@@ -81,13 +81,14 @@ std::string startingOverlapError(const DemSystem &system, int body, double overl
     if (deepest.ratio <= overlap_limit)
         return "";
     const std::size_t i = deepest.particle;
-    char text[320];
+    char text[400];
     std::snprintf(text, sizeof text,
                   "body '%s' starts cutting %.2f of grain %zu's radius (%.2f mm; the grain's top "
-                  "is %.2f mm above the bed surface): start it at least %.1f mm higher",
+                  "is %.2f mm above the bed surface): start it at least %.1f mm higher (the limit "
+                  "is half of max_overlap_ratio, %.3g)",
                   mesh_body.name().c_str(), deepest.ratio, i, 1000.0 * deepest.ratio * p.radius[i],
                   1000.0 * (p.position[i].z() + p.radius[i] - bedSurface(p)),
-                  1000.0 * deepest.ratio * p.radius[i] + 0.1);
+                  1000.0 * deepest.ratio * p.radius[i] + 0.1, overlap_limit);
     return text;
 }
 

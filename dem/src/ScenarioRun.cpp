@@ -347,6 +347,12 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
                                       starts[b].position_m,
                                       2.0 * scenario.deposition.radius.largest())
                              .c_str());
+            // The coupled soil node's refusal, before the first step (not on a resume: a body
+            // in a checkpoint may overlap grains up to max_overlap_ratio by then).
+            const std::string error = startingOverlapError(
+                *sys, int(b), 0.5 * scenario.settings.max_overlap_ratio);
+            if (!error.empty())
+                throw std::runtime_error(scenario.file + ": " + error);
         }
         if (fs::exists(series_path))
             fs::remove(series_path);

@@ -163,6 +163,22 @@ TEST_CASE("coupling guard: a bounce the coupling feeds warns and one dying down 
         }
     CHECK(warnings == 1);
 
+    // With the soil's work only 1e-4 J a window the same created energy is 10 % of it: the
+    // energy check warns at the first span's end, and the bounce is still judged on that span,
+    // so it warns at the third, not a span late.
+    CouplingGuard both(settings);
+    std::vector<int> at;
+    std::vector<GuardWarning::Kind> kinds;
+    for (int k = 0; k < 3000; ++k)
+        if (const auto w = both.afterWindow(1e-4 + feeding, 1e-4, bounce.wrench(k),
+                                            bounce.state(k), 1e-3)) {
+            at.push_back(k);
+            kinds.push_back(w->kind);
+        }
+    CHECK(at == std::vector<int>{499, 1499});
+    CHECK(kinds == std::vector<GuardWarning::Kind>{GuardWarning::Kind::Energy,
+                                                   GuardWarning::Kind::Bounce});
+
     // Half of it (4 %): quiet. 8 % for two spans, then 4 %: quiet (it must persist).
     CouplingGuard half(settings), brief(settings);
     int others = 0;

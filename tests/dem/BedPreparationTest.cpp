@@ -361,7 +361,9 @@ TEST_CASE("a body placed cutting the highest grain is refused naming the grain a
                   "body 'plate' starts cutting 0.50 of grain %zu's radius (%.2f mm;", top,
                   500.0 * r);
     CHECK_THAT(error, Catch::StartsWith(expected));
-    std::snprintf(expected, sizeof expected, "start it at least %.1f mm higher", 500.0 * r + 0.1);
+    std::snprintf(expected, sizeof expected,
+                  "start it at least %.1f mm higher (the limit is half of max_overlap_ratio, 0.2)",
+                  500.0 * r + 0.1);
     CHECK_THAT(error, Catch::EndsWith(expected));
     // Half a radius is within a limit of 0.6, and 1 mm above the grain's top nothing is cut.
     CHECK(startingOverlapError(*sys, 0, 0.6).empty());

@@ -74,6 +74,7 @@ private:
     std::size_t windows_ = 0;
     bool energy_warned_ = false, oscillation_warned_ = false, bounce_warned_ = false;
     unsigned bounce_run_ = 0;       ///< consecutive spans past the bounce share
+    std::optional<GuardWarning> pending_; ///< a bounce warning found beside another one
     std::vector<double> component_; ///< one force component over the span (reused storage)
 };
 
