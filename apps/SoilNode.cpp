@@ -212,7 +212,7 @@ private:
     /// Said before the first step rather than as an overlap failure in it (dem::BedPreparation).
     void refuseStartingOverlap(std::size_t b) const {
         const std::string error =
-            dem::startingOverlapError(*sys_, int(b), 0.5 * scenario_.settings.max_overlap_ratio);
+            dem::startingOverlapError(*sys_, int(b), scenario_.settings.max_overlap_ratio);
         if (!error.empty())
             throw coupling::CouplingError(error);
     }

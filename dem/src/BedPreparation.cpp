@@ -73,7 +73,8 @@ double bedSurface(const ParticleStore &p) {
     return tops[k];
 }
 
-std::string startingOverlapError(const DemSystem &system, int body, double overlap_limit) {
+std::string startingOverlapError(const DemSystem &system, int body, double max_overlap_ratio) {
+    const double overlap_limit = 0.5 * max_overlap_ratio;
     const ParticleStore &p = system.particles();
     const MeshBody &mesh_body = system.body(body);
     const GrainOverlap deepest =

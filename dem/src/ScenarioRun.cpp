@@ -349,8 +349,7 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
                              .c_str());
             // The coupled soil node's refusal, before the first step (not on a resume: a body
             // in a checkpoint may overlap grains up to max_overlap_ratio by then).
-            const std::string error = startingOverlapError(
-                *sys, int(b), 0.5 * scenario.settings.max_overlap_ratio);
+            const std::string error = startingOverlapError(*sys, int(b), scenario.settings.max_overlap_ratio);
             if (!error.empty())
                 throw std::runtime_error(scenario.file + ": " + error);
         }

@@ -355,7 +355,7 @@ TEST_CASE("a body placed cutting the highest grain is refused naming the grain a
     RigidBodyState cutting;
     cutting.position_m = p.position[top] + Vec3(0.0, 0.0, 0.5 * r);
     sys->addBody(MeshBody("plate", makeRectangle(0.001, 0.001, 1, 1), cutting));
-    const std::string error = startingOverlapError(*sys, 0, 0.2);
+    const std::string error = startingOverlapError(*sys, 0, 0.4);
     char expected[160];
     std::snprintf(expected, sizeof expected,
                   "body 'plate' starts cutting 0.50 of grain %zu's radius (%.2f mm;", top,
@@ -365,10 +365,10 @@ TEST_CASE("a body placed cutting the highest grain is refused naming the grain a
                   "start it at least %.1f mm higher (the limit is half of max_overlap_ratio, 0.2)",
                   500.0 * r + 0.1);
     CHECK_THAT(error, Catch::EndsWith(expected));
-    // Half a radius is within a limit of 0.6, and 1 mm above the grain's top nothing is cut.
-    CHECK(startingOverlapError(*sys, 0, 0.6).empty());
+    // Half a radius is within the limit of max_overlap_ratio 1.2 (0.6), and 1 mm above the grain's top nothing is cut.
+    CHECK(startingOverlapError(*sys, 0, 1.2).empty());
     RigidBodyState above;
     above.position_m = p.position[top] + Vec3(0.0, 0.0, r + 0.001);
     sys->addBody(MeshBody("above", makeRectangle(0.001, 0.001, 1, 1), above));
-    CHECK(startingOverlapError(*sys, 1, 0.2).empty());
+    CHECK(startingOverlapError(*sys, 1, 0.4).empty());
 }

@@ -33,11 +33,11 @@ Material crustMaterial(const Material &soil, const CrustSpec &crust);
 /// Height of a settled bed's surface: 98th percentile of grain tops (robust to stray grains).
 double bedSurface(const ParticleStore &particles);
 /// Why body `body` of `system`, as placed, cannot start, or "" when it can: it cuts a grain by
-/// more than `overlap_limit` of the grain's radius. Grains stand up to a radius and more above
+/// more than half of `max_overlap_ratio` of the grain's radius. Grains stand up to a radius and more above
 /// the 98th-percentile surface, so a body placed above that surface can still cut one deep; its
 /// first step would push the grain out at once, or stop at the overlap limit with a message
 /// about the time step. The message names the body, the grain and the height to add.
-std::string startingOverlapError(const DemSystem &system, int body, double overlap_limit);
+std::string startingOverlapError(const DemSystem &system, int body, double max_overlap_ratio);
 /// Solid fraction of the bed below its surface: grain volume / (footprint area x (surface -
 /// floor)), the floor being the lowest grain bottom.
 double packingFraction(const ParticleStore &particles, double footprint_area_m2);
