@@ -20,3 +20,24 @@ TEST_CASE("Coupling section: past windows are reused by IQN-ILS only", "[couplin
                       Catch::StartsWith("c.yaml:7: key 'coupling.implicit.reuse_windows': only "
                                         "acceleration: iqn-ils reuses past windows"));
 }
+
+TEST_CASE("Coupling section: the guard's bounce keys are read, and a bad value is named with its "
+          "file and line",
+          "[coupling][keys]") {
+    const auto config = [](const std::string &guard) {
+        return coordinatorConfigFrom(ConfigNode::loadString(
+            "coupling:\n  scheme: explicit-serial\n  end_time_s: 1.0\n  macro_step_s: 0.01\n"
+            "  guard:\n" + guard +
+                "participants: []\n",
+            "c.yaml"));
+    };
+    const CoordinatorConfig read = config("    bounce_energy_share: 0.1\n    bounce_spans: 4\n");
+    CHECK(read.guard.bounce_energy_share == 0.1);
+    CHECK(read.guard.bounce_spans == 4);
+    CHECK_THROWS_WITH(config("    bounce_energy_share: -0.1\n"),
+                      Catch::StartsWith("c.yaml:6: key 'coupling.guard.bounce_energy_share'"));
+    CHECK_THROWS_WITH(config("    bounce_spans: 0\n"),
+                      Catch::StartsWith("c.yaml:6: key 'coupling.guard.bounce_spans'"));
+    CHECK_THROWS_WITH(config("    bounce_energy_share: abc\n"),
+                      Catch::StartsWith("c.yaml:6: key 'coupling.guard.bounce_energy_share'"));
+}
