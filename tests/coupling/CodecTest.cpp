@@ -19,10 +19,6 @@ namespace pb = grainlink::v1;
 
 namespace {
 
-std::string bytesOf(const pb::Envelope &e) {
-    return e.SerializeAsString();
-}
-
 /// The ProtocolError `f` throws (fails the test when it throws none).
 template <typename F> codec::ProtocolError protocolError(F f) {
     try {
@@ -61,7 +57,7 @@ TEST_CASE("Codec: an envelope must parse, speak our major version and carry a bo
     e.set_sender("soil");
     e.set_sequence(2);
     SECTION("missing body") {
-        const std::string bytes = bytesOf(e);
+        const std::string bytes = e.SerializeAsString();
         const auto error =
             protocolError([&] { codec::decode(bytes.data(), bytes.size(), "participant 'soil'"); });
         CHECK(error.code == pb::Error::CODE_MALFORMED);
@@ -72,7 +68,7 @@ TEST_CASE("Codec: an envelope must parse, speak our major version and carry a bo
     SECTION("another major version") {
         e.set_version(kProtocolMajor + 1);
         e.mutable_heartbeat();
-        const std::string bytes = bytesOf(e);
+        const std::string bytes = e.SerializeAsString();
         const auto error =
             protocolError([&] { codec::decode(bytes.data(), bytes.size(), "participant 'soil'"); });
         CHECK(error.code == pb::Error::CODE_VERSION_MISMATCH);
@@ -103,7 +99,7 @@ TEST_CASE("Codec: a message that would unpack into too many parts is refused unp
     e.mutable_hello()->set_participant("soil");
     for (int i = 0; i < 10; ++i)
         e.mutable_hello()->add_provides();
-    const std::string bytes = bytesOf(e);
+    const std::string bytes = e.SerializeAsString();
     CHECK(
         codec::decode(bytes.data(), bytes.size(), "a new connection", 13).hello().provides_size() ==
         10);
@@ -120,7 +116,7 @@ TEST_CASE("Codec: a message that would unpack into too many parts is refused unp
     auto *indices = mesh.mutable_hello()->add_provides()->mutable_mesh();
     for (std::uint32_t i = 0; i < 3000; ++i)
         indices->add_triangle_indices(i);
-    const std::string mesh_bytes = bytesOf(mesh);
+    const std::string mesh_bytes = mesh.SerializeAsString();
     CHECK_NOTHROW(codec::decode(mesh_bytes.data(), mesh_bytes.size(), "a new connection", 5));
 }
 

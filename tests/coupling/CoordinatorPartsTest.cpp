@@ -233,10 +233,6 @@ std::vector<Peer> twoPeers() {
     return peers;
 }
 
-std::string bytesOf(const pb::Envelope &e) {
-    return e.SerializeAsString();
-}
-
 pb::Envelope beat(const std::string &name) {
     pb::Envelope e;
     e.set_version(kProtocolMajor);
@@ -258,12 +254,12 @@ TEST_CASE("Lobby: strangers are answered, never joined, and never stop anything"
     };
 
     SECTION("a valid Hello joins; a second one for the name is refused to its sender only") {
-        const auto joined = receive("A", bytesOf(soilHello()));
+        const auto joined = receive("A", soilHello().SerializeAsString());
         REQUIRE(joined.joined == std::size_t(1));
         CHECK_FALSE(joined.error);
         CHECK(peers[1].joined);
         CHECK(peers[1].routing_id == "A");
-        const auto again = receive("B", bytesOf(soilHello()));
+        const auto again = receive("B", soilHello().SerializeAsString());
         CHECK(again.error == pb::Error::CODE_ALREADY_JOINED);
         CHECK(peers[1].routing_id == "A");
         CHECK(peers[1].refusal.empty());
@@ -271,7 +267,7 @@ TEST_CASE("Lobby: strangers are answered, never joined, and never stop anything"
     SECTION("an invalid Hello claims nothing: the real participant joins after it") {
         pb::Envelope old_version = soilHello();
         old_version.set_version(2);
-        const auto refused = receive("S", bytesOf(old_version));
+        const auto refused = receive("S", old_version.SerializeAsString());
         CHECK(refused.error == pb::Error::CODE_VERSION_MISMATCH);
         CHECK(refused.text == "speaks protocol major version 2, the coordinator speaks 1");
         CHECK(refused.warning ==
@@ -279,15 +275,17 @@ TEST_CASE("Lobby: strangers are answered, never joined, and never stop anything"
               "speaks 1");
         CHECK_FALSE(peers[1].joined);
         CHECK(peers[1].refusal == refused.text); // for the handshake timeout's message
-        CHECK(receive("A", bytesOf(soilHello())).joined == std::size_t(1));
+        CHECK(receive("A", soilHello().SerializeAsString()).joined == std::size_t(1));
         CHECK(peers[1].refusal.empty());
         // The same stranger after the soil joined: refused again, the soil untouched.
-        CHECK(receive("S", bytesOf(old_version)).error == pb::Error::CODE_VERSION_MISMATCH);
+        CHECK(receive("S", old_version.SerializeAsString()).error ==
+              pb::Error::CODE_VERSION_MISMATCH);
         CHECK(peers[1].routing_id == "A");
         CHECK(peers[1].refusal.empty());
     }
     SECTION("no Hello once the run started") {
-        CHECK(receive("A", bytesOf(soilHello()), false).error == pb::Error::CODE_ALREADY_JOINED);
+        CHECK(receive("A", soilHello().SerializeAsString(), false).error ==
+              pb::Error::CODE_ALREADY_JOINED);
         CHECK_FALSE(peers[1].joined);
     }
     SECTION("an unknown name is neither echoed nor logged in full") {
@@ -295,7 +293,7 @@ TEST_CASE("Lobby: strangers are answered, never joined, and never stop anything"
         const std::string name = "x\ncoordinator: forged line" + std::string(1'000'000, 'y');
         e.set_sender(name);
         e.mutable_hello()->set_participant(name);
-        const auto a = receive("S", bytesOf(e));
+        const auto a = receive("S", e.SerializeAsString());
         CHECK(a.error == pb::Error::CODE_UNKNOWN_PARTICIPANT);
         CHECK(a.text.size() < 200);
         CHECK(a.text.find('\n') == std::string::npos);
@@ -304,27 +302,30 @@ TEST_CASE("Lobby: strangers are answered, never joined, and never stop anything"
         CHECK_THAT(a.warning, Catch::EndsWith("... (1000026 bytes)'"));
     }
     SECTION("a message of two frames, garbage, and a message before Hello are refused") {
-        const auto two = receive("S", bytesOf(soilHello()), true, 2);
+        const auto two = receive("S", soilHello().SerializeAsString(), true, 2);
         CHECK(two.error == pb::Error::CODE_MALFORMED);
         CHECK(two.text == "a message is one frame, not 2; ignored");
         CHECK_FALSE(peers[1].joined);
         CHECK(receive("S", "\xff\xff garbage").error == pb::Error::CODE_MALFORMED);
         pb::Envelope done = soilHello();
         done.mutable_window_done();
-        CHECK(receive("S", bytesOf(done)).text == "send Hello first (got window_done)");
+        CHECK(receive("S", done.SerializeAsString()).text == "send Hello first (got window_done)");
     }
     SECTION("heartbeats: the first connection for a name is its heartbeat connection") {
-        CHECK(receive("H", bytesOf(beat("soil"))).heartbeat); // answered before it joined
+        CHECK(
+            receive("H", beat("soil").SerializeAsString()).heartbeat); // answered before it joined
         CHECK(peers[1].heartbeat_id == "H");
-        const auto other = receive("X", bytesOf(beat("soil")));
+        const auto other = receive("X", beat("soil").SerializeAsString());
         CHECK_FALSE(other.heartbeat);
         CHECK(other.warning == "ignored a heartbeat for 'soil' from a second connection");
-        CHECK_FALSE(receive("X", bytesOf(beat("nobody"))).heartbeat);
+        CHECK_FALSE(receive("X", beat("nobody").SerializeAsString()).heartbeat);
         // With CURVE, a key beats only for its own name.
         CHECK_FALSE(
-            lobby.receive("M", bytesOf(beat("mbs")), 1, std::string("soil"), true, now).heartbeat);
+            lobby.receive("M", beat("mbs").SerializeAsString(), 1, std::string("soil"), true, now)
+                .heartbeat);
         CHECK(peers[0].heartbeat_id.empty());
-        CHECK(lobby.receive("M", bytesOf(beat("mbs")), 1, std::string("mbs"), true, now).heartbeat);
+        CHECK(lobby.receive("M", beat("mbs").SerializeAsString(), 1, std::string("mbs"), true, now)
+                  .heartbeat);
     }
     SECTION("a connection that floods is dropped with a logged reason, then ignored") {
         for (unsigned i = 0; i < CoordinatorLimits{}.max_stranger_messages_per_s; ++i)
@@ -334,7 +335,7 @@ TEST_CASE("Lobby: strangers are answered, never joined, and never stop anything"
         CHECK(dropped.warning == "dropped connection 0x46: more than "
                                  "limits.max_stranger_messages_per_s = 100 messages within a "
                                  "second; it is ignored from now on");
-        const auto after = receive("F", bytesOf(soilHello()));
+        const auto after = receive("F", soilHello().SerializeAsString());
         CHECK_FALSE(after.error);
         CHECK(after.warning.empty());
         CHECK_FALSE(peers[1].joined);

@@ -4,10 +4,42 @@
 #include "TwoMassParticipant.hpp"
 #include "grainlink/coupling/Coordinator.hpp"
 
+#include <unistd.h>
+
+#include <filesystem>
 #include <future>
 #include <string>
 
 namespace grainlink::testing {
+
+/// A fresh directory per test process (ctest runs test cases in parallel processes).
+inline std::string scratch(const std::string &name) {
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("grainlink-coupling-" + std::to_string(::getpid())) / name;
+    std::filesystem::remove_all(dir);
+    std::filesystem::create_directories(dir);
+    return dir.string();
+}
+
+/// The error a coordinator's run stops with.
+inline std::string failureOf(coupling::Coordinator &coordinator) {
+    try {
+        coordinator.run();
+    } catch (const coupling::CouplingError &e) {
+        return e.what();
+    }
+    return "(the run did not fail)";
+}
+
+/// The error a participant's side (started on its own thread) stops with.
+template <typename T> std::string failureOf(std::future<T> &side) {
+    try {
+        side.get();
+    } catch (const std::exception &e) {
+        return e.what();
+    }
+    return "(the participant did not fail)";
+}
 
 inline coupling::CoordinatorConfig
 twoMassRun(coupling::SchemeKind kind, const std::string &endpoint, double window_s, double end_s) {

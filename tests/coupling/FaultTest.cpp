@@ -15,6 +15,8 @@ using grainlink::examples::twoMassConfig;
 using grainlink::testing::RawPeer;
 namespace pb = grainlink::v1;
 
+using grainlink::testing::failureOf;
+
 namespace {
 
 CoordinatorConfig faultRun(double end_s = 0.2) {
@@ -28,24 +30,6 @@ CoordinatorConfig faultRun(double end_s = 0.2) {
 std::future<double> startMultibody(const std::string &endpoint,
                                    grainlink::examples::SideHooks hooks = {}) {
     return grainlink::testing::startSide(Role::Multibody, endpoint, hooks, 3.0);
-}
-
-std::string failureOf(Coordinator &coordinator) {
-    try {
-        coordinator.run();
-    } catch (const CouplingError &e) {
-        return e.what();
-    }
-    return "(the run did not fail)";
-}
-
-std::string failureOf(std::future<double> &side) {
-    try {
-        side.get();
-    } catch (const CouplingError &e) {
-        return e.what();
-    }
-    return "(the participant did not fail)";
 }
 
 } // namespace

@@ -17,6 +17,8 @@ using grainlink::examples::twoMassConfig;
 using grainlink::examples::TwoMassNode;
 using grainlink::testing::twoMassRun;
 
+using grainlink::testing::failureOf;
+
 namespace {
 
 /// A two-mass side that logs every hook the loop calls: "start", "save", "restore",
@@ -62,24 +64,6 @@ std::future<void> startRecorded(Role role, const std::string &endpoint,
         Recording node(std::move(inner), log);
         runParticipant(p, node);
     });
-}
-
-std::string failureOf(Coordinator &coordinator) {
-    try {
-        coordinator.run();
-    } catch (const CouplingError &e) {
-        return e.what();
-    }
-    return "(the run did not fail)";
-}
-
-template <typename T> std::string failureOf(std::future<T> &side) {
-    try {
-        side.get();
-    } catch (const std::exception &e) {
-        return e.what();
-    }
-    return "(the participant did not fail)";
 }
 
 } // namespace

@@ -12,20 +12,13 @@ using namespace grainlink::coupling;
 using grainlink::examples::runTwoMassSide;
 using grainlink::examples::twoMassConfig;
 
+using grainlink::testing::scratch;
+
 namespace {
 
 CoordinatorConfig smallRun(double end_s = 0.05) {
     return grainlink::testing::twoMassRun(SchemeKind::ExplicitSerial, "tcp://127.0.0.1:*", 0.01,
                                           end_s);
-}
-
-/// A fresh directory per test process (ctest runs test cases in parallel processes).
-std::string scratch(const std::string &name) {
-    const auto dir = std::filesystem::temp_directory_path() /
-                     ("grainlink-coupling-" + std::to_string(::getpid())) / name;
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-    return dir.string();
 }
 
 } // namespace

@@ -16,16 +16,9 @@ using namespace grainlink::coupling;
 using grainlink::examples::twoMassConfig;
 namespace fs = std::filesystem;
 
-namespace {
+using grainlink::testing::scratch;
 
-/// A fresh directory per test process (ctest runs test cases in parallel processes).
-std::string scratch(const std::string &name) {
-    const auto dir =
-        fs::temp_directory_path() / ("grainlink-security-" + std::to_string(::getpid())) / name;
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-    return dir.string();
-}
+namespace {
 
 /// coordinator, mbs and soil keys in a fresh directory.
 std::string runKeys(const std::string &name) {
@@ -44,7 +37,7 @@ CoordinatorConfig keyedRun(const std::optional<CurveServerKeys> &keys) {
 }
 
 /// Starts `coordinator` on a thread; its future holds its failure line.
-std::future<std::string> failureOf(Coordinator &coordinator) {
+std::future<std::string> failureLater(Coordinator &coordinator) {
     return std::async(std::launch::async, [&coordinator] {
         try {
             coordinator.run();
@@ -84,7 +77,7 @@ TEST_CASE("CURVE: a participant's key admits only its own name", "[coupling][sec
     }
     const std::string keys = runKeys("bound");
     Coordinator coordinator(keyedRun(loadServerKeys(keys)));
-    auto failure = failureOf(coordinator);
+    auto failure = failureLater(coordinator);
     // The soil's key, used to say Hello as 'mbs'.
     const std::string refused =
         "says Hello as 'mbs' with the CURVE key of 'soil' (each participant joins with its own "
@@ -107,7 +100,7 @@ TEST_CASE("CURVE: a key the coordinator does not know is refused, and the client
     writeKeyPair(other, "mbs", generateKeyPair());
     const CurveClientKeys stranger = loadClientKeys(other, "mbs");
     Coordinator coordinator(keyedRun(loadServerKeys(keys)));
-    auto failure = failureOf(coordinator);
+    auto failure = failureLater(coordinator);
     CHECK(joinAs("mbs", coordinator.boundEndpoint(), stranger) ==
           "participant 'mbs': the coordinator at " + coordinator.boundEndpoint() +
               " refused this participant's CURVE key (public key " +
@@ -132,7 +125,7 @@ TEST_CASE("CURVE on one side only, or another coordinator's key: told at once",
     // connection break off: each side's message covers both.
     SECTION("a participant without keys, a coordinator with CURVE") {
         Coordinator coordinator(keyedRun(loadServerKeys(keys)));
-        auto failure = failureOf(coordinator);
+        auto failure = failureLater(coordinator);
         const std::string at = "participant 'mbs': the coordinator at " +
                                coordinator.boundEndpoint() + " requires CURVE";
         const std::string or_at = "participant 'mbs': the handshake with the coordinator at " +
@@ -151,7 +144,7 @@ TEST_CASE("CURVE on one side only, or another coordinator's key: told at once",
     }
     SECTION("a participant with keys, a coordinator without CURVE") {
         Coordinator coordinator(keyedRun(std::nullopt));
-        auto failure = failureOf(coordinator);
+        auto failure = failureLater(coordinator);
         CHECK_THAT(joinAs("mbs", coordinator.boundEndpoint(), loadClientKeys(keys, "mbs")),
                    Catch::Equals("participant 'mbs': this participant has CURVE keys but the "
                                  "coordinator at " +
@@ -167,7 +160,7 @@ TEST_CASE("CURVE on one side only, or another coordinator's key: told at once",
         writeKeyPair(other, "coordinator", generateKeyPair());
         fs::copy(keys + "/mbs.key", other + "/mbs.key");
         Coordinator coordinator(keyedRun(loadServerKeys(keys)));
-        auto failure = failureOf(coordinator);
+        auto failure = failureLater(coordinator);
         CHECK(joinAs("mbs", coordinator.boundEndpoint(), loadClientKeys(other, "mbs")) ==
               "participant 'mbs': the handshake with the coordinator at " +
                   coordinator.boundEndpoint() +

@@ -46,7 +46,7 @@ DepositionSpec bedSpec() {
 }
 
 /// The bed settled once per test process; tests work on copies.
-const DemSystem &settledBed() {
+const DemSystem &settledPreparationBed() {
     static const std::unique_ptr<DemSystem> bed = [] {
         auto sys = boxSystem();
         REQUIRE(deposit(*sys, bedSpec()).settled);
@@ -57,7 +57,7 @@ const DemSystem &settledBed() {
 
 std::unique_ptr<DemSystem> copyOfSettledBed(double dt_s = kTimeStep_s) {
     auto sys = boxSystem(dt_s);
-    copyState(settledBed(), *sys);
+    copyState(settledPreparationBed(), *sys);
     return sys;
 }
 
@@ -84,13 +84,13 @@ deposition:
            "packing_cache_directory: '" + cache + "'\nrun: {duration_s: 0.1}\n";
 }
 
-DemScenario parsed(const std::string &text) {
+DemScenario parsedPreparation(const std::string &text) {
     return parseScenario(ConfigNode::loadString(text, "prepared.yaml"));
 }
 
-std::string errorOf(const std::string &preparation) {
+std::string preparationError(const std::string &preparation) {
     try {
-        parsed(scenarioText(preparation));
+        parsedPreparation(scenarioText(preparation));
     } catch (const ConfigError &e) {
         return e.what();
     }
@@ -104,7 +104,7 @@ TEST_CASE("strike-off: the surface ends within a grain diameter of the blade, ev
           "[dem][preparation]") {
     const double height = 0.025; // about 9 mm below the settled surface
     std::size_t above = 0;
-    for (const Vec3 &x : settledBed().particles().position)
+    for (const Vec3 &x : settledPreparationBed().particles().position)
         above += x.z() > height ? 1 : 0;
     REQUIRE(above > 50);
 
@@ -129,17 +129,17 @@ TEST_CASE("strike-off above the bed removes nothing and leaves the bed as it was
     auto sys = copyOfSettledBed();
     const double above = bedSurface(sys->particles()) + 3.0 * kRadiusMax;
     CHECK(strikeOff(*sys, above) == 0);
-    CHECK(sys->particles().position == settledBed().particles().position);
+    CHECK(sys->particles().position == settledPreparationBed().particles().position);
     CHECK_THROWS_WITH(strikeOff(*sys, 0.0), Catch::Contains("nothing of the bed would be left"));
 }
 
 TEST_CASE("compaction: the plate holds pressure x area, and the packing fraction rises with the "
           "pressure",
           "[dem][preparation][slow]") {
-    const double settled = packingFraction(settledBed().particles(), footprintArea());
+    const double settled = packingFraction(settledPreparationBed().particles(), footprintArea());
     std::printf("compaction of %zu grains in a %.0f mm square bin (E = 3 MPa, mu = 0.3, dt = "
                 "%.0e s): packing fraction at 0 kPa %.4f\n",
-                settledBed().particles().size(), kBox.x() * 1e3, kTimeStep_s, settled);
+                settledPreparationBed().particles().size(), kBox.x() * 1e3, kTimeStep_s, settled);
     std::vector<double> fractions;
     for (double pressure_Pa : {500.0, 2000.0, 5000.0, 10000.0}) {
         auto sys = copyOfSettledBed();
@@ -196,7 +196,7 @@ TEST_CASE("crust: the grains whose tops lie within the thickness of the surface,
           "lattice",
           "[dem][preparation]") {
     DemScenario s =
-        parsed(scenarioText("  crust: {thickness_m: 0.01, youngs_modulus_factor: 4}\n"));
+        parsedPreparation(scenarioText("  crust: {thickness_m: 0.01, youngs_modulus_factor: 4}\n"));
     auto sys = makeSystem(s);
     REQUIRE(sys->materials().size() == 2);
     const Material &crust = sys->materials()[1];
@@ -225,8 +225,8 @@ TEST_CASE("crust: the Hertz force between a crust grain and a soil grain follows
     for (const double factor : {10.0, 0.2}) {
         INFO("youngs_modulus_factor " << factor);
         DemScenario s =
-            parsed(scenarioText("  crust: {thickness_m: 0.001, youngs_modulus_factor: " +
-                                std::to_string(factor) + "}\n"));
+            parsedPreparation(scenarioText("  crust: {thickness_m: 0.001, youngs_modulus_factor: " +
+                                           std::to_string(factor) + "}\n"));
         s.settings.gravity_m_s2.setZero();
         s.law.damping = DampingRestitution{1.0}; // no dashpot: the force is Hertz's alone
         s.settings.time_step_s =
@@ -262,28 +262,28 @@ TEST_CASE("crust: the Hertz force between a crust grain and a soil grain follows
 TEST_CASE("preparation keys are read strictly and refused where they would change nothing",
           "[dem][preparation]") {
     // The preparation lines start at line 14 of scenarioText.
-    CHECK(errorOf("  strike_off_height_m: -0.01\n") ==
+    CHECK(preparationError("  strike_off_height_m: -0.01\n") ==
           "prepared.yaml:14: key 'deposition.strike_off_height_m': must lie above the bed's "
           "floor (region.lower_m z = 0 m)");
-    CHECK(errorOf("  strike_off_height_m: 0.079\n")
+    CHECK(preparationError("  strike_off_height_m: 0.079\n")
               .find("prepared.yaml:14: key 'deposition.strike_off_height_m': removes nothing") ==
           0);
-    CHECK(errorOf("  compaction: {pressure_Pa: 0}\n") ==
+    CHECK(preparationError("  compaction: {pressure_Pa: 0}\n") ==
           "prepared.yaml:14: key 'deposition.compaction.pressure_Pa': must be > 0, got 0");
-    CHECK(errorOf("  compaction:\n    pressure_Pa: 1000\n    hold_time_ms: 100\n")
+    CHECK(preparationError("  compaction:\n    pressure_Pa: 1000\n    hold_time_ms: 100\n")
               .find("prepared.yaml:16: unknown key 'deposition.compaction.hold_time_ms'") == 0);
-    CHECK(errorOf("  compaction: {pressure_Pa: 1000, speed_m_s: -1}\n") ==
+    CHECK(preparationError("  compaction: {pressure_Pa: 1000, speed_m_s: -1}\n") ==
           "prepared.yaml:14: key 'deposition.compaction.speed_m_s': must be > 0, got -1");
-    CHECK(errorOf("  crust: {thickness_m: 0.01, youngs_modulus_factor: 1}\n") ==
+    CHECK(preparationError("  crust: {thickness_m: 0.01, youngs_modulus_factor: 1}\n") ==
           "prepared.yaml:14: key 'deposition.crust.youngs_modulus_factor': 1 changes nothing "
           "(the crust would be the soil itself): leave crust out");
-    CHECK(errorOf("  crust: {thickness_m: 0, youngs_modulus_factor: 3}\n") ==
+    CHECK(preparationError("  crust: {thickness_m: 0, youngs_modulus_factor: 3}\n") ==
           "prepared.yaml:14: key 'deposition.crust.thickness_m': must be > 0, got 0");
-    CHECK(errorOf("  crust: {youngs_modulus_factor: 3}\n").find("thickness_m") !=
+    CHECK(preparationError("  crust: {youngs_modulus_factor: 3}\n").find("thickness_m") !=
           std::string::npos);
-    const DemScenario s =
-        parsed(scenarioText("  strike_off_height_m: 0.03\n  compaction: {pressure_Pa: 2000}\n"
-                            "  crust: {thickness_m: 0.005, youngs_modulus_factor: 0.5}\n"));
+    const DemScenario s = parsedPreparation(
+        scenarioText("  strike_off_height_m: 0.03\n  compaction: {pressure_Pa: 2000}\n"
+                     "  crust: {thickness_m: 0.005, youngs_modulus_factor: 0.5}\n"));
     CHECK(*s.deposition.strike_off_height_m == 0.03);
     CHECK(s.deposition.compaction->pressure_Pa == 2000.0);
     CHECK(s.deposition.compaction->hold_time_s == 0.1); // documented defaults
@@ -294,11 +294,11 @@ TEST_CASE("preparation keys are read strictly and refused where they would chang
 TEST_CASE("packing key: every preparation key changes the packed bed's key, and a bed that is only "
           "settled keeps the key it had",
           "[dem][preparation]") {
-    const std::string plain = packingKey(parsed(scenarioText("")));
+    const std::string plain = packingKey(parsedPreparation(scenarioText("")));
     // The key main's packingKey gives this scenario (before the preparation keys existed).
     CHECK(plain == "06724c91adb0e760");
     const auto key = [](const std::string &preparation) {
-        return packingKey(parsed(scenarioText(preparation)));
+        return packingKey(parsedPreparation(scenarioText(preparation)));
     };
     const std::string compacted = key("  compaction: {pressure_Pa: 2000}\n");
     CHECK(compacted != plain);
@@ -318,10 +318,10 @@ TEST_CASE("a prepared bed is cached with its crust and read back as it was settl
           "[dem][preparation]") {
     const auto cache = std::filesystem::temp_directory_path() / "grainlink_preparation_cache";
     std::filesystem::remove_all(cache);
-    const DemScenario s =
-        parsed(scenarioText("  strike_off_height_m: 0.02\n  compaction: {pressure_Pa: 1000}\n"
-                            "  crust: {thickness_m: 0.004, youngs_modulus_factor: 2}\n",
-                            cache.string()));
+    const DemScenario s = parsedPreparation(
+        scenarioText("  strike_off_height_m: 0.02\n  compaction: {pressure_Pa: 1000}\n"
+                     "  crust: {thickness_m: 0.004, youngs_modulus_factor: 2}\n",
+                     cache.string()));
     bool from_cache = true;
     const auto fresh = prepareSoil(s, 60.0, &from_cache);
     CHECK(!from_cache);

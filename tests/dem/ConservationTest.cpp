@@ -9,8 +9,6 @@ using namespace grainlink::dem::testing;
 
 namespace {
 
-const Material kMaterial = soil(1e7, 0.3, 2500.0);
-
 struct Momenta {
     Vec3 linear = Vec3::Zero();
     Vec3 angular = Vec3::Zero(); ///< about the origin: sum m x × v + I w

@@ -11,7 +11,6 @@ using namespace grainlink::dem::testing;
 
 namespace {
 
-const Material kMaterial = soil(1e7, 0.3, 2500.0);
 const Vec3 kBoxVelocity(0.05, 0.03, 0.0); // m/s
 
 ContactLaw law() {

@@ -11,10 +11,6 @@ using namespace grainlink::dem::testing;
 
 namespace {
 
-const Material kMaterial = soil(1e7, 0.3, 2500.0);
-constexpr double kRadius = 0.005;
-constexpr double kG = 9.81;
-
 /// Linear cohesion against Hertz (§2.7): net attraction f(d) = a d - b d^1.5 with a = k_c pi R*,
 /// b = 4/3 E* sqrt(R*). Zero at d0 = (a/b)^2, largest at d* = (a / 1.5 b)^2, where it is the
 /// pull-off force P = a d* / 3.

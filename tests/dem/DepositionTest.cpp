@@ -10,7 +10,7 @@ using namespace grainlink::dem::testing;
 
 namespace {
 
-std::unique_ptr<DemSystem> boxSystem(const Vec3 &upper) {
+std::unique_ptr<DemSystem> depositionBox(const Vec3 &upper) {
     DemSettings settings;
     settings.time_step_s = 1e-4;
     auto sys = std::make_unique<DemSystem>(hertzRestitution(0.3, 0.5),
@@ -41,7 +41,7 @@ TEST_CASE("random insertion places non-overlapping grains of the requested sizes
     spec.radius.radii_m = {0.002, 0.003};
     spec.radius.fractions = {3.0, 1.0};
     spec.seed = 11;
-    auto a = boxSystem(Vec3(0.07, 0.05, 0.2));
+    auto a = depositionBox(Vec3(0.07, 0.05, 0.2));
     Random random(spec.seed);
     REQUIRE(insertRandom(*a, spec, random, spec.count, spec.region_lower_m, spec.region_upper_m) ==
             400);
@@ -58,7 +58,7 @@ TEST_CASE("random insertion places non-overlapping grains of the requested sizes
     CHECK(small == Approx(300).margin(35));
     CHECK(largestOverlap(p) <= 0.0);
 
-    auto b = boxSystem(Vec3(0.07, 0.05, 0.2));
+    auto b = depositionBox(Vec3(0.07, 0.05, 0.2));
     Random again(spec.seed);
     insertRandom(*b, spec, again, spec.count, spec.region_lower_m, spec.region_upper_m);
     CHECK(b->particles().position == p.position);
@@ -78,7 +78,7 @@ TEST_CASE("deposition by rain fills layer by layer and settles below the energy 
     spec.layer_interval_s = 0.08;
     spec.settle_kinetic_energy_J = 1e-8;
     spec.max_settle_time_s = 2.0;
-    auto sys = boxSystem(Vec3(0.05, 0.05, 0.3));
+    auto sys = depositionBox(Vec3(0.05, 0.05, 0.3));
     std::vector<std::size_t> counts;
     const DepositionReport report = deposit(*sys, spec, [&](const DepositionReport &r) {
         if (counts.empty() || counts.back() != r.inserted)
@@ -102,7 +102,7 @@ TEST_CASE("a region too small for the grains is an error that says what to chang
     spec.count = 500;
     spec.radius.kind = RadiusDistribution::Kind::Constant;
     spec.radius.min_m = spec.radius.max_m = 0.003;
-    auto sys = boxSystem(Vec3(0.02, 0.02, 0.2));
+    auto sys = depositionBox(Vec3(0.02, 0.02, 0.2));
     CHECK_THROWS_WITH(deposit(*sys, spec),
                       Catch::Contains("particles fit into the insertion region"));
 }

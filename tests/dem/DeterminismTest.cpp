@@ -9,8 +9,6 @@ using namespace grainlink::dem::testing;
 
 namespace {
 
-const Material kMaterial = soil(1e7, 0.3, 2500.0);
-
 /// 300 grains poured into a box of planes while a cylinder (mesh body) sinks into them: pair,
 /// plane and mesh contacts, friction with history, rolling resistance, re-sorts and rebuilds.
 ParticleStore pour(int threads) {

@@ -22,6 +22,15 @@ inline Material soil(double youngs_modulus_Pa = 1e7, double poisson = 0.3,
     return m;
 }
 
+/// The elastic grain material and radius most contact tests share.
+inline const Material kMaterial = soil(1e7, 0.3, 2500.0);
+inline constexpr double kRadius = 0.005;
+inline constexpr double kG = 9.81;
+
+inline double deg(double degrees) {
+    return degrees * M_PI / 180.0;
+}
+
 inline ContactLaw hertzRestitution(double restitution, double friction) {
     ContactLaw law;
     law.damping = DampingRestitution{restitution};

@@ -9,14 +9,6 @@ using namespace grainlink::dem::testing;
 
 namespace {
 
-const Material kMaterial = soil(1e7, 0.3, 2500.0);
-constexpr double kRadius = 0.005;
-constexpr double kG = 9.81;
-
-double deg(double degrees) {
-    return degrees * M_PI / 180.0;
-}
-
 /// Overlap of a grain pressed on a wall of its own material by `load_N`.
 double restingOverlap(double load_N) {
     return std::pow(load_N / (4.0 / 3.0 * effectiveModulus(kMaterial) * std::sqrt(kRadius)),

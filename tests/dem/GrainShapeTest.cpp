@@ -21,13 +21,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kRadius = 0.005;
 constexpr double kDensity = 2500.0;
-constexpr double kG = 9.81;
-
-double deg(double degrees) {
-    return degrees * M_PI / 180.0;
-}
 
 RollingGrainShape grainShape(double gamma_deg) {
     RollingGrainShape shape;

@@ -23,7 +23,7 @@ ContactLaw bedLaw() {
 }
 
 /// ~500 grains of r = 2.5 mm settled under gravity in a 48 mm square box of planes.
-const DemSystem& settledBed() {
+const DemSystem &settledStabilityBed() {
     static const DemSystem bed = [] {
         DemSettings settings;
         settings.time_step_s = 5e-5; // Table 1's maximum step
@@ -44,7 +44,7 @@ struct Trial {
 };
 
 Trial tryStep(Integrator integrator, double dt, int steps, double kinetic_limit_J) {
-    const DemSystem& bed = settledBed();
+    const DemSystem &bed = settledStabilityBed();
     DemSettings settings;
     settings.time_step_s = dt;
     settings.integrator = integrator;
@@ -103,7 +103,7 @@ TEST_CASE("Largest stable step: velocity Verlet vs Newmark (beta 1/4, gamma 1/2)
     // w dt < 2 exactly like velocity Verlet. The paper's claim holds for an implicit Newmark
     // solve, not for this scheme. Asserted: the two limits agree within 10 % (either way), and
     // Table 1's 5e-5 s is stable with a margin of 3.
-    const DemSystem& bed = settledBed();
+    const DemSystem &bed = settledStabilityBed();
     double bed_mass = 0.0;
     for (double m : bed.particles().mass)
         bed_mass += m;

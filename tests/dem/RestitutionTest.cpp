@@ -13,9 +13,6 @@ using namespace grainlink::dem::testing;
 
 namespace {
 
-const Material kMaterial = soil(1e7, 0.3, 2500.0);
-constexpr double kRadius = 0.005;
-
 /// Two equal spheres approach head-on at relative `speed`; returns separation / approach speed.
 /// The step is 1/2000 of the elastic Hertz duration at that speed.
 double pairRestitution(const ContactLaw& law, double speed) {

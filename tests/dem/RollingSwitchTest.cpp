@@ -16,8 +16,8 @@ namespace fs = std::filesystem;
 namespace {
 
 // 150 grains poured into a 6 cm box; settles in about 0.4 s simulated.
-std::string scenarioText(const std::string &contact_rolling, const std::string &settling_rolling,
-                         const std::string &cache) {
+std::string rollingScenarioText(const std::string &contact_rolling,
+                                const std::string &settling_rolling, const std::string &cache) {
     std::string text = R"(name: switch
 simulation: {time_step_s: 5.0e-5}
 material: {youngs_modulus_Pa: 3.0e6, poisson_ratio: 0.2, density_kg_m3: 2400}
@@ -40,7 +40,7 @@ deposition:
     return text + "packing_cache_directory: " + cache + "\nrun: {duration_s: 0.01}\n";
 }
 
-DemScenario parsed(const std::string &text) {
+DemScenario parsedRolling(const std::string &text) {
     return parseScenario(ConfigNode::loadString(text, "switch.yaml"));
 }
 
@@ -74,17 +74,17 @@ std::size_t contactsWithRollingHistory(DemSystem &sys) {
 TEST_CASE("deposition.rolling: the packing key is the settling law's", "[dem][scenario]") {
     const std::string cache = "/tmp/unused";
     // Rolling laws that settle alike share a packing; the run's own law decides otherwise.
-    CHECK(packingKey(parsed(scenarioText(kEpsd, kNone, cache))) ==
-          packingKey(parsed(scenarioText(kShape, kNone, cache))));
-    CHECK(packingKey(parsed(scenarioText(kEpsd, kNone, cache))) ==
-          packingKey(parsed(scenarioText(kNone, "", cache))));
-    CHECK(packingKey(parsed(scenarioText(kEpsd, "", cache))) !=
-          packingKey(parsed(scenarioText(kNone, "", cache))));
-    CHECK(packingKey(parsed(scenarioText(kNone, kEpsd, cache))) ==
-          packingKey(parsed(scenarioText(kEpsd, "", cache))));
+    CHECK(packingKey(parsedRolling(rollingScenarioText(kEpsd, kNone, cache))) ==
+          packingKey(parsedRolling(rollingScenarioText(kShape, kNone, cache))));
+    CHECK(packingKey(parsedRolling(rollingScenarioText(kEpsd, kNone, cache))) ==
+          packingKey(parsedRolling(rollingScenarioText(kNone, "", cache))));
+    CHECK(packingKey(parsedRolling(rollingScenarioText(kEpsd, "", cache))) !=
+          packingKey(parsedRolling(rollingScenarioText(kNone, "", cache))));
+    CHECK(packingKey(parsedRolling(rollingScenarioText(kNone, kEpsd, cache))) ==
+          packingKey(parsedRolling(rollingScenarioText(kEpsd, "", cache))));
     // A bad law there is reported at its key and line, like contact.rolling.
     try {
-        parsed(scenarioText(kNone, "{model: spheroid}", cache));
+        parsedRolling(rollingScenarioText(kNone, "{model: spheroid}", cache));
         FAIL("expected an error");
     } catch (const ConfigError &e) {
         const std::string msg = e.what();
@@ -102,7 +102,8 @@ TEST_CASE("deposition.rolling: several rolling laws run on one settled packing",
 
     // Settled under EPSD (its rolling springs loaded), run under grain shape with seed eq. 12.
     bool from_cache = true;
-    auto shaped = prepareSoil(parsed(scenarioText(kShape, kEpsd, cache.string())), 0.0, &from_cache);
+    auto shaped = prepareSoil(parsedRolling(rollingScenarioText(kShape, kEpsd, cache.string())),
+                              0.0, &from_cache);
     CHECK_FALSE(from_cache);
     REQUIRE(std::holds_alternative<RollingGrainShape>(shaped->law().rolling));
     // The settled EPSD contacts carried rolling moments; the new law starts from none of them.
@@ -119,23 +120,26 @@ TEST_CASE("deposition.rolling: several rolling laws run on one settled packing",
 
     // The same packing from the cache, for EPSD and for no rolling resistance: positions bit
     // for bit, each system with its own law, spheres' moments back where eq. 12 is not the law.
-    auto epsd = prepareSoil(parsed(scenarioText(kEpsd, kEpsd, cache.string())), 0.0, &from_cache);
+    auto epsd = prepareSoil(parsedRolling(rollingScenarioText(kEpsd, kEpsd, cache.string())), 0.0,
+                            &from_cache);
     CHECK(from_cache);
     CHECK(samePositions(shaped->particles(), epsd->particles()));
     CHECK(std::holds_alternative<RollingEpsd>(epsd->law().rolling));
-    auto none = prepareSoil(parsed(scenarioText(kNone, kEpsd, cache.string())), 0.0, &from_cache);
+    auto none = prepareSoil(parsedRolling(rollingScenarioText(kNone, kEpsd, cache.string())), 0.0,
+                            &from_cache);
     CHECK(from_cache);
     CHECK(samePositions(shaped->particles(), none->particles()));
     CHECK(none->particles().inertia[0].x() == sphereMoment(*none));
 
     // The cached packing does carry them: read without a switch, under EPSD (the same key).
-    auto settled = prepareSoil(parsed(scenarioText(kEpsd, "", cache.string())), 0.0, &from_cache);
+    auto settled = prepareSoil(parsedRolling(rollingScenarioText(kEpsd, "", cache.string())), 0.0,
+                               &from_cache);
     CHECK(from_cache);
     CHECK(contactsWithRollingHistory(*settled) > 100);
 
     // A cached grain-shape bed continues exactly as the freshly settled one.
-    auto shaped_cached =
-        prepareSoil(parsed(scenarioText(kShape, kEpsd, cache.string())), 0.0, &from_cache);
+    auto shaped_cached = prepareSoil(
+        parsedRolling(rollingScenarioText(kShape, kEpsd, cache.string())), 0.0, &from_cache);
     CHECK(from_cache);
     CHECK(contactsWithRollingHistory(*shaped_cached) == 0);
     shaped->run(400);

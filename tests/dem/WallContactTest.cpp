@@ -9,9 +9,6 @@ using namespace grainlink::dem::testing;
 
 namespace {
 
-const Material kMaterial = soil(1e7, 0.3, 2500.0);
-constexpr double kRadius = 0.005;
-
 /// The same boundary twice: the plane z = 0 or a flat mesh in z = 0 (nx x ny cells of 2 triangles).
 enum class Floor { Plane, Mesh };
 
@@ -33,7 +30,7 @@ Vec3 floorForce(const DemSystem& sys) {
 }
 
 /// Overlap of a grain resting on a wall of its own material under its weight.
-double restingOverlap(double weight_N) {
+double restingWallOverlap(double weight_N) {
     return std::pow(weight_N / (4.0 / 3.0 * effectiveModulus(kMaterial) * std::sqrt(kRadius)),
                     2.0 / 3.0);
 }
@@ -128,8 +125,9 @@ TEST_CASE("A flat mesh acts exactly like its plane for a sliding and rolling sph
             DemSystem plane = makeFloor(Floor::Plane, *law, settings);
             DemSystem mesh = makeFloor(Floor::Mesh, *law, settings, 0.2, 40);
             for (DemSystem* sys : {&plane, &mesh}) {
-                ParticleSpec s = sphere(path.start + Vec3(0, 0, kRadius - restingOverlap(weight)),
-                                        kRadius, kMaterial.density_kg_m3, path.velocity);
+                ParticleSpec s =
+                    sphere(path.start + Vec3(0, 0, kRadius - restingWallOverlap(weight)), kRadius,
+                           kMaterial.density_kg_m3, path.velocity);
                 s.angular_velocity_rad_s = path.spin;
                 sys->particles().add(s);
             }

@@ -2,6 +2,7 @@
 // hidden effect with its strength, claim nothing where there is no gap, and call an effect
 // outside the catalogue unexplained. The reference is the planted truth, not the code.
 #include "grainlink/gap/Diagnosis.hpp"
+#include "ShippedEffects.hpp"
 #include "grainlink/gap/Report.hpp"
 
 #include <catch2/catch.hpp>
@@ -16,8 +17,6 @@
 using namespace grainlink::gap;
 
 namespace {
-
-EffectCatalogue catalogue() { return loadEffects(GRAINLINK_SOURCE_DIR "/data/effects.yaml"); }
 
 /// Plate pressure of the analytic soil: Bekker-like p = k (1 + a / d) z^1.3 with a box factor,
 /// and each effect a change of its own shape.
@@ -144,7 +143,7 @@ public:
 Diagnosis run(const Truth &t, unsigned seed = 7,
               std::vector<std::string> held_out = {"large_90", "large_110", "small_90",
                                                    "small_110"}) {
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     AnalyticSimulator sim;
     DiagnosisOptions o;
     o.seeds = 4;
@@ -353,7 +352,7 @@ private:
 } // namespace
 
 TEST_CASE("diagnosis: failed simulations are never read as agreement", "[gap][diagnosis]") {
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     DiagnosisOptions o;
     o.seeds = 3;
     o.signature_seeds = 2;
@@ -378,7 +377,7 @@ TEST_CASE("diagnosis: failed simulations are never read as agreement", "[gap][di
 TEST_CASE("diagnosis: without a held-out experiment a gap is found but nothing is claimed, and "
           "it says why",
           "[gap][diagnosis]") {
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     AnalyticSimulator sim;
     DiagnosisOptions o;
     o.seeds = 4;
@@ -398,7 +397,7 @@ TEST_CASE("diagnosis: an effect whose runs failed is not fitted as if it agreed"
     // Every polydispersity run fails on the calibration plates: with their features missing its
     // chi^2 was 0 and it led the candidates. It must be left out, saying why, and the hidden
     // cohesion still named.
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     FailingEffectSimulator sim("polydispersity", {"large_50", "large_70"});
     DiagnosisOptions o;
     o.seeds = 4;
@@ -420,7 +419,7 @@ TEST_CASE("diagnosis: a candidate whose confirming runs failed is replaced by th
           "[gap][diagnosis]") {
     // The hidden cohesion leads; its confirming runs fail on a held-out plate. It is not
     // claimed, and one more candidate than otherwise is confirmed in its place.
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     DiagnosisOptions o;
     o.seeds = 4;
     o.signature_seeds = 3;

@@ -1,4 +1,5 @@
 #include "grainlink/gap/Effects.hpp"
+#include "ShippedEffects.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -29,13 +30,11 @@ bevameter:
   max_sinkage_m: 0.01
 )";
 
-EffectCatalogue catalogue() { return loadEffects(GRAINLINK_SOURCE_DIR "/data/effects.yaml"); }
-
 } // namespace
 
 TEST_CASE("the default catalogue holds the issue's effects, each with a prior and a signature",
           "[gap][effects]") {
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     for (const char *name :
          {"rolling_resistance", "grain_shape", "cohesion", "polydispersity", "grain_stiffness",
           "grain_density", "wall_friction", "domain_size", "tool_friction", "rig_compliance",
@@ -51,7 +50,7 @@ TEST_CASE("the default catalogue holds the issue's effects, each with a prior an
 
 TEST_CASE("effects resolve their off value against the base", "[gap][effects]") {
     const YAML::Node base = YAML::Load(kScenario);
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     CHECK(resolveAgainst(c.find("rolling_resistance"), base).prior.off == Approx(0.3));
     CHECK(resolveAgainst(c.find("cohesion"), base).prior.off == 0.0);
     // Walls without their own friction use the grains': tan 32 deg.
@@ -66,7 +65,7 @@ TEST_CASE("effects resolve their off value against the base", "[gap][effects]") 
 
 TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off", "[gap][effects]") {
     const YAML::Node base = YAML::Load(kScenario);
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     const YAML::Node stiff = applyEffect(c.find("grain_stiffness"), 4.0, base, ExperimentType::PlateSinkage);
     CHECK(stiff["soil"]["material"]["youngs_modulus_Pa"].as<double>() == Approx(4.0e7));
     CHECK(stiff["soil"]["contact"]["tangential"]["stiffness_N_m"].as<double>() == Approx(800.0));
@@ -116,7 +115,7 @@ TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off"
 TEST_CASE("a soft surface layer is a crust of softer grains in the prepared beds only",
           "[gap][effects]") {
     const YAML::Node base = YAML::Load(kScenario);
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     const Effect &layer = c.find("soft_surface_layer");
     CHECK(resolveAgainst(layer, base).prior.off == 1.0);
     const YAML::Node soft = applyEffect(layer, 0.2, base, ExperimentType::PlateSinkage);
@@ -133,7 +132,7 @@ TEST_CASE("a soft surface layer is a crust of softer grains in the prepared beds
 TEST_CASE("polydispersity keeps the mean radius and the solid volume; domain size the depth",
           "[gap][effects]") {
     const YAML::Node base = YAML::Load(kScenario);
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     const YAML::Node wide = applyEffect(c.find("polydispersity"), 0.3, base, ExperimentType::PlateSinkage);
     const YAML::Node r = wide["soil"]["deposition"]["radius"];
     const double lo = r["min_m"].as<double>(), hi = r["max_m"].as<double>();
@@ -161,7 +160,7 @@ TEST_CASE("polydispersity keeps the mean radius and the solid volume; domain siz
 
 TEST_CASE("measurement effects shift the simulated sinkage: a constant offset, or compliance x force",
           "[gap][effects]") {
-    const EffectCatalogue c = catalogue();
+    const EffectCatalogue c = shippedEffects();
     Experiment e;
     e.type = ExperimentType::PlateSinkage;
     e.numbers["plate_diameter_m"] = 0.1;

@@ -18,7 +18,7 @@ namespace {
 /// the test at a few seconds. Rolling resistance stands in for grain shape: frictional spheres
 /// without it fail under the plate at ~2 kPa (bearing capacity of a bed of low bulk friction)
 /// and p(z) then wanders on a plateau; with it p(z) rises throughout, as for real sand.
-const std::string kTiny =
+const std::string kTinyBevameter =
     "name: tiny-bevameter\n" + tinyBinSoil("0.05", "0.08", "2600") + R"(bevameter:
   plate_radii_m: [0.010, 0.013]
   speed_m_s: 0.1
@@ -28,19 +28,19 @@ const std::string kTiny =
   min_resolution: 5
 )";
 
-lab::BevameterScenario parse(const std::string &text) {
+lab::BevameterScenario parseBevameterText(const std::string &text) {
     return lab::parseBevameter(config::ConfigNode::loadString(text, "bevameter.yaml"));
 }
 
-std::string edited(const std::string &from, const std::string &to) {
-    return replacedOnce(kTiny, from, to);
+std::string editedBevameter(const std::string &from, const std::string &to) {
+    return replacedOnce(kTinyBevameter, from, to);
 }
 
 } // namespace
 
 TEST_CASE("Bevameter on a tiny bed: pressure grows with sinkage for both plates, Bekker fits",
           "[lab][bevameter][slow]") {
-    const auto result = lab::runBevameter(parse(kTiny), {});
+    const auto result = lab::runBevameter(parseBevameterText(kTinyBevameter), {});
     INFO(result.report());
     REQUIRE(result.runs.size() == 2);
     for (const auto &plate : result.runs) {
@@ -80,12 +80,15 @@ TEST_CASE("Bevameter on a tiny bed: pressure grows with sinkage for both plates,
 
 TEST_CASE("Bevameter input errors name the key and the line", "[lab][bevameter]") {
     // Gamma = R / r_max below the required resolution.
-    CHECK_THROWS_WITH(parse(edited("min_resolution: 5", "min_resolution: 10")),
-                      Contains("bevameter.yaml:20:") && Contains("bevameter.plate_radii_m") &&
-                          Contains("Gamma = 6.66"));
-    CHECK_THROWS_WITH(parse(edited("speed_m_s: 0.1", "speed_m_s: -0.1")),
+    CHECK_THROWS_WITH(
+        parseBevameterText(editedBevameter("min_resolution: 5", "min_resolution: 10")),
+        Contains("bevameter.yaml:20:") && Contains("bevameter.plate_radii_m") &&
+            Contains("Gamma = 6.66"));
+    CHECK_THROWS_WITH(parseBevameterText(editedBevameter("speed_m_s: 0.1", "speed_m_s: -0.1")),
                       Contains("bevameter.speed_m_s") && Contains("must be > 0"));
-    CHECK_THROWS_WITH(parse(edited("  min_resolution: 5\n", "  min_resolution: 5\n  depth_m: 1\n")),
+    CHECK_THROWS_WITH(parseBevameterText(editedBevameter("  min_resolution: 5\n",
+                                                         "  min_resolution: 5\n  depth_m: 1\n")),
                       Contains("unknown key 'bevameter.depth_m'"));
-    CHECK_THROWS_WITH(parse(edited("max_sinkage_m", "max_sinkage_mm")), Contains("wrong unit"));
+    CHECK_THROWS_WITH(parseBevameterText(editedBevameter("max_sinkage_m", "max_sinkage_mm")),
+                      Contains("wrong unit"));
 }

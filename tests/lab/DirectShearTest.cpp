@@ -14,19 +14,17 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-lab::DirectShearScenario parse(const std::string &text) {
+lab::DirectShearScenario parseShearBoxText(const std::string &text) {
     return lab::parseDirectShear(config::ConfigNode::loadString(text, "direct_shear.yaml"));
 }
 
-std::string edited(const std::string &from, const std::string &to) {
+std::string editedShearBox(const std::string &from, const std::string &to) {
     return replacedOnce(kTinyShearBox, from, to);
 }
 
-std::string errorOf(const std::string &text) {
+std::string shearBoxError(const std::string &text) {
     try {
-        parse(text);
+        parseShearBoxText(text);
     } catch (const std::exception &e) {
         return e.what();
     }
@@ -39,7 +37,7 @@ TEST_CASE("Mohr-Coulomb fit recovers c and psi exactly from points on a line",
           "[lab][direct_shear]") {
     // Points exactly on tau = 1500 Pa + sigma tan 31 deg: least squares must return the line
     // to rounding (1e-9 relative) and zero standard errors (residuals ~1e-12 Pa).
-    const double c = 1500.0, psi = 31.0, slope = std::tan(psi * kPi / 180.0);
+    const double c = 1500.0, psi = 31.0, slope = std::tan(psi * M_PI / 180.0);
     std::vector<double> sigma{5000, 10000, 15000, 20000}, tau;
     for (double s : sigma)
         tau.push_back(c + s * slope);
@@ -70,8 +68,8 @@ TEST_CASE("Mohr-Coulomb fit: standard errors as the textbook line fit", "[lab][d
     std::vector<double> tau{1000 + 500 + e, 1000 + 1000 - e, 1000 + 1500 - e, 1000 + 2000 + e};
     const auto fit = lab::fitMohrCoulomb(sigma, tau, true);
     const double se_slope = std::sqrt(4 * e * e / 2) / std::sqrt(5e6);
-    CHECK(fit.friction_angle_deg == Approx(std::atan(0.5) * 180 / kPi).epsilon(1e-9));
-    CHECK(fit.friction_angle_se_deg == Approx(se_slope / 1.25 * 180 / kPi).epsilon(1e-9));
+    CHECK(fit.friction_angle_deg == Approx(std::atan(0.5) * 180 / M_PI).epsilon(1e-9));
+    CHECK(fit.friction_angle_se_deg == Approx(se_slope / 1.25 * 180 / M_PI).epsilon(1e-9));
     CHECK(fit.friction_angle_half_width_95_deg ==
           Approx(4.30265273 * fit.friction_angle_se_deg).epsilon(1e-9));
     CHECK(fit.cohesion_Pa == Approx(1000.0).epsilon(1e-9));
@@ -81,22 +79,26 @@ TEST_CASE("Mohr-Coulomb fit: standard errors as the textbook line fit", "[lab][d
 }
 
 TEST_CASE("Direct shear input errors name the key", "[lab][direct_shear]") {
-    CHECK_NOTHROW(parse(kTinyShearBox));
-    CHECK_THAT(errorOf(edited("  packing_cache_directory: \"\"\n",
-                              "  packing_cache_directory: \"\"\n  walls: []\n")),
+    CHECK_NOTHROW(parseShearBoxText(kTinyShearBox));
+    CHECK_THAT(shearBoxError(editedShearBox("  packing_cache_directory: \"\"\n",
+                                            "  packing_cache_directory: \"\"\n  walls: []\n")),
                Contains("remove soil.walls"));
-    CHECK_THAT(errorOf(edited("max_displacement_m: 0.003", "max_displacement_m: 0.02")),
-               Contains("max_displacement_m") && Contains("half the box length"));
-    CHECK_THAT(errorOf(edited("upper_m: [0.03, 0.03, 0.1]", "upper_m: [0.04, 0.03, 0.1]")),
-               Contains("deposition") && Contains("inside the box"));
-    CHECK_THAT(errorOf(edited("max_speed_m_s: 0.05, ", "")), Contains("max_speed_m_s"));
-    CHECK_THAT(errorOf(edited("fit_cohesion: false", "fit_cohesion: false\n  speed: 1")),
-               Contains("speed"));
+    CHECK_THAT(
+        shearBoxError(editedShearBox("max_displacement_m: 0.003", "max_displacement_m: 0.02")),
+        Contains("max_displacement_m") && Contains("half the box length"));
+    CHECK_THAT(
+        shearBoxError(editedShearBox("upper_m: [0.03, 0.03, 0.1]", "upper_m: [0.04, 0.03, 0.1]")),
+        Contains("deposition") && Contains("inside the box"));
+    CHECK_THAT(shearBoxError(editedShearBox("max_speed_m_s: 0.05, ", "")),
+               Contains("max_speed_m_s"));
+    CHECK_THAT(
+        shearBoxError(editedShearBox("fit_cohesion: false", "fit_cohesion: false\n  speed: 1")),
+        Contains("speed"));
 }
 
 TEST_CASE("Direct shear on a tiny box: the servo holds sigma and strength grows with it",
           "[lab][direct_shear][dem][slow]") {
-    const auto scenario = parse(kTinyShearBox);
+    const auto scenario = parseShearBoxText(kTinyShearBox);
     const auto result = lab::runDirectShear(scenario, {});
     REQUIRE(result.runs.size() == 2);
     for (const auto &run : result.runs) {
@@ -156,12 +158,13 @@ TEST_CASE("Direct shear: the servo's integral term removes the dilation lag",
     auto text =
         replacedOnce(kTinyShearBox, "    seed: 3\n", "    seed: 3\n    rolling: {model: none}\n");
     text = replacedOnce(text, "normal_stresses_Pa: [4000, 12000]", "normal_stresses_Pa: [4000]");
-    const auto scenario = parse(text);
+    const auto scenario = parseShearBoxText(text);
     const auto proportional = lab::runDirectShear(scenario, {});
-    const auto integral = lab::runDirectShear(
-        parse(replacedOnce(text, "control_interval_s: 0.00025}",
-                           "control_interval_s: 0.00025, integral_gain_m_s2_per_N: 0.5}")),
-        {});
+    const auto integral =
+        lab::runDirectShear(parseShearBoxText(replacedOnce(
+                                text, "control_interval_s: 0.00025}",
+                                "control_interval_s: 0.00025, integral_gain_m_s2_per_N: 0.5}")),
+                            {});
     REQUIRE(proportional.runs.size() == 1);
     REQUIRE(integral.runs.size() == 1);
     // Mean relative load error and the proportional lag rise / (T g N_target) of a run.
@@ -213,16 +216,16 @@ TEST_CASE("Direct shear: frictionless spheres are much weaker than phi = 30 deg 
         REQUIRE(result.runs.size() == 1);
         const auto &run = result.runs[0];
         return std::atan(run.residual_shear_stress_Pa / run.residual_normal_stress_Pa) * 180.0 /
-               kPi;
+               M_PI;
     };
     double rough = 0.0, smooth = 0.0;
     for (const char *seed : {"seed: 3", "seed: 4"}) {
-        auto text = edited("seed: 3", seed);
+        auto text = editedShearBox("seed: 3", seed);
         text =
             replacedOnce(text, "normal_stresses_Pa: [4000, 12000]", "normal_stresses_Pa: [4000]");
-        const double r = residualAngle(lab::runDirectShear(parse(text), {}));
-        const double s = residualAngle(
-            lab::runDirectShear(parse(replacedOnce(text, smooth_edit_from, smooth_edit_to)), {}));
+        const double r = residualAngle(lab::runDirectShear(parseShearBoxText(text), {}));
+        const double s = residualAngle(lab::runDirectShear(
+            parseShearBoxText(replacedOnce(text, smooth_edit_from, smooth_edit_to)), {}));
         WARN(seed << ": residual psi rough " << r << " deg, smooth " << s << " deg");
         rough += 0.5 * r;
         smooth += 0.5 * s;

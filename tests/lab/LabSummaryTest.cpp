@@ -21,7 +21,6 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
 const double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 /// A summary with a fit, a NaN, a run value and two curves; 0.1 and 1/3 need all 17 digits.
@@ -135,8 +134,8 @@ TEST_CASE("Bed summary: a simple cubic packing has packing fraction pi / 6", "[l
     const lab::LabBedSummary bed = lab::measureBed(system, soil, {400 * r * r, 0.0});
     CHECK(bed.grains == 500);
     CHECK(bed.surface_m == Approx(10 * r).epsilon(1e-12));
-    CHECK(bed.packing_fraction == Approx(kPi / 6.0).epsilon(1e-12));
-    CHECK(bed.bulk_density_kg_m3 == Approx(2500.0 * kPi / 6.0).epsilon(1e-12));
+    CHECK(bed.packing_fraction == Approx(M_PI / 6.0).epsilon(1e-12));
+    CHECK(bed.bulk_density_kg_m3 == Approx(2500.0 * M_PI / 6.0).epsilon(1e-12));
     CHECK(bed.seed == 7);
 }
 

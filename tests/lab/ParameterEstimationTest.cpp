@@ -13,8 +13,6 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// The seed's Table 1 soil with its given E: wheel with 15 mm grousers at Gamma = 3; the
 /// pressure is the normal load 8.33 kg over a 125 mm x 60 mm contact patch (~10.9 kPa).
 const char *kTable1 = R"(soil:
@@ -36,12 +34,12 @@ model:
   youngs_modulus_Pa: 3.0e6
 )";
 
-lab::SoilTestDescription parse(const std::string &text) {
+lab::SoilTestDescription parseDescription(const std::string &text) {
     return lab::parseSoilTestDescription(config::ConfigNode::loadString(text, "params.yaml"));
 }
 
 /// kTable1 with one line replaced (`from` must occur).
-std::string edited(const std::string &from, const std::string &to) {
+std::string editedTable1(const std::string &from, const std::string &to) {
     std::string text = kTable1;
     const auto at = text.find(from);
     REQUIRE(at != std::string::npos);
@@ -53,7 +51,7 @@ std::string edited(const std::string &from, const std::string &to) {
 TEST_CASE("Seed Table 1: Gamma = 3 on 15 mm grousers gives r = 2.5 mm and a stable step above "
           "5e-5 s for E = 3e6 Pa, rho = 2400",
           "[lab][params]") {
-    const auto m = lab::estimateParameters(parse(kTable1));
+    const auto m = lab::estimateParameters(parseDescription(kTable1));
     // Eq. 11: r_max = L_min / (2 Gamma) = 15 mm / 6; exact arithmetic, rounding only.
     CHECK(m.radius_max_m == Approx(2.5e-3).epsilon(1e-12));
     // Rayleigh time of a 2.5 mm grain of E = 3 MPa, nu = 0.2, rho = 2400 worked by hand
@@ -95,7 +93,7 @@ TEST_CASE("Seed Table 1: Gamma = 3 on 15 mm grousers gives r = 2.5 mm and a stab
 TEST_CASE("Eq. 10: the weight term is a cubic column's weight and Hertz at a_max carries F_max "
           "with the minimum Young's modulus",
           "[lab][params]") {
-    auto d = parse(kTable1);
+    auto d = parseDescription(kTable1);
     d.youngs_modulus_Pa.reset();
 
     SECTION("weight of a cubic-lattice column, no plate load") {
@@ -104,7 +102,7 @@ TEST_CASE("Eq. 10: the weight term is a cubic column's weight and Hertz at a_max
         const double r = m.radius_min_m, z_h = d.bed_height_m - d.expected_sinkage_m;
         // z_h / (2 r) grains of (4/3) pi r^3 rho g stacked: independent arithmetic, 1e-12.
         const double column =
-            z_h / (2.0 * r) * 4.0 / 3.0 * kPi * r * r * r * d.grain_density_kg_m3 * d.gravity_m_s2;
+            z_h / (2.0 * r) * 4.0 / 3.0 * M_PI * r * r * r * d.grain_density_kg_m3 * d.gravity_m_s2;
         CHECK(m.worst_contact_force_N == Approx(column).epsilon(1e-12));
     }
     SECTION("Hertz at the allowed overlap carries the worst-case force") {
@@ -140,7 +138,7 @@ TEST_CASE("Eq. 10: the weight term is a cubic column's weight and Hertz at a_max
 }
 
 TEST_CASE("Eq. 12: inertia of the virtual grain", "[lab][params]") {
-    auto d = parse(kTable1);
+    auto d = parseDescription(kTable1);
     d.aspect_ratios = Eigen::Vector3d(1.0, 2.0, 0.5);
     const auto m = lab::estimateParameters(d);
     // J_i = (1/9) pi rho r^3 (r/A_i)^2: for A = 1 it is 15/72 of a solid sphere's (8/15) pi rho
@@ -152,10 +150,10 @@ TEST_CASE("Eq. 12: inertia of the virtual grain", "[lab][params]") {
 
 TEST_CASE("The printed soil block is a valid grainlink soil section with the derived values",
           "[lab][params]") {
-    auto d = parse(kTable1);
+    auto d = parseDescription(kTable1);
     d.youngs_modulus_Pa.reset();
     const auto m = lab::estimateParameters(d);
-    // The user adds bed geometry; the block must parse as it is printed.
+    // The user adds bed geometry; the block must parseDescription as it is printed.
     const std::string text = lab::soilBlock(m) + R"(  deposition:
     region: {lower_m: [0, 0, 0], upper_m: [0.05, 0.05, 0.05]}
     count: 10
@@ -178,26 +176,30 @@ TEST_CASE("The printed soil block is a valid grainlink soil section with the der
 }
 
 TEST_CASE("Bad params input: errors name the key and the line", "[lab][params]") {
-    CHECK_THROWS_WITH(parse(edited("  tool_size_m: 0.015\n", "")),
+    CHECK_THROWS_WITH(parseDescription(editedTable1("  tool_size_m: 0.015\n", "")),
                       Contains("missing key 'test.tool_size_m'"));
-    CHECK_THROWS_WITH(parse(edited("expected_pressure_Pa", "expected_pressure_kPa")),
-                      Contains("params.yaml:8:") && Contains("wrong unit"));
     CHECK_THROWS_WITH(
-        parse(edited("  damping_fraction: 0.1\n", "  damping_fraction: 0.1\n  dampnig_ratio: 2\n")),
+        parseDescription(editedTable1("expected_pressure_Pa", "expected_pressure_kPa")),
+        Contains("params.yaml:8:") && Contains("wrong unit"));
+    CHECK_THROWS_WITH(
+        parseDescription(editedTable1("  damping_fraction: 0.1\n",
+                                      "  damping_fraction: 0.1\n  dampnig_ratio: 2\n")),
         Contains("params.yaml:17:") && Contains("unknown key 'model.dampnig_ratio'"));
-    CHECK_THROWS_WITH(parse(edited("max_overlap_ratio: 0.05", "max_overlap_ratio: 1.5")),
-                      Contains("params.yaml:15:") && Contains("model.max_overlap_ratio") &&
-                          Contains("(0, 1)"));
-    CHECK_THROWS_WITH(parse(edited("slip_angle_deg: 30", "slip_angle_deg: 35")),
+    CHECK_THROWS_WITH(
+        parseDescription(editedTable1("max_overlap_ratio: 0.05", "max_overlap_ratio: 1.5")),
+        Contains("params.yaml:15:") && Contains("model.max_overlap_ratio") && Contains("(0, 1)"));
+    CHECK_THROWS_WITH(parseDescription(editedTable1("slip_angle_deg: 30", "slip_angle_deg: 35")),
                       Contains("soil.slip_angle_deg") && Contains("[0, 32]"));
-    CHECK_THROWS_WITH(parse(edited("expected_sinkage_m: 0.02", "expected_sinkage_m: 0.3")),
-                      Contains("test.expected_sinkage_m"));
-    CHECK_THROWS_WITH(parse(edited("grain_density_kg_m3: 2400", "grain_density_kg_m3: -1")),
-                      Contains("soil.grain_density_kg_m3"));
-    CHECK_THROWS_WITH(parse(edited("resolution: 3", "resolution: three")),
+    CHECK_THROWS_WITH(
+        parseDescription(editedTable1("expected_sinkage_m: 0.02", "expected_sinkage_m: 0.3")),
+        Contains("test.expected_sinkage_m"));
+    CHECK_THROWS_WITH(
+        parseDescription(editedTable1("grain_density_kg_m3: 2400", "grain_density_kg_m3: -1")),
+        Contains("soil.grain_density_kg_m3"));
+    CHECK_THROWS_WITH(parseDescription(editedTable1("resolution: 3", "resolution: three")),
                       Contains("model.resolution") && Contains("expected a number"));
     // Programmatic use is checked too.
-    auto d = parse(kTable1);
+    auto d = parseDescription(kTable1);
     d.poisson_ratio = 0.5;
     CHECK_THROWS_WITH(lab::estimateParameters(d), Contains("poisson_ratio"));
 }

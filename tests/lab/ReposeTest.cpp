@@ -14,16 +14,12 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
-const std::string &kTiny = kTinyRepose;
-
-lab::ReposeScenario parse(const std::string &text) {
+lab::ReposeScenario parseReposeText(const std::string &text) {
     return lab::parseRepose(config::ConfigNode::loadString(text, "repose.yaml"));
 }
 
-std::string edited(const std::string &from, const std::string &to) {
-    return replacedOnce(kTiny, from, to);
+std::string editedRepose(const std::string &from, const std::string &to) {
+    return replacedOnce(kTinyRepose, from, to);
 }
 
 } // namespace
@@ -32,7 +28,7 @@ TEST_CASE("Heap measurement recovers the angle of a packed cone", "[lab][repose]
     // Grains of r = 1 mm on a simple cubic lattice filling a cone of 30 deg, 40 mm high, on the
     // floor. The profile's bin maxima follow the cone to within a lattice step, so the fitted
     // angle must be 30 deg within 1.5 deg (lattice steps over a ~40 mm flank).
-    const double r = 0.001, angle = 30.0 * kPi / 180.0, height = 0.04;
+    const double r = 0.001, angle = 30.0 * M_PI / 180.0, height = 0.04;
     std::vector<Eigen::Vector3d> positions;
     std::vector<double> radii;
     for (double x = -0.08; x <= 0.08; x += 2 * r)
@@ -96,12 +92,12 @@ TEST_CASE("Angle of repose: more rolling resistance builds a steeper heap", "[la
     Mean steep, flat;
     const char *seeds[] = {"seed: 1", "seed: 2", "seed: 4"};
     for (const char *seed : seeds) {
-        const std::string text = edited("seed: 3", seed);
-        const auto s = lab::runRepose(parse(text), {});
-        const auto f =
-            lab::runRepose(parse(replacedOnce(text, "rolling: {model: epsd, coefficient: 0.3}",
-                                              "rolling: {model: epsd, coefficient: 0.1}")),
-                           {});
+        const std::string text = editedRepose("seed: 3", seed);
+        const auto s = lab::runRepose(parseReposeText(text), {});
+        const auto f = lab::runRepose(
+            parseReposeText(replacedOnce(text, "rolling: {model: epsd, coefficient: 0.3}",
+                                         "rolling: {model: epsd, coefficient: 0.1}")),
+            {});
         WARN(seed << "\n" << s.report() << f.report());
         steep.angle_deg += s.angle_deg / 3.0;
         steep.half_width_sq += s.angle_half_width_95_deg * s.angle_half_width_95_deg / 9.0;
@@ -119,10 +115,11 @@ TEST_CASE("Angle of repose: more rolling resistance builds a steeper heap", "[la
 }
 
 TEST_CASE("Repose input errors name the key and the line", "[lab][repose]") {
-    CHECK_THROWS_WITH(parse(edited("tube_radius_m: 0.021", "tube_radius_m: 0.015")),
+    CHECK_THROWS_WITH(parseReposeText(editedRepose("tube_radius_m: 0.021", "tube_radius_m: 0.015")),
                       Contains("repose.yaml:19:") && Contains("repose.tube_radius_m") &&
                           Contains("inside the tube"));
-    CHECK_THROWS_WITH(parse(edited("lift_speed_m_s: 0.1", "lift_speed_m_s: 0")),
+    CHECK_THROWS_WITH(parseReposeText(editedRepose("lift_speed_m_s: 0.1", "lift_speed_m_s: 0")),
                       Contains("repose.lift_speed_m_s") && Contains("must be > 0"));
-    CHECK_THROWS_WITH(parse(edited("tube_height_m", "tube_height_mm")), Contains("wrong unit"));
+    CHECK_THROWS_WITH(parseReposeText(editedRepose("tube_height_m", "tube_height_mm")),
+                      Contains("wrong unit"));
 }

@@ -16,13 +16,11 @@ using Catch::Matchers::Contains;
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-
 /// A tiny bed: 2300 grains of 1.5 mm radius in a 60 mm box (~15 mm deep); an annulus of 12 and
 /// 22 mm radius with eight 3 mm grousers (Gamma = width / grain diameter = 3.3 instead of the
 /// seed's 10, min_resolution lowered, to keep each run at a few seconds), turned at 4 rad/s to
 /// j = 12 mm (0.7 rad). Rolling resistance stands in for grain shape, as in the bevameter test.
-const std::string kTiny =
+const std::string kTinyAnnulus =
     "name: tiny-shear\n" + tinyBinSoil("0.06", "0.04", "2300") + R"(bevameter_shear:
   inner_radius_m: 0.012
   outer_radius_m: 0.022
@@ -37,12 +35,12 @@ const std::string kTiny =
   min_resolution: 3
 )";
 
-lab::ShearAnnulusScenario parse(const std::string &text) {
+lab::ShearAnnulusScenario parseAnnulusText(const std::string &text) {
     return lab::parseShearAnnulus(config::ConfigNode::loadString(text, "shear.yaml"));
 }
 
-std::string edited(const std::string &from, const std::string &to) {
-    return replacedOnce(kTiny, from, to);
+std::string editedAnnulus(const std::string &from, const std::string &to) {
+    return replacedOnce(kTinyAnnulus, from, to);
 }
 
 /// Mean shear stress of the samples with j in [from, to) x j_max.
@@ -59,9 +57,9 @@ double meanStress(const lab::ShearRun &run, double from, double to, double j_max
 }
 
 /// tau(j) curves from known parameters, 60 points each to j = 10 mm, Gaussian noise.
-std::vector<lab::ShearCurve> synthetic(const lab::JanosiParameters &p,
-                                       const std::vector<double> &pressures, double noise_Pa,
-                                       unsigned seed) {
+std::vector<lab::ShearCurve> syntheticShearCurves(const lab::JanosiParameters &p,
+                                                  const std::vector<double> &pressures,
+                                                  double noise_Pa, unsigned seed) {
     std::mt19937 random(seed);
     std::normal_distribution<double> noise(0.0, noise_Pa);
     std::vector<lab::ShearCurve> curves;
@@ -102,7 +100,7 @@ TEST_CASE("Shear annulus mesh is closed, wound outward, with the expected volume
         volume +=
             mesh.vertices_m[t[0]].dot(mesh.vertices_m[t[1]].cross(mesh.vertices_m[t[2]])) / 6.0;
     const double n = g.ring_segments;
-    const double ring = 0.5 * n * std::sin(2 * kPi / n) * (0.05 * 0.05 - 0.03 * 0.03) * 0.005;
+    const double ring = 0.5 * n * std::sin(2 * M_PI / n) * (0.05 * 0.05 - 0.03 * 0.03) * 0.005;
     const double grousers = 6 * 0.02 * 0.002 * (0.004 + 0.0025);
     CHECK(volume == Approx(ring + grousers).epsilon(1e-12));
     // The grouser tips are the lowest points, at -h; the ring's top at t.
@@ -114,12 +112,13 @@ TEST_CASE("Shear annulus mesh is closed, wound outward, with the expected volume
     CHECK(z_min == Approx(-0.004).epsilon(1e-12));
     CHECK(z_max == Approx(0.005).epsilon(1e-12));
     // Area and torque factor, closed forms (physics.md §12.12).
-    CHECK(g.area_m2() == Approx(kPi * (0.0025 - 0.0009)).epsilon(1e-14));
-    CHECK(g.torqueFactor_m3() == Approx(2 * kPi / 3 * (1.25e-4 - 2.7e-5)).epsilon(1e-14));
+    CHECK(g.area_m2() == Approx(M_PI * (0.0025 - 0.0009)).epsilon(1e-14));
+    CHECK(g.torqueFactor_m3() == Approx(2 * M_PI / 3 * (1.25e-4 - 2.7e-5)).epsilon(1e-14));
     CHECK(g.meanRadius_m() == Approx(0.04).epsilon(1e-14));
 }
 
-TEST_CASE("Janosi fit recovers c, phi and K from synthetic curves", "[lab][shear_annulus]") {
+TEST_CASE("Janosi fit recovers c, phi and K from syntheticShearCurves curves",
+          "[lab][shear_annulus]") {
     lab::JanosiParameters truth;
     truth.cohesion_Pa = 800.0;
     truth.friction_angle_deg = 31.0;
@@ -127,7 +126,7 @@ TEST_CASE("Janosi fit recovers c, phi and K from synthetic curves", "[lab][shear
     const std::vector<double> pressures{2000.0, 4000.0, 8000.0};
 
     SECTION("noise-free: exact to 1e-6 (Levenberg-Marquardt's tolerance, far below any use)") {
-        const auto fit = lab::fitJanosi(synthetic(truth, pressures, 0.0, 1));
+        const auto fit = lab::fitJanosi(syntheticShearCurves(truth, pressures, 0.0, 1));
         CHECK(fit.parameters.cohesion_Pa == Approx(800.0).epsilon(1e-6));
         CHECK(fit.parameters.friction_angle_deg == Approx(31.0).epsilon(1e-6));
         CHECK(fit.parameters.shear_modulus_m == Approx(0.0015).epsilon(1e-6));
@@ -143,7 +142,7 @@ TEST_CASE("Janosi fit recovers c, phi and K from synthetic curves", "[lab][shear
         // is 1 / sqrt(2 x 177) = 5.3 %, so 20 % is 3.8 standard deviations).
         int misses[3] = {0, 0, 0};
         for (unsigned seed = 1; seed <= 100; ++seed) {
-            const auto fit = lab::fitJanosi(synthetic(truth, pressures, 50.0, seed));
+            const auto fit = lab::fitJanosi(syntheticShearCurves(truth, pressures, 50.0, seed));
             const double est[3] = {fit.parameters.cohesion_Pa, fit.parameters.friction_angle_deg,
                                    fit.parameters.shear_modulus_m};
             const double tru[3] = {800.0, 31.0, 0.0015};
@@ -157,7 +156,7 @@ TEST_CASE("Janosi fit recovers c, phi and K from synthetic curves", "[lab][shear
         }
     }
     SECTION("one normal pressure cannot separate c and phi: refused") {
-        CHECK_THROWS_WITH(lab::fitJanosi(synthetic(truth, {4000.0}, 0.0, 1)),
+        CHECK_THROWS_WITH(lab::fitJanosi(syntheticShearCurves(truth, {4000.0}, 0.0, 1)),
                           Contains("two or more normal pressures"));
     }
 }
@@ -165,7 +164,7 @@ TEST_CASE("Janosi fit recovers c, phi and K from synthetic curves", "[lab][shear
 TEST_CASE("Shear annulus on a tiny bed: load held, tau(j) rises and saturates, higher sigma "
           "gives higher tau_max",
           "[lab][shear_annulus][slow]") {
-    const auto scenario = parse(kTiny);
+    const auto scenario = parseAnnulusText(kTinyAnnulus);
     const auto result = lab::runShearAnnulus(scenario, {});
     INFO(result.report());
     REQUIRE(result.runs.size() == 2);
@@ -208,10 +207,10 @@ TEST_CASE("Shear annulus: frictionless grains carry a much smaller tau_max than 
     // pushing grains aside. Written: 195 Pa against 735 Pa (ratio 0.26); required below 0.6,
     // which a frictionless bed that still carried 60 % of the frictional strength would fail.
     auto one = [](const std::string &text) {
-        auto scenario = parse(text);
+        auto scenario = parseAnnulusText(text);
         return lab::runShearAnnulus(scenario, {}).runs.at(0).max_shear_stress_Pa;
     };
-    const std::string frictional = edited("[1000, 2000]", "[1000]");
+    const std::string frictional = editedAnnulus("[1000, 2000]", "[1000]");
     const std::string frictionless =
         replacedOnce(replacedOnce(frictional, "stick_angle_deg: 32, slip_angle_deg: 30",
                                   "stick_angle_deg: 0, slip_angle_deg: 0"),
@@ -222,16 +221,17 @@ TEST_CASE("Shear annulus: frictionless grains carry a much smaller tau_max than 
 }
 
 TEST_CASE("Shear annulus input errors name the key and the line", "[lab][shear_annulus]") {
-    CHECK_THROWS_WITH(parse(edited("min_resolution: 3", "min_resolution: 5")),
+    CHECK_THROWS_WITH(parseAnnulusText(editedAnnulus("min_resolution: 3", "min_resolution: 5")),
                       Contains("shear.yaml:21:") && Contains("bevameter_shear.outer_radius_m") &&
                           Contains("Gamma = 3.33"));
-    CHECK_THROWS_WITH(parse(edited("outer_radius_m: 0.022", "outer_radius_m: 0.010")),
-                      Contains("bevameter_shear.outer_radius_m") &&
-                          Contains("must exceed inner_radius_m"));
-    CHECK_THROWS_WITH(parse(edited("[1000, 2000]", "[1000, -5]")),
+    CHECK_THROWS_WITH(
+        parseAnnulusText(editedAnnulus("outer_radius_m: 0.022", "outer_radius_m: 0.010")),
+        Contains("bevameter_shear.outer_radius_m") && Contains("must exceed inner_radius_m"));
+    CHECK_THROWS_WITH(parseAnnulusText(editedAnnulus("[1000, 2000]", "[1000, -5]")),
                       Contains("bevameter_shear.normal_pressures_Pa") && Contains("> 0"));
-    CHECK_THROWS_WITH(parse(edited("gain_m_s_per_N: 0.1, ", "")),
+    CHECK_THROWS_WITH(parseAnnulusText(editedAnnulus("gain_m_s_per_N: 0.1, ", "")),
                       Contains("missing key 'bevameter_shear.servo.gain_m_s_per_N'"));
-    CHECK_THROWS_WITH(parse(edited("  min_resolution: 3\n", "  min_resolution: 3\n  torque: 1\n")),
+    CHECK_THROWS_WITH(parseAnnulusText(editedAnnulus("  min_resolution: 3\n",
+                                                     "  min_resolution: 3\n  torque: 1\n")),
                       Contains("unknown key 'bevameter_shear.torque'"));
 }

@@ -18,8 +18,9 @@ namespace {
 
 /// A tiny bin 200 x 50 mm, ~30 mm of 2.5 mm grains (the tiny beds' contacts); a smooth wheel
 /// 60 mm across and 30 mm wide (Gamma = 6) under 2 N, its carriage at 0.12 m/s over 60 mm.
-const std::string kTiny = "name: tiny-wheel\nsoil:\n  simulation: {time_step_s: 5.0e-5, threads: 1}\n" +
-                          kTinyGrainContacts + R"(  walls:
+const std::string kTinyWheel =
+    "name: tiny-wheel\nsoil:\n  simulation: {time_step_s: 5.0e-5, threads: 1}\n" +
+    kTinyGrainContacts + R"(  walls:
     - {name: bin, type: box, lower_m: [0, 0, 0], upper_m: [0.2, 0.05, 0.2]}
   deposition:
     region: {lower_m: [0, 0, 0], upper_m: [0.2, 0.05, 0.07]}
@@ -39,7 +40,7 @@ wheel:
   sample_interval_s: 0.001
 )";
 
-lab::WheelScenario parse(const std::string &text) {
+lab::WheelScenario parseWheelText(const std::string &text) {
     return lab::parseWheel(config::ConfigNode::loadString(text, "wheel.yaml"));
 }
 
@@ -58,7 +59,7 @@ TEST_CASE("wheel: the rim speed of a slip, driven, braked and locked, by hand", 
 TEST_CASE("wheel: a braked wheel is pushed back, a driven one pulls, the servo holds the load and "
           "the motor's power covers the drawbar's",
           "[lab][wheel][slow]") {
-    const lab::WheelScenario s = parse(kTiny);
+    const lab::WheelScenario s = parseWheelText(kTinyWheel);
     const lab::WheelResult r = lab::runWheel(s, {});
     REQUIRE(r.runs.size() == 3);
     const lab::WheelRun &braked = r.runs[0], &rolling = r.runs[1], &driven = r.runs[2];
@@ -96,16 +97,18 @@ TEST_CASE("wheel: a braked wheel is pushed back, a driven one pulls, the servo h
 }
 
 TEST_CASE("wheel: bad input names the file, the key and the line", "[lab][wheel]") {
-    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "slips: [-0.4, 0.0, 0.5]", "slips: [0.2, 1.0]")),
-                      Contains("wheel.yaml:") && Contains("wheel.slips[1]") && Contains("[-1, 1)"));
-    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "travel_m: 0.06", "travel_m: 0.5")),
+    CHECK_THROWS_WITH(
+        parseWheelText(replacedOnce(kTinyWheel, "slips: [-0.4, 0.0, 0.5]", "slips: [0.2, 1.0]")),
+        Contains("wheel.yaml:") && Contains("wheel.slips[1]") && Contains("[-1, 1)"));
+    CHECK_THROWS_WITH(parseWheelText(replacedOnce(kTinyWheel, "travel_m: 0.06", "travel_m: 0.5")),
                       Contains("wheel.travel_m") && Contains("can travel at most"));
-    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "width_m: 0.03", "width_m: 0.01")),
+    CHECK_THROWS_WITH(parseWheelText(replacedOnce(kTinyWheel, "width_m: 0.03", "width_m: 0.01")),
                       Contains("wheel.shape.width_m") && Contains("min_resolution"));
-    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "{diameter_m: 0.06, width_m: 0.03}",
-                                         "{diameter_m: 0.06, width_m: 0.03, grouser_height_m: 0.005}")),
-                      Contains("grouser_count 0"));
-    CHECK_THROWS_WITH(parse(replacedOnce(kTiny, "load_N: 2", "load_N: 0")),
+    CHECK_THROWS_WITH(
+        parseWheelText(replacedOnce(kTinyWheel, "{diameter_m: 0.06, width_m: 0.03}",
+                                    "{diameter_m: 0.06, width_m: 0.03, grouser_height_m: 0.005}")),
+        Contains("grouser_count 0"));
+    CHECK_THROWS_WITH(parseWheelText(replacedOnce(kTinyWheel, "load_N: 2", "load_N: 0")),
                       Contains("wheel.load_N") && Contains("must be > 0"));
     CHECK_THROWS_WITH(lab::loadLabScenario("wheels", "x.yaml"), Contains("wheel"));
 }

@@ -2,6 +2,7 @@
 // the wheel states every window and hands over through applyWrenches — the interface the soil
 // uses. Tolerances and their reasons are stated per check.
 #include "grainlink/mbs/RockerBogie.hpp"
+#include "Angles.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -174,11 +175,6 @@ double pitchOf(const Quat &q) { // body-fixed z-y-x pitch (nose-down positive)
 }
 
 /// Angle about y of a rotation that is a pure rotation about y.
-double angleAboutY(const Quat &q) {
-    const Vec3 x = q * Vec3::UnitX();
-    return std::atan2(-x.z(), x.x());
-}
-
 std::vector<double> flatten(const RockerBogie &rover) {
     std::vector<double> out{rover.time()};
     auto add = [&](const RigidState &s) {

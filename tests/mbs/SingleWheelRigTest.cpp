@@ -1,5 +1,6 @@
 // The single-wheel rig without soil against analytic motion (tolerances stated per check).
 #include "grainlink/mbs/SingleWheelRig.hpp"
+#include "Angles.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -17,11 +18,6 @@ SingleWheelRigSettings seedRig() {
     s.wheel.width_m = 0.1;
     s.start_position_m = Vec3(0.1, 0.05, 0.5);
     return s;
-}
-
-double angleAboutY(const Quat &q) {
-    const Vec3 x = q * Vec3::UnitX(); // turning about +y takes x towards -z
-    return std::atan2(-x.z(), x.x());
 }
 
 } // namespace
