@@ -6,11 +6,19 @@ when the run reached it, the steady state of RUN_DIR/rig_summary.json: the judge
 shaded, its mean ± sd drawn and written on each panel, and the normal load is a line beside the
 support force.
 
-Usage: tools/plot_wheel.py RUN_DIR   -> RUN_DIR/wheel.png
+With --grousers N RADIUS_M HEIGHT_M (count, rim radius, grouser height) a fifth panel counts
+the grousers whose tips are below the settled bed surface (the seed's "6 or 7 grousers in the
+soil" at 28), and the count over the steady span is printed. A tip is in the soil when it is
+deeper than (r + h)(1 - cos theta) below the wheel's lowest point, whose depth is soil.csv's
+sinkage; theta is each grouser's angle from straight down, from omega integrated over rig.csv
+(the initial phase is arbitrary: over whole revolutions it does not change the shares).
+
+Usage: tools/plot_wheel.py RUN_DIR [--grousers N RADIUS_M HEIGHT_M]   -> RUN_DIR/wheel.png
 Runs under Debian's /usr/bin/python3 (python3-matplotlib).
 """
 import csv
 import json
+import math
 import os
 import sys
 
@@ -25,10 +33,38 @@ def read(path):
         return list(csv.DictReader(f))
 
 
+def grousers_in_soil(rig, soil, wheel, count, radius, height):
+    """Per rig row: how many grouser tips are below the settled surface."""
+    soil_t = [float(r["time_s"]) for r in soil if r["body"] == wheel]
+    soil_s = [float(r["sinkage_m"]) for r in soil if r["body"] == wheel]
+    tip = radius + height
+    angle, previous, j, counts = 0.0, None, 0, []
+    for row in rig:
+        t, omega = float(row["time_s"]), float(row["omega_rad_s"])
+        if previous is not None:
+            angle += 0.5 * (omega + previous[1]) * (t - previous[0])
+        previous = (t, omega)
+        while j + 1 < len(soil_t) and soil_t[j + 1] <= t:
+            j += 1
+        depth = soil_s[j] if soil_t and soil_t[j] <= t else 0.0
+        counts.append(sum(1 for k in range(count)
+                          if tip * (1.0 - math.cos(angle + 2.0 * math.pi * k / count)) < depth))
+    return counts
+
+
 def main():
-    if len(sys.argv) != 2:
+    args = sys.argv[1:]
+    grousers = None
+    if "--grousers" in args:
+        at = args.index("--grousers")
+        try:
+            grousers = (int(args[at + 1]), float(args[at + 2]), float(args[at + 3]))
+        except (IndexError, ValueError):
+            sys.exit("--grousers takes N RADIUS_M HEIGHT_M\n" + __doc__)
+        del args[at:at + 4]
+    if len(args) != 1:
         sys.exit(__doc__)
-    run_dir = sys.argv[1]
+    run_dir = args[0]
     rig = read(f"{run_dir}/rig.csv")
     soil = read(f"{run_dir}/soil.csv")
     if not rig or not soil:
@@ -44,7 +80,7 @@ def main():
     summary = json.load(open(summary_path)) if os.path.exists(summary_path) else {}
     steady = summary.get("steady", False)
 
-    fig, axes = plt.subplots(4, 1, figsize=(8, 11))
+    fig, axes = plt.subplots(5 if grousers else 4, 1, figsize=(8, 13.5 if grousers else 11))
     if drive:
         axes[0].plot(col(drive, "travel_m"), col(drive, wheel + ".Fx_N"), lw=0.6, label="F_x (traction)")
         axes[0].plot(col(drive, "travel_m"), col(drive, wheel + ".Fz_N"), lw=0.6, label="F_z (support)")
@@ -60,6 +96,19 @@ def main():
     axes[2].set_ylabel("sinkage [mm]")
     axes[3].plot(t, col(rig, "motor_torque_N_m"), lw=0.6)
     axes[3].set_ylabel("motor torque [N m]")
+    if grousers:
+        counts = grousers_in_soil(rig, soil, wheel, *grousers)
+        axes[4].step(t, counts, where="post", lw=0.8)
+        axes[4].set_ylabel(f"grousers in the soil (of {grousers[0]})")
+        if steady:
+            start, end = summary["span_s"]
+            span = [c for c, ti in zip(counts, t) if start <= ti <= end]
+            shares = {c: span.count(c) / len(span) for c in sorted(set(span))}
+            text = ", ".join(f"{c}: {100 * share:.0f} %" for c, share in shares.items())
+            mean = sum(span) / len(span)
+            axes[4].axvspan(start, end, color="tab:green", alpha=0.15)
+            axes[4].set_title(f"steady: {mean:.2f} on average ({text} of the time)", fontsize="small")
+            print(f"grousers in the soil over the steady span: mean {mean:.2f}; {text} of the time")
     for axis in axes[1:]:
         axis.set_xlabel("time [s]")
         if t_drive:
