@@ -447,10 +447,12 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
     saveCheckpoint();
 
     summary.particles = sys->particles().size();
-    summary.steps = sys->stepCount() - first_step;
+    // The whole run's steps, a resumed run's too; the speed and wall time are this process's.
+    summary.steps = sys->stepCount() - run_start_step;
     summary.simulated_s = double(summary.steps) * dt;
     summary.wall_s = progress.wallSeconds();
-    summary.particle_steps_per_s = progress.rate(summary.steps * summary.particles);
+    summary.particle_steps_per_s =
+        progress.rate((sys->stepCount() - first_step) * summary.particles);
     std::ostringstream text;
     text << "grainlink dem: scenario '" << scenario.name << "' finished\n"
          << "  particles            " << summary.particles << "\n"

@@ -16,6 +16,7 @@ Kind standardKind(const std::string &kind, const std::string &test) {
                 "summary.json",
                 "simulation.threads",
                 "deposition.seed",
+                "checkpoint.bin",
                 [](const config::ConfigNode &root) { dem::parseScenario(root); }};
     }
     if (kind == "run") {
@@ -23,9 +24,13 @@ Kind standardKind(const std::string &kind, const std::string &test) {
             throw std::invalid_argument("kind 'run' takes no test (got '" + test + "')");
         // The coupled rig's machine-readable summary comes with its own issue; the name is
         // fixed here so a study of coupled runs needs no change when it arrives.
-        return {
-            "run", {"run"}, "rig_summary.json", "soil.simulation.threads", "soil.deposition.seed",
-            {}};
+        return {"run",
+                {"run"},
+                "rig_summary.json",
+                "soil.simulation.threads",
+                "soil.deposition.seed",
+                "checkpoints/latest",
+                {}};
     }
     if (kind == "lab") {
         lab::requireLabTest(test);
@@ -34,6 +39,7 @@ Kind standardKind(const std::string &kind, const std::string &test) {
                 "summary.json",
                 "soil.simulation.threads",
                 "soil.deposition.seed",
+                "", // a lab test has no checkpoint: an interrupted one starts again
                 [test](const config::ConfigNode &root) { lab::parseLabScenario(test, root); }};
     }
     throw std::invalid_argument("kind '" + kind + "' is not one of: dem, run, lab");

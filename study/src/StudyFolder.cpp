@@ -9,6 +9,7 @@
 #include <chrono>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
@@ -70,7 +71,8 @@ json kindJson(const Kind &k) {
             {"command", k.command},
             {"summary_file", k.summary_file},
             {"threads_key", k.threads_key},
-            {"seed_key", k.seed_key}};
+            {"seed_key", k.seed_key},
+            {"checkpoint_file", k.checkpoint_file}};
 }
 
 Kind kindFrom(const json &j) {
@@ -80,7 +82,14 @@ Kind kindFrom(const json &j) {
     k.summary_file = j.at("summary_file").get<std::string>();
     k.threads_key = j.at("threads_key").get<std::string>();
     k.seed_key = j.at("seed_key").get<std::string>();
+    // A study folder written before points resumed has none: its points start again.
+    k.checkpoint_file = j.value("checkpoint_file", std::string());
     return k;
+}
+
+void appendToLog(const std::string &path, const std::string &line) {
+    std::ofstream out(path, std::ios::app);
+    out << line;
 }
 
 } // namespace
@@ -208,17 +217,36 @@ PointResult StudyFolder::runPoint(const Point &point, const std::string &grainli
     r = PointResult();
     r.point = point;
     // Leftovers of runs whose process died: nobody else runs this point while we hold the lock.
+    // The newest that holds a checkpoint is continued with the run's own --resume (which gives
+    // the uninterrupted run's results); the others are removed.
     const std::string stem = point.id + ".tmp-";
+    const std::string &checkpoint = point.kind.checkpoint_file;
+    std::vector<fs::path> leftovers;
     for (const auto &entry : fs::directory_iterator(directory_ + "/points"))
         if (entry.path().filename().string().rfind(stem, 0) == 0)
-            fs::remove_all(entry.path());
+            leftovers.push_back(entry.path());
+    std::optional<fs::path> resumable;
+    for (const fs::path &left : leftovers)
+        if (!checkpoint.empty() && fs::exists(left / checkpoint) &&
+            (!resumable ||
+             fs::last_write_time(left / checkpoint) > fs::last_write_time(*resumable / checkpoint)))
+            resumable = left;
+    for (const fs::path &left : leftovers)
+        if (left != resumable)
+            fs::remove_all(left);
 
     const fs::path tmp = pointPath(point) + ".tmp-" + std::to_string(getpid());
+    if (resumable)
+        fs::rename(*resumable, tmp);
     fs::create_directories(tmp);
     r.log = (tmp / "log.txt").string();
     std::vector<std::string> argv{grainlink};
     argv.insert(argv.end(), point.kind.command.begin(), point.kind.command.end());
     argv.insert(argv.end(), {scenarioPath(point), "--out", tmp.string()});
+    if (resumable) {
+        argv.push_back("--resume");
+        appendToLog(r.log, "[study] continuing from the checkpoint an interrupted attempt left\n");
+    }
     const auto run_start = std::chrono::steady_clock::now();
     const ExitStatus exit = runLogged(argv, directory, r.log);
     const double process_s = secondsSince(run_start);
@@ -233,10 +261,15 @@ PointResult StudyFolder::runPoint(const Point &point, const std::string &grainli
             problem = "the run ended but its summary is unreadable: " + std::string(e.what());
         }
     } else if (exit.interrupted()) {
-        fs::remove_all(tmp);
+        // Kept when it holds a checkpoint: the next start continues from there.
+        const bool kept = !checkpoint.empty() && fs::exists(tmp / checkpoint);
+        if (!kept) {
+            fs::remove_all(tmp);
+            r.log.clear();
+        }
         r.status = PointStatus::Unfinished;
-        r.log.clear();
-        r.error = "interrupted (" + exit.describe() + "); rerun the study to finish it";
+        r.error = "interrupted (" + exit.describe() + "); rerun the study to finish it" +
+                  (kept ? " from its last checkpoint" : "");
         return r;
     } else {
         problem = exit.describe() + ": " + reasonIn(r.log);

@@ -223,6 +223,73 @@ TEST_CASE("a run killed from outside leaves its point unfinished while the study
     CHECK_THAT(output, Catch::Contains("3 points: 3 done (1 run now), 0 failed, 0 unfinished"));
 }
 
+TEST_CASE("a point whose run was killed after a checkpoint continues from it, to the result of "
+          "an uninterrupted run",
+          "[study][local]") {
+    TempFolder folder("resumed-point");
+    // The test scenario run to 3 s (a few seconds of wall time, long enough to be killed) with a
+    // checkpoint every 0.05 s, one point.
+    std::string scenario = readFile(kData + "/plate.yaml");
+    const std::string run = "run: {duration_s: 0.12}";
+    scenario.replace(scenario.find(run), run.size(), "run: {duration_s: 3.0}");
+    const std::string output = "output: {series_interval_s: 0.01}";
+    scenario.replace(scenario.find(output), output.size(),
+                     "output: {series_interval_s: 0.01, checkpoint_interval_s: 0.05}");
+    writeFile(folder / "plate.yaml", scenario);
+    writeFile(folder / "one.yaml", "name: one\nbase: {kind: dem, scenario: plate.yaml}\n"
+                                   "observables: [bodies.plate.force_N.2]\n");
+    const auto command = [&](const std::string &out) {
+        return std::vector<std::string>{
+            kGrainlink, "study", folder / "one.yaml", "--out", folder / out, "--jobs", "1"};
+    };
+    std::string whole_output;
+    REQUIRE(runToEnd(command("whole"), folder.path.string(), whole_output) == 0);
+    const auto whole = finishedPoints(folder.path / "whole");
+    REQUIRE(whole.size() == 1);
+
+    // The same point, its run killed once a checkpoint past the first is written.
+    Process study(command("broken"), folder.path, folder / "first.log");
+    std::vector<pid_t> runs;
+    REQUIRE(waitUntil([&] { return !(runs = childrenOf(study.pid())).empty(); }, 30.0));
+    REQUIRE(waitUntil(
+        [&] {
+            for (const auto &e : fs::directory_iterator(folder.path / "broken" / "points"))
+                if (fs::exists(e.path() / "checkpoint.previous.bin"))
+                    return true;
+            return false;
+        },
+        60.0));
+    kill(runs[0], SIGKILL);
+    CHECK(study.wait() == 0);
+    const std::string first = readFile(folder / "first.log");
+    INFO(first);
+    CHECK_THAT(first, Catch::Contains("rerun the study to finish it from its last checkpoint"));
+    CHECK_THAT(first, Catch::Contains("0 failed, 1 unfinished"));
+
+    std::string second;
+    REQUIRE(runToEnd(command("broken"), folder.path.string(), second) == 0);
+    INFO(second);
+    const auto resumed = finishedPoints(folder.path / "broken");
+    REQUIRE(resumed == whole);
+    const fs::path point = folder.path / "broken" / "points" / resumed[0];
+    CHECK_THAT(
+        readFile(point / "log.txt"),
+        Catch::Contains("[study] continuing from the checkpoint an interrupted attempt left"));
+    // Every number of the summary but the wall times is the uninterrupted run's.
+    const json a =
+        json::parse(readFile(folder.path / "whole" / "points" / whole[0] / "summary.json"));
+    const json b = json::parse(readFile(point / "summary.json"));
+    const json flat_a = a.flatten(), flat_b = b.flatten();
+    REQUIRE(flat_a.size() == flat_b.size());
+    for (const auto &[key, value] : flat_a.items()) {
+        INFO(key);
+        if (key.find("wall") == std::string::npos && key.find("per_s") == std::string::npos)
+            CHECK(flat_b.at(key) == value);
+    }
+    CHECK(readFile(point / "series.csv") ==
+          readFile(folder.path / "whole" / "points" / whole[0] / "series.csv"));
+}
+
 TEST_CASE("a study of coupled runs collects each rig's steady report", "[study][local]") {
     // `grainlink study` (whose reader of coupled scenarios is the command's) on two coupled
     // wheel runs on the rigid floor (rig, floor, coordinator: three processes each): one steady,

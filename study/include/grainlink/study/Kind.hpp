@@ -1,6 +1,7 @@
 #pragma once
 // What kind of run a study point is: the `grainlink` subcommand that runs it, the summary file
-// it leaves, where its thread count and deposition seed live, and the parser that checks it.
+// it leaves, where its thread count and deposition seed live, its checkpoint, and the parser that
+// checks it.
 #include "grainlink/config/ConfigNode.hpp"
 
 #include <functional>
@@ -15,6 +16,9 @@ struct Kind {
     std::string summary_file;         ///< machine-readable result in the run's output folder
     std::string threads_key;          ///< dotted path of the scenario's thread count
     std::string seed_key;             ///< dotted path replicates vary by default
+    /// The run's latest checkpoint in its output folder: an interrupted point that left one
+    /// continues from it (`--resume`) instead of starting again; empty for runs without one.
+    std::string checkpoint_file;
     /// The run's own scenario reader, called in-process; throws config::ConfigError.
     std::function<void(const config::ConfigNode &root)> validate;
 };
