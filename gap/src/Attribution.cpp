@@ -333,12 +333,12 @@ DensityComparison compareDensities(const Eigen::VectorXd &measured,
         ss += (x - mean) * (x - mean);
     const double sd = d.size() > 1 ? std::sqrt(ss / double(d.size() - 1)) : 0.0;
     c.mean_gain = mean;
+    // One held-out value, or gains without any spread, cannot tell a better model from luck:
+    // no claim rests on them (p = 1; the t test would give 0 for any gain above zero).
+    if (d.size() < 2 || sd <= 0.0)
+        return c;
     // The features of one experiment move together: the mean is worth n_eff of them.
     const double n = std::clamp(n_eff, 1.0, double(d.size()));
-    if (sd <= 0.0) {
-        c.p_value = mean > 0.0 ? 0.0 : 1.0;
-        return c;
-    }
     const double t = mean / (sd / std::sqrt(n));
     const boost::math::students_t dist(std::max(1.0, n - 1.0));
     c.p_value = boost::math::cdf(boost::math::complement(dist, t));

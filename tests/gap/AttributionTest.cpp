@@ -172,6 +172,11 @@ TEST_CASE("the held-out density test: a model as good as the null is not better;
                                        all(6), 6.0);
     CHECK(miss.mean_gain < 0.0);
     CHECK(miss.p_value > 0.99);
+    // One held-out value is no evidence, however well it is hit (the t test's p was 0).
+    const FeatureSet one{Eigen::Index(0)};
+    const auto single = compareDensities(y, y + off, v, y + off, v * 10.0, one, 1.0);
+    CHECK(single.mean_gain > 0.9);
+    CHECK(single.p_value == 1.0);
 }
 
 TEST_CASE("a fit pinned at its prior's edge is flagged only when the data ask for more",

@@ -190,18 +190,25 @@ std::vector<pid_t> childrenOf(pid_t pid) {
     return children;
 }
 
+/// The test scenario as folder/plate.yaml with a longer run (the plate rests after 0.12 s), so
+/// that its process is there to be killed; `output_keys` are added to its output line.
+void writeLongerPlate(const TempFolder &folder, const std::string &duration_s,
+                      const std::string &output_keys = "") {
+    std::string scenario = readFile(kData + "/plate.yaml");
+    const std::string run = "run: {duration_s: 0.12}";
+    scenario.replace(scenario.find(run), run.size(), "run: {duration_s: " + duration_s + "}");
+    const std::string output = "output: {series_interval_s: 0.01";
+    scenario.insert(scenario.find(output) + output.size(), output_keys);
+    writeFile(folder / "plate.yaml", scenario);
+}
+
 } // namespace
 
 TEST_CASE("a run killed from outside leaves its point unfinished while the study goes on; the "
           "next start runs just that point",
           "[study][local]") {
     TempFolder folder("killed-run");
-    // The test scenario with a longer run (the plate rests after 0.12 s), so its process is
-    // there to be killed.
-    std::string scenario = readFile(kData + "/plate.yaml");
-    const std::string run = "run: {duration_s: 0.12}";
-    scenario.replace(scenario.find(run), run.size(), "run: {duration_s: 0.8}");
-    writeFile(folder / "plate.yaml", scenario);
+    writeLongerPlate(folder, "0.8");
     writeFile(folder / "three.yaml", "name: three\nbase: {kind: dem, scenario: plate.yaml}\n"
                                      "design:\n  replicates: 3\n"
                                      "observables: [bodies.plate.force_N.2]\n");
@@ -227,15 +234,8 @@ TEST_CASE("a point whose run was killed after a checkpoint continues from it, to
           "an uninterrupted run",
           "[study][local]") {
     TempFolder folder("resumed-point");
-    // The test scenario run to 3 s (a few seconds of wall time, long enough to be killed) with a
-    // checkpoint every 0.05 s, one point.
-    std::string scenario = readFile(kData + "/plate.yaml");
-    const std::string run = "run: {duration_s: 0.12}";
-    scenario.replace(scenario.find(run), run.size(), "run: {duration_s: 3.0}");
-    const std::string output = "output: {series_interval_s: 0.01}";
-    scenario.replace(scenario.find(output), output.size(),
-                     "output: {series_interval_s: 0.01, checkpoint_interval_s: 0.05}");
-    writeFile(folder / "plate.yaml", scenario);
+    // A few seconds of wall time, with a checkpoint every 0.05 s; one point.
+    writeLongerPlate(folder, "3.0", ", checkpoint_interval_s: 0.05");
     writeFile(folder / "one.yaml", "name: one\nbase: {kind: dem, scenario: plate.yaml}\n"
                                    "observables: [bodies.plate.force_N.2]\n");
     const auto command = [&](const std::string &out) {

@@ -150,11 +150,11 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
                           const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_val,
                           const FeatureSet &use);
 
-
 /// Sample-split test that a model predicts held-out features better than the null, by the log
 /// predictive density (a proper score: a model gains nothing by widening its spread, nor by
 /// a confident miss): the per-feature differences of log density, their mean over `n_eff`
-/// independent features, and the one-sided p of a t test that the mean is > 0.
+/// independent features, and the one-sided p of a t test that the mean is > 0; p = 1 for fewer
+/// than two features or gains without spread.
 struct DensityComparison {
     double mean_gain = 0.0; ///< mean log-density gain per feature (model - null)
     double p_value = 1.0;
