@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 namespace grainlink::gap {
 
@@ -65,6 +66,12 @@ FeatureDesign designFeatures(const ExperimentSet &set, int bins) {
             for (const Curve &c : zeroedTrials(e, o))
                 if (!c.empty())
                     maxima.push_back(c.x.back());
+            // Said here, naming it: else its reach is NaN and its whole kind gets no bins.
+            if (maxima.empty())
+                throw std::runtime_error(
+                    e.source + ": experiment '" + e.id + "': no trial of '" + o +
+                    "' has a sample from its zero on (a force_threshold above every measured "
+                    "value? check zero.threshold and its unit)");
             // The reach of at least half of the trials: the lower median of their maxima.
             const double reach = lowerMedian(maxima);
             d.x_reach[slot(e.id, o)] = reach;

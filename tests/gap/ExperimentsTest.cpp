@@ -201,6 +201,14 @@ TEST_CASE("experiments.yaml: a plate force with z up becomes its pressure", "[ga
     CHECK(c.y.back() == Approx(200.0 / area)); // 70.7 kPa
     CHECK(e.zero.threshold == Approx(5.0 / area));
     CHECK(e.uncertainty.y_sigma == Approx(2.0 / area));
+    // A threshold no trial reaches (500 N against 200 N at most) is said with the experiment.
+    write(dir / "experiments.yaml",
+          head + "      x: {column: z_mm, unit: mm, scale: -1}\n"
+                 "      y: {force_N: {column: Fz_N, unit: N, scale: -1}}\n"
+                 "    zero: {method: force_threshold, threshold: 500, unit: N}\n");
+    CHECK_THROWS_WITH(designFeatures(loadExperiments(dir.string())),
+                      Catch::Matches(".*experiments.yaml:[0-9]+: experiment 'p60': no trial of "
+                                     "'pressure_Pa' has a sample from its zero on.*"));
 
     const auto refused = [&](const std::string &axes, const std::string &what) {
         checkRefused(dir, head + axes, what);
