@@ -146,6 +146,20 @@ TEST_CASE("experiments.yaml: scalars and scatters", "[gap][experiments]") {
     CHECK(m.u_D[0] == Approx(1.0)); // sd sqrt 2 over sqrt 2
     CHECK(m.value[1] == Approx(11.0));
     CHECK(m.value[2] == Approx(30.0));
+
+    // One y_sigma in newtons cannot be the sinkage's sigma too.
+    write(dir / "wheel.csv", "slip,F,S\n0.1,10,5\n0.12,12,6\n0.5,30,9\n");
+    write(dir / "experiments.yaml",
+          "experiments:\n"
+          "  - id: w0\n    type: wheel_steady_state\n    conditions: {slip_angle_deg: 0}\n"
+          "    data:\n      files: [wheel.csv]\n      scatter: true\n"
+          "      x: {column: slip, unit: '-'}\n"
+          "      y: {traction_N: {column: F, unit: N}, sinkage_m: {column: S, unit: mm}}\n"
+          "    bins: {edges: [0, 0.2, 0.4, 0.6], unit: '-'}\n"
+          "    uncertainty: {y_sigma: 0.5, unit: N}\n");
+    CHECK_THROWS_WITH(loadExperiments(dir.string()),
+                      Catch::Matches(".*experiments.yaml:11: .*y_sigma.*'traction_N' \\(force\\) "
+                                     "cannot serve 'sinkage_m' \\(length\\).*"));
 }
 
 TEST_CASE("experiments.yaml: bad input names the file, the key and the line",
