@@ -494,15 +494,16 @@ ExperimentSet loadExperiments(const std::string &directory) {
         if (const auto u = node.optional("uncertainty")) {
             // One sigma has one unit (the first observable's): it cannot serve an observable of
             // another dimension, which would read it in that unit.
+            const std::string &first = e.observables.front();
+            const auto other = std::find_if(
+                e.observables.begin(), e.observables.end(),
+                [&](const std::string &o) { return dimensionOf(o) != dimensionOf(first); });
             for (const char *key : {"y_sigma", "y_systematic"})
-                for (const std::string &o : e.observables)
-                    if (u->has(key) && plate_area <= 0.0 &&
-                        dimensionOf(o) != dimensionOf(e.observables.front()))
-                        (*u)[key].fail("one " + std::string(key) + " in the unit of '" +
-                                       e.observables.front() + "' (" +
-                                       dimensionOf(e.observables.front()) + ") cannot serve '" + o +
-                                       "' (" + dimensionOf(o) +
-                                       "): give y_relative, or one experiment per observable");
+                if (u->has(key) && plate_area <= 0.0 && other != e.observables.end())
+                    (*u)[key].fail("one " + std::string(key) + " in the unit of '" + first +
+                                   "' (" + dimensionOf(first) + ") cannot serve '" + *other +
+                                   "' (" + dimensionOf(*other) +
+                                   "): give y_relative, or one experiment per observable");
             if (u->has("y_sigma"))
                 e.uncertainty.y_sigma = yValue(*u, "y_sigma");
             if (u->has("y_systematic"))
