@@ -45,13 +45,14 @@ TEST_CASE("u_val combines the seeds, one bed's scatter, the checks and the measu
     CHECK(validate(oneFeature(1.5, 0.1, true), base, {}).u_bed[0] == 0.0);
 }
 
-TEST_CASE("a numerical check's systematic part: found when it shifts the curve, near zero when "
-          "it does not",
+TEST_CASE("a numerical check's systematic part: found when it shifts or reshapes the curve, "
+          "near zero when it does not",
           "[gap][validation]") {
     // Six bins of one experiment, beds moving the whole curve (level sd 10 %), three base seeds
-    // and two check seeds. A check that lowers everything by 30 % is found at about 30 %; one
-    // that changes nothing contributes about half the noise of the difference on average (the
-    // positive part of d^2 - var d), not the noise itself.
+    // and two check seeds. A check that lowers everything by 30 % is found at about 30 %, as is
+    // one that raises the first three bins by 30 % and lowers the last three by 30 % (a signed
+    // mean of the differences saw none of it); one that changes nothing contributes about half
+    // the noise of the difference on average (the positive part of d^2 - var d), not the noise.
     Measured m;
     for (int b = 0; b < 6; ++b)
         m.keys.push_back({"e", "p", "k", 0.001 * b, 0.001 * (b + 1)});
@@ -61,10 +62,10 @@ TEST_CASE("a numerical check's systematic part: found when it shifts the curve, 
     m.from_repeats.assign(6, true);
     std::mt19937 rng(5);
     std::normal_distribution<double> z;
-    double shifted = 0.0, still = 0.0;
+    double shifted = 0.0, still = 0.0, reshaped = 0.0;
     const int draws = 400;
     for (int d = 0; d < draws; ++d) {
-        Eigen::MatrixXd base(3, 6), same(2, 6), lower(2, 6);
+        Eigen::MatrixXd base(3, 6), same(2, 6), lower(2, 6), tilted(2, 6);
         for (int s = 0; s < 3; ++s) {
             const double level = 1.0 + 0.1 * z(rng);
             for (int b = 0; b < 6; ++b)
@@ -75,14 +76,17 @@ TEST_CASE("a numerical check's systematic part: found when it shifts the curve, 
             for (int b = 0; b < 6; ++b) {
                 same(s, b) = 100.0 * level * (1.0 + 0.02 * z(rng));
                 lower(s, b) = 0.7 * same(s, b);
+                tilted(s, b) = (b < 3 ? 1.3 : 0.7) * same(s, b);
             }
         }
         still += validate(m, base, {{"time_step", same}}).u_checks[0].second[2] / draws;
         shifted += validate(m, base, {{"time_step", lower}}).u_checks[0].second[2] / draws;
+        reshaped += validate(m, base, {{"time_step", tilted}}).u_checks[0].second[2] / draws;
     }
     // The seed noise of a 3-vs-2 mean difference of one level is 10 % x sqrt(1/3 + 1/2) = 9 %.
     CHECK(still < 7.0);
     CHECK(shifted == Approx(30.0).margin(6.0));
+    CHECK(reshaped == Approx(30.0).margin(6.0));
 }
 
 TEST_CASE("standardised residuals of a matching model are about unit normal",
