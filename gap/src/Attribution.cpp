@@ -98,6 +98,30 @@ bool beyondPrior(F chi2, const Profile &p, double t0, double t1, double t_off) {
     return std::isfinite(c) && c < p.chi2 - std::max(kDeltaChi2_95, 0.1 * p.chi2);
 }
 
+/// The features of `use` that every sample of a response has: one missing at some strengths
+/// (a bin a softer soil never reaches, a run that failed there) would drop out of chi^2 only
+/// there and make those strengths look better.
+FeatureSet supported(const FeatureSet &use, const std::vector<Eigen::VectorXd> &samples) {
+    FeatureSet kept;
+    for (Eigen::Index k : use) {
+        bool everywhere = true;
+        for (const Eigen::VectorXd &m : samples)
+            everywhere = everywhere && std::isfinite(m[k]);
+        if (everywhere)
+            kept.push_back(k);
+    }
+    return kept;
+}
+
+/// Where a strength profile over [t0, t1] looks: its grid, "off", and a fifth of the span
+/// beyond each end (where a pinned fit is tested).
+std::vector<double> profilePoints(double t0, double t1, double t_off) {
+    std::vector<double> t{t_off, t0 - 0.2 * (t1 - t0), t1 + 0.2 * (t1 - t0)};
+    for (int k = 0; k < kGrid; ++k)
+        t.push_back(t0 + (t1 - t0) * k / double(kGrid - 1));
+    return t;
+}
+
 } // namespace
 
 double Prior::toScale(double s) const {
@@ -178,7 +202,12 @@ double chiSquare(const Eigen::VectorXd &measured, const Eigen::VectorXd &mean,
 
 StrengthFit fitStrength(const Response &response, const Prior &prior,
                         const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
-                        const FeatureSet &use, const BlockCorrelation &correlation) {
+                        const FeatureSet &all_features, const BlockCorrelation &correlation) {
+    const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi);
+    std::vector<Eigen::VectorXd> samples;
+    for (double t : profilePoints(t0, t1, prior.toScale(prior.off)))
+        samples.push_back(response.mean(prior.fromScale(t)));
+    const FeatureSet use = supported(all_features, samples);
     const auto chi2 = [&](double t) {
         const double s = prior.fromScale(t);
         return chiSquare(measured, response.mean(s), response.variance(s), u2_fixed, use,
@@ -187,7 +216,6 @@ StrengthFit fitStrength(const Response &response, const Prior &prior,
     StrengthFit fit;
     fit.features = int(use.size());
     // A first pass gives the Birge ratio that widens the interval of a poor best fit.
-    const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi);
     const Profile first = minimiseProfile(chi2, t0, t1, 1.0);
     const int dof = std::max(1, fit.features - 1);
     fit.birge = std::max(1.0, first.chi2 / dof);
@@ -215,16 +243,22 @@ Eigen::VectorXd PairResponse::variance(double sa, double sb) const {
 PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Prior &pb,
                 const Eigen::VectorXd &base_mean, const Eigen::VectorXd &base_variance,
                 const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
-                const FeatureSet &use, const BlockCorrelation &correlation) {
+                const FeatureSet &all_features, const BlockCorrelation &correlation) {
     PairResponse pair(a, b, base_mean, base_variance);
+    const double a0 = pa.toScale(pa.lo), a1 = pa.toScale(pa.hi);
+    const double b0 = pb.toScale(pb.lo), b1 = pb.toScale(pb.hi);
+    constexpr int n = 41;
+    // A pair's mean is the sum of its two responses' changes: its features are those both have.
+    std::vector<Eigen::VectorXd> samples;
+    for (const auto &[r, p] : {std::pair{&a, &pa}, std::pair{&b, &pb}})
+        for (double t : profilePoints(p->toScale(p->lo), p->toScale(p->hi), p->toScale(p->off)))
+            samples.push_back(r->mean(p->fromScale(t)));
+    const FeatureSet use = supported(all_features, samples);
     const auto chi2 = [&](double ta, double tb) {
         const double sa = pa.fromScale(ta), sb = pb.fromScale(tb);
         return chiSquare(measured, pair.mean(sa, sb), pair.variance(sa, sb), u2_fixed, use,
                          correlation);
     };
-    const double a0 = pa.toScale(pa.lo), a1 = pa.toScale(pa.hi);
-    const double b0 = pb.toScale(pb.lo), b1 = pb.toScale(pb.hi);
-    constexpr int n = 41;
     double best = std::numeric_limits<double>::infinity(), ta = a0, tb = b0;
     for (int i = 0; i < n; ++i)
         for (int j = 0; j < n; ++j) {
@@ -309,39 +343,29 @@ DensityComparison compareDensities(const Eigen::VectorXd &measured,
                                    const Eigen::VectorXd &model_variance,
                                    const Eigen::VectorXd &null_mean,
                                    const Eigen::VectorXd &null_variance, const FeatureSet &use,
-                                   double n_eff) {
+                                   const std::vector<FeatureKey> &keys) {
     const auto logDensity = [](double r, double v) {
         return -0.5 * (r * r / v + std::log(2.0 * M_PI * v));
     };
-    std::vector<double> d;
+    Eigen::VectorXd gain = Eigen::VectorXd::Constant(measured.size(), kNaN);
     for (Eigen::Index k : use) {
         const double rm = measured[k] - model_mean[k], rn = measured[k] - null_mean[k];
         const double vm = model_variance[k], vn = null_variance[k];
         if (std::isfinite(rm) && std::isfinite(rn) && vm > 0.0 && vn > 0.0)
-            d.push_back(logDensity(rm, vm) - logDensity(rn, vn));
+            gain[k] = logDensity(rm, vm) - logDensity(rn, vn);
     }
+    const ClusteredMean g = clusteredMean(gain, use, keys);
     DensityComparison c;
-    c.features = int(d.size());
-    if (d.empty())
+    c.features = g.values;
+    c.experiments = g.experiments;
+    c.mean_gain = g.mean;
+    c.gain_correlation = g.icc;
+    // One held-out experiment, or gains without any spread, cannot tell a better model from
+    // luck: no claim rests on them (p = 1; the t test would give 0 for any gain above zero).
+    if (g.experiments < 2 || !(g.variance > 0.0) || !std::isfinite(g.variance))
         return c;
-    double mean = 0.0;
-    for (double x : d)
-        mean += x;
-    mean /= double(d.size());
-    double ss = 0.0;
-    for (double x : d)
-        ss += (x - mean) * (x - mean);
-    const double sd = d.size() > 1 ? std::sqrt(ss / double(d.size() - 1)) : 0.0;
-    c.mean_gain = mean;
-    // One held-out value, or gains without any spread, cannot tell a better model from luck:
-    // no claim rests on them (p = 1; the t test would give 0 for any gain above zero).
-    if (d.size() < 2 || sd <= 0.0)
-        return c;
-    // The features of one experiment move together: the mean is worth n_eff of them.
-    const double n = std::clamp(n_eff, 1.0, double(d.size()));
-    const double t = mean / (sd / std::sqrt(n));
-    const boost::math::students_t dist(std::max(1.0, n - 1.0));
-    c.p_value = boost::math::cdf(boost::math::complement(dist, t));
+    const boost::math::students_t dist(g.dof);
+    c.p_value = boost::math::cdf(boost::math::complement(dist, g.mean / std::sqrt(g.variance)));
     return c;
 }
 

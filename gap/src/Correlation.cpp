@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace grainlink::gap {
 
@@ -68,14 +69,52 @@ double BlockCorrelation::chiSquare(const Eigen::VectorXd &e, const FeatureSet &u
     return total;
 }
 
-double BlockCorrelation::effectiveCount(const FeatureSet &use) const {
-    double n = 0.0;
-    for (const auto &[id, idx] : groups(use)) {
-        const double r = experiment_of_.empty() ? 0.0 : rho(id);
-        const double k = double(idx.size());
-        n += k / (1.0 + (k - 1.0) * r);
+ClusteredMean clusteredMean(const Eigen::VectorXd &values, const FeatureSet &use,
+                            const std::vector<FeatureKey> &keys) {
+    std::map<std::string, std::vector<double>> by;
+    for (Eigen::Index k : use)
+        if (std::isfinite(values[k]))
+            by[keys[std::size_t(k)].experiment].push_back(values[k]);
+    ClusteredMean c;
+    c.experiments = int(by.size());
+    double n = 0.0, sum_k2 = 0.0;
+    for (const auto &[id, v] : by) {
+        n += double(v.size());
+        sum_k2 += double(v.size() * v.size());
+        for (double x : v)
+            c.mean += x;
     }
-    return n;
+    c.values = int(n);
+    if (n == 0.0)
+        return c;
+    c.mean /= n;
+    const double m = double(by.size());
+    double ssb = 0.0, ssw = 0.0;
+    for (const auto &[id, v] : by) {
+        double mean = 0.0;
+        for (double x : v)
+            mean += x;
+        mean /= double(v.size());
+        ssb += double(v.size()) * (mean - c.mean) * (mean - c.mean);
+        for (double x : v)
+            ssw += (x - mean) * (x - mean);
+    }
+    if (m < 2.0 || n < 2.0) { // nothing tells how one experiment's values vary as a whole
+        c.variance = std::numeric_limits<double>::infinity();
+        return c;
+    }
+    if (n == m) { // one value each: independent values
+        c.variance = (ssb / (n - 1.0)) / n;
+        c.dof = n - 1.0;
+        return c;
+    }
+    const double msb = ssb / (m - 1.0), msw = ssw / (n - m);
+    const double k0 = (n - sum_k2 / n) / (m - 1.0); // the effective experiment size
+    const double between = std::max(0.0, (msb - msw) / k0);
+    c.variance = msw / n + between * sum_k2 / (n * n);
+    c.dof = between > 0.0 ? m - 1.0 : n - m;
+    c.icc = between + msw > 0.0 ? between / (between + msw) : 0.0;
+    return c;
 }
 
 } // namespace grainlink::gap

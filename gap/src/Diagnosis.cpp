@@ -224,7 +224,6 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     D.held_out_null = scoreHeldOut(meas.value, null_mean, null_var, u2_val, D.held_out);
     D.null_mean = null_mean;
     D.null_variance = null_var;
-    const double n_eff = correlation.effectiveCount(D.held_out);
 
     const auto notCompared = [&] {
         return D.not_compared.empty()
@@ -241,6 +240,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                   D.verdict.summary + ")" + notCompared();
         return D;
     }
+    // A base that a numerical check moves by over half its value may show a gap all the
+    // same, but an effect fitted on it may be fitting its numerical error: located, not claimed.
+    const bool resolved = unresolved.empty();
     if (!D.verdict.gap) {
         D.outcome = Diagnosis::Outcome::NoGap;
         D.claim = std::string(D.not_compared.empty() ? "no gap: every experiment agrees"
@@ -426,7 +428,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const Eigen::VectorXd predictive = var + strength_var;
         score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);
         const DensityComparison c = compareDensities(meas.value, mean, predictive, null_mean,
-                                                     null_var, D.held_out, n_eff);
+                                                     null_var, D.held_out, meas.keys);
         p_value = c.p_value;
         Eigen::VectorXd e = (meas.value - mean).array() / var.array().sqrt();
         for (Eigen::Index k = 0; k < e.size(); ++k)
@@ -533,7 +535,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // A strength at its prior's edge may stand in for something the catalogue lacks (LIGGGHTS'
         // 5x softer soil fitted by the softest grains allowed): it may beat the null, it is
         // still not claimed as the cause.
-        R.explains = R.beats_null && !R.after.gap && !R.fit.at_prior_edge;
+        R.explains = R.beats_null && !R.after.gap && !R.fit.at_prior_edge && resolved;
     }
     for (Live &L : live)
         D.candidates.push_back(L.result);
@@ -589,12 +591,18 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             const bool better = evaluateModel(pair_rows[i], P.held_out, P.p_value, P.after,
                                               P.confirmed_mean, Eigen::VectorXd::Zero(n));
             P.explains = better && P.p_value < pair_level && !P.after.gap && !D.held_out.empty() &&
-                         !P.fit.a.at_prior_edge && !P.fit.b.at_prior_edge;
+                         !P.fit.a.at_prior_edge && !P.fit.b.at_prior_edge && resolved;
         }
         D.pairs = pairs;
     }
 
     // The verdict.
+    const auto heldOutCompared = [&] {
+        std::set<std::string> ids;
+        for (Eigen::Index k : D.held_out)
+            ids.insert(meas.keys[std::size_t(k)].experiment);
+        return ids.size();
+    };
     const auto reduction = [&](const HeldOutScore &after) {
         return D.held_out_base.gap > 0.0 ? 100.0 * (1.0 - after.gap / D.held_out_base.gap) : 0.0;
     };
@@ -629,10 +637,18 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             D.best_model_mean = pair->confirmed_mean;
         } else {
             D.outcome = Diagnosis::Outcome::Unexplained;
-            if (D.held_out.empty())
+            if (!resolved)
+                claim << "unexplained: " << unresolved
+                      << " (an effect fitted on it may be fitting its numerical error: none is "
+                         "claimed)";
+            else if (D.held_out.empty())
                 claim << "unexplained: no held-out experiment to test a candidate on (a claim "
                          "needs experiments it was not fitted to: give two or more experiments "
                          "of a type, or name them with --hold-out)";
+            else if (heldOutCompared() < 2)
+                claim << "unexplained: one held-out experiment is one piece of evidence, however "
+                         "many features it has (a claim needs two or more: name them with "
+                         "--hold-out)";
             else
                 claim << "unexplained: no catalogued effect, alone or in a pair, predicts the "
                          "held-out experiments better than the null model and leaves no gap";

@@ -76,7 +76,8 @@ double chiSquare(const Eigen::VectorXd &measured, const Eigen::VectorXd &mean,
                  const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_fixed,
                  const FeatureSet &use, const BlockCorrelation &correlation = {});
 
-/// The strength that minimises chi^2 over `use` (a grid over the prior, then golden section),
+/// The strength that minimises chi^2 over the features of `use` that the response has at every
+/// strength of its prior (a grid over the prior, then golden section),
 /// with a 95 % interval from the chi^2 profile (delta chi^2 = 3.84, widened by the Birge ratio
 /// chi^2 / dof when the best fit is poor).
 struct StrengthFit {
@@ -152,19 +153,22 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
 
 /// Sample-split test that a model predicts held-out features better than the null, by the log
 /// predictive density (a proper score: a model gains nothing by widening its spread, nor by
-/// a confident miss): the per-feature differences of log density, their mean over `n_eff`
-/// independent features, and the one-sided p of a t test that the mean is > 0; p = 1 for fewer
-/// than two features or gains without spread.
+/// a confident miss): the per-feature differences of log density, their mean, and the
+/// one-sided p of a t test that it is > 0 with the variance of a mean over experiments whose
+/// gains may move together (`clusteredMean`); p = 1 with fewer than two held-out experiments
+/// or gains without spread.
 struct DensityComparison {
     double mean_gain = 0.0; ///< mean log-density gain per feature (model - null)
     double p_value = 1.0;
     int features = 0;
+    int experiments = 0;           ///< held-out experiments with a gain
+    double gain_correlation = 0.0; ///< the share of the gains' variance between experiments
 };
 DensityComparison compareDensities(const Eigen::VectorXd &measured,
                                    const Eigen::VectorXd &model_mean,
                                    const Eigen::VectorXd &model_variance,
                                    const Eigen::VectorXd &null_mean,
                                    const Eigen::VectorXd &null_variance, const FeatureSet &use,
-                                   double n_eff);
+                                   const std::vector<FeatureKey> &keys);
 
 } // namespace grainlink::gap

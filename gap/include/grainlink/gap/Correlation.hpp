@@ -25,8 +25,6 @@ public:
     BlockCorrelation(const std::vector<FeatureKey> &keys, const Eigen::MatrixXd &rows);
     /// e^T R^-1 e of standardised residuals e over `use` (generalised least squares).
     double chiSquare(const Eigen::VectorXd &e, const FeatureSet &use) const;
-    /// How many independent features `use` is worth (Kish: k / (1 + (k - 1) rho) each).
-    double effectiveCount(const FeatureSet &use) const;
     double rho(const std::string &experiment) const;
 
 private:
@@ -34,5 +32,19 @@ private:
     std::vector<std::string> experiment_of_;
     std::map<std::string, double> rho_;
 };
+
+/// The mean of `values` over `use` when each experiment's values may share an error (a model's
+/// gain over another moves with the experiment's systematic error, which the beds' correlation
+/// does not see): one-way random-effects ANOVA over the experiments, Var(mean) = s_w^2 / N +
+/// s_b^2 sum k_E^2 / N^2, with m - 1 degrees of freedom when the experiments differ beyond
+/// their values' scatter (s_b^2 > 0), else N - m. One experiment of several values gives no
+/// between-experiment scatter: its variance is unknown (infinite).
+struct ClusteredMean {
+    double mean = 0.0, variance = 0.0, dof = 0.0;
+    double icc = 0.0; ///< s_b^2 / (s_b^2 + s_w^2)
+    int values = 0, experiments = 0;
+};
+ClusteredMean clusteredMean(const Eigen::VectorXd &values, const FeatureSet &use,
+                            const std::vector<FeatureKey> &keys);
 
 } // namespace grainlink::gap
