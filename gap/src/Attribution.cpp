@@ -98,19 +98,26 @@ bool beyondPrior(F chi2, const Profile &p, double t0, double t1, double t_off) {
     return std::isfinite(c) && c < p.chi2 - std::max(kDeltaChi2_95, 0.1 * p.chi2);
 }
 
-/// The features of `use` that every sample of a response has: one missing at some strengths
-/// (a bin a softer soil never reaches, a run that failed there) would drop out of chi^2 only
-/// there and make those strengths look better.
-FeatureSet supported(const FeatureSet &use, const std::vector<Eigen::VectorXd> &samples) {
-    FeatureSet kept;
-    for (Eigen::Index k : use) {
-        bool everywhere = true;
-        for (const Eigen::VectorXd &m : samples)
-            everywhere = everywhere && std::isfinite(m[k]);
-        if (everywhere)
-            kept.push_back(k);
-    }
-    return kept;
+/// Whether every sample of a response has feature k.
+std::vector<bool> everywhere(Eigen::Index n, const std::vector<Eigen::VectorXd> &samples) {
+    std::vector<bool> all(std::size_t(n), true);
+    for (const Eigen::VectorXd &m : samples)
+        for (Eigen::Index k = 0; k < n; ++k)
+            all[std::size_t(k)] = all[std::size_t(k)] && std::isfinite(m[k]);
+    return all;
+}
+
+/// `mean` with every feature a response lacks somewhere taken at the base (`off`): one missing
+/// at some strengths (a bin a softer soil never reaches) would drop out of chi^2 only there and
+/// make those strengths look better; dropped everywhere, the effect's chi^2 would be summed over
+/// fewer features than its rivals'. At the base, it counts for every strength and every effect
+/// as what this effect does not explain.
+Eigen::VectorXd atBaseWhereMissing(Eigen::VectorXd mean, const std::vector<bool> &has,
+                                   const Eigen::VectorXd &off) {
+    for (Eigen::Index k = 0; k < mean.size(); ++k)
+        if (!has[std::size_t(k)])
+            mean[k] = off[k];
+    return mean;
 }
 
 /// Where a strength profile over [t0, t1] looks: its grid, "off", and a fifth of the span
@@ -207,13 +214,17 @@ StrengthFit fitStrength(const Response &response, const Prior &prior,
     std::vector<Eigen::VectorXd> samples;
     for (double t : profilePoints(t0, t1, prior.toScale(prior.off)))
         samples.push_back(response.mean(prior.fromScale(t)));
-    const FeatureSet use = supported(all_features, samples);
+    const std::vector<bool> has = everywhere(measured.size(), samples);
+    const Eigen::VectorXd off_mean = response.mean(prior.off),
+                          off_var = response.variance(prior.off);
     const auto chi2 = [&](double t) {
         const double s = prior.fromScale(t);
-        return chiSquare(measured, response.mean(s), response.variance(s), u2_fixed, use,
-                         correlation);
+        return chiSquare(measured, atBaseWhereMissing(response.mean(s), has, off_mean),
+                         atBaseWhereMissing(response.variance(s), has, off_var), u2_fixed,
+                         all_features, correlation);
     };
     StrengthFit fit;
+    const FeatureSet &use = all_features;
     fit.features = int(use.size());
     // A first pass gives the Birge ratio that widens the interval of a poor best fit.
     const Profile first = minimiseProfile(chi2, t0, t1, 1.0);
@@ -248,16 +259,19 @@ PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Pri
     const double a0 = pa.toScale(pa.lo), a1 = pa.toScale(pa.hi);
     const double b0 = pb.toScale(pb.lo), b1 = pb.toScale(pb.hi);
     constexpr int n = 41;
-    // A pair's mean is the sum of its two responses' changes: its features are those both have.
+    // A pair's mean is the sum of its two responses' changes: its features are those both
+    // have; the others are taken at the base, as for one effect.
     std::vector<Eigen::VectorXd> samples;
     for (const auto &[r, p] : {std::pair{&a, &pa}, std::pair{&b, &pb}})
         for (double t : profilePoints(p->toScale(p->lo), p->toScale(p->hi), p->toScale(p->off)))
             samples.push_back(r->mean(p->fromScale(t)));
-    const FeatureSet use = supported(all_features, samples);
+    const std::vector<bool> has = everywhere(measured.size(), samples);
+    const FeatureSet &use = all_features;
     const auto chi2 = [&](double ta, double tb) {
         const double sa = pa.fromScale(ta), sb = pb.fromScale(tb);
-        return chiSquare(measured, pair.mean(sa, sb), pair.variance(sa, sb), u2_fixed, use,
-                         correlation);
+        return chiSquare(measured, atBaseWhereMissing(pair.mean(sa, sb), has, base_mean),
+                         atBaseWhereMissing(pair.variance(sa, sb), has, base_variance), u2_fixed,
+                         use, correlation);
     };
     double best = std::numeric_limits<double>::infinity(), ta = a0, tb = b0;
     for (int i = 0; i < n; ++i)

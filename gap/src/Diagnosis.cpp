@@ -113,7 +113,10 @@ std::vector<std::string> defaultHeldOut(const ExperimentSet &set) {
                 if ((e->labels.count("box") ? e->labels.at("box") : "") == last)
                     held.push_back(e->id);
         } else {
-            held.push_back(list.back()->id);
+            // Its last half, rounded down: two held-out experiments are the fewest a claim can
+            // rest on (one is one piece of evidence), and the calibration keeps the rest.
+            for (std::size_t i = list.size() - list.size() / 2; i < list.size(); ++i)
+                held.push_back(list[i]->id);
         }
     }
     return held;
@@ -545,8 +548,15 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         if (R.explains && (!winner || R.held_out.log_density > winner->held_out.log_density))
             winner = &R;
 
-    // Pairs, where no single effect explains the gap.
-    if (!winner) {
+    // Pairs, where no single effect explains the gap and a claim is possible at all (a
+    // resolved base, two or more held-out experiments compared).
+    const std::size_t held_out_compared = [&] {
+        std::set<std::string> ids;
+        for (Eigen::Index k : D.held_out)
+            ids.insert(meas.keys[std::size_t(k)].experiment);
+        return ids.size();
+    }();
+    if (!winner && resolved && held_out_compared >= 2) {
         std::vector<std::size_t> pool;
         for (std::size_t i : applicable)
             if (int(pool.size()) < opt.pair_pool && live[i].result.calibration_gain > 0.0)
@@ -597,12 +607,6 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     }
 
     // The verdict.
-    const auto heldOutCompared = [&] {
-        std::set<std::string> ids;
-        for (Eigen::Index k : D.held_out)
-            ids.insert(meas.keys[std::size_t(k)].experiment);
-        return ids.size();
-    };
     const auto reduction = [&](const HeldOutScore &after) {
         return D.held_out_base.gap > 0.0 ? 100.0 * (1.0 - after.gap / D.held_out_base.gap) : 0.0;
     };
@@ -645,7 +649,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 claim << "unexplained: no held-out experiment to test a candidate on (a claim "
                          "needs experiments it was not fitted to: give two or more experiments "
                          "of a type, or name them with --hold-out)";
-            else if (heldOutCompared() < 2)
+            else if (held_out_compared < 2)
                 claim << "unexplained: one held-out experiment is one piece of evidence, however "
                          "many features it has (a claim needs two or more: name them with "
                          "--hold-out)";

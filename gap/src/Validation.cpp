@@ -83,9 +83,11 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
     }
     Eigen::VectorXd num2 = v.u_seed.array().square();
     // A numerical choice moves an experiment's curve, as a whole or in shape: its systematic
-    // part is the root mean square of the experiment's relative differences from the base, with
-    // their seed noise removed (docs/gap.md, "Validation uncertainty"). A signed mean would let
-    // a check that raises the curve's start and lowers its end look like no change.
+    // part is the root mean square of the experiment's differences from the base, with their
+    // seed noise removed, relative to the base's root mean square (docs/gap.md, "Validation
+    // uncertainty"). A signed mean would let a check that raises the curve's start and lowers
+    // its end look like no change; a mean of relative differences would let a bin near zero
+    // (the first millimetre of a plate) speak for the whole curve.
     std::map<std::string, std::vector<Eigen::Index>> by_experiment;
     for (Eigen::Index k = 0; k < n; ++k)
         by_experiment[measured.keys[std::size_t(k)].experiment].push_back(k);
@@ -97,7 +99,7 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
         const ColumnStats c = columnStats(check.rows);
         Eigen::VectorXd u = Eigen::VectorXd::Zero(n);
         for (const auto &[id, idx] : by_experiment) {
-            double sum2 = 0.0, var = 0.0;
+            double sum2 = 0.0, var = 0.0, level2 = 0.0;
             int k_used = 0;
             for (Eigen::Index k : idx) {
                 if (c.count[k] == 0 || !std::isfinite(b.mean[k]) || b.mean[k] == 0.0)
@@ -108,9 +110,10 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
                 const double sc2 = nc >= 2 && std::isfinite(c.sd[k]) ? c.sd[k] * c.sd[k] : sb2;
                 const double dof = std::max(1.0, nb + nc - 2.0);
                 const double pooled = ((nb - 1.0) * sb2 + std::max(0.0, nc - 1.0) * sc2) / dof;
-                const double d = (c.mean[k] - b.mean[k]) / b.mean[k];
+                const double d = c.mean[k] - b.mean[k];
                 sum2 += d * d;
-                var += pooled * (1.0 / nc + 1.0 / std::max(1.0, nb)) / (b.mean[k] * b.mean[k]);
+                var += pooled * (1.0 / nc + 1.0 / std::max(1.0, nb));
+                level2 += b.mean[k] * b.mean[k];
                 ++k_used;
             }
             if (k_used == 0) {
@@ -122,7 +125,7 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
                 continue;
             }
             // E[d^2] = delta^2 + var d, whatever the features' correlation.
-            const double systematic = std::sqrt(std::max(0.0, (sum2 - var) / k_used));
+            const double systematic = std::sqrt(std::max(0.0, (sum2 - var) / level2));
             for (Eigen::Index k : idx)
                 if (std::isfinite(b.mean[k]))
                     u[k] = systematic * std::abs(b.mean[k]);

@@ -90,8 +90,8 @@ TEST_CASE("CURVE: keyed participants run, a wrong key is refused and named",
     config.curve = loadServerKeys(keys);
     CHECK(config.curve->allowed_participants.size() == 2);
 
-    auto side = [&keys](Role role, const char *name, const std::string &endpoint,
-                        const std::string &key_directory) {
+    auto side = [](Role role, const char *name, const std::string &endpoint,
+                   const std::string &key_directory) {
         return std::async(std::launch::async, [=] {
             auto c = twoMassConfig(role, name, endpoint);
             c.curve = loadClientKeys(key_directory, name);

@@ -501,3 +501,28 @@ TEST_CASE("when nothing is claimed the closest by held-out gap and the nearest t
     CHECK(none.by_gap == nullptr);
     CHECK(none.by_p_value == nullptr);
 }
+
+TEST_CASE("the default held-out experiments: the last box, else the last half of a type",
+          "[gap][diagnosis]") {
+    const auto set = [](int plates, bool boxes) {
+        ExperimentSet s;
+        for (int i = 0; i < plates; ++i) {
+            Experiment e;
+            e.id = "p" + std::to_string(i);
+            e.type = ExperimentType::PlateSinkage;
+            if (boxes)
+                e.labels["box"] = i < 2 ? "large" : "small";
+            s.experiments.push_back(e);
+        }
+        Experiment shear;
+        shear.id = "shear";
+        shear.type = ExperimentType::DirectShear;
+        s.experiments.push_back(shear); // alone of its type: calibration only
+        return s;
+    };
+    CHECK(defaultHeldOut(set(4, false)) == std::vector<std::string>{"p2", "p3"});
+    CHECK(defaultHeldOut(set(5, false)) == std::vector<std::string>{"p3", "p4"});
+    CHECK(defaultHeldOut(set(3, false)) == std::vector<std::string>{"p2"});
+    CHECK(defaultHeldOut(set(1, false)).empty());
+    CHECK(defaultHeldOut(set(5, true)) == std::vector<std::string>{"p2", "p3", "p4"});
+}

@@ -89,6 +89,27 @@ TEST_CASE("a numerical check's systematic part: found when it shifts or reshapes
     CHECK(reshaped == Approx(30.0).margin(6.0));
 }
 
+TEST_CASE("a numerical check's systematic part is not set by a bin near zero",
+          "[gap][validation]") {
+    // Six bins, the first at 1 (a plate's first millimetre), the rest at 100; the check moves
+    // the first by 1 (100 % of it) and nothing else. Its part is sqrt(1 / (1 + 5 * 100^2)) of
+    // each bin's value: 0.45 at 100 (a mean of relative differences gave 41 %, 41 at 100).
+    Measured m;
+    for (int b = 0; b < 6; ++b)
+        m.keys.push_back({"e", "p", "k", 0.001 * b, 0.001 * (b + 1)});
+    m.value = Eigen::VectorXd::Constant(6, 100.0);
+    m.u_D = Eigen::VectorXd::Constant(6, 1.0);
+    m.trials = Eigen::VectorXd::Constant(6, 3).cast<int>();
+    m.from_repeats.assign(6, true);
+    Eigen::MatrixXd base = Eigen::MatrixXd::Constant(3, 6, 100.0), check(2, 6);
+    base.col(0).setConstant(1.0);
+    check = base.topRows(2);
+    check.col(0).setConstant(2.0);
+    const auto u = validate(m, base, {{"resolution", check}}).u_checks[0].second;
+    CHECK(u[3] == Approx(100.0 / std::sqrt(1.0 + 5.0 * 1e4)).epsilon(1e-9));
+    CHECK(u[0] == Approx(1.0 / std::sqrt(1.0 + 5.0 * 1e4)).epsilon(1e-9));
+}
+
 TEST_CASE("standardised residuals of a matching model are about unit normal",
           "[gap][validation]") {
     // Monte Carlo: the truth and the simulation are the same process (bed scatter 1), the

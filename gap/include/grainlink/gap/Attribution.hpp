@@ -76,8 +76,9 @@ double chiSquare(const Eigen::VectorXd &measured, const Eigen::VectorXd &mean,
                  const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_fixed,
                  const FeatureSet &use, const BlockCorrelation &correlation = {});
 
-/// The strength that minimises chi^2 over the features of `use` that the response has at every
-/// strength of its prior (a grid over the prior, then golden section),
+/// The strength that minimises chi^2 over `use`, a feature the response lacks at some strength
+/// of its prior taken at the base ("off") at all of them (a grid over the prior, then golden
+/// section),
 /// with a 95 % interval from the chi^2 profile (delta chi^2 = 3.84, widened by the Birge ratio
 /// chi^2 / dof when the best fit is poor).
 struct StrengthFit {

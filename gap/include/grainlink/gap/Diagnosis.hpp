@@ -152,7 +152,8 @@ ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidat
 
 /// The calibration / held-out split by experiment id (docs/gap.md): `held_out` when given;
 /// otherwise, for every experiment type with two or more experiments, the experiments of its
-/// last condition group (its last `box` label when it has several, else its last experiment).
+/// last condition group (its last `box` label when it has several, else its last half, rounded
+/// down).
 std::vector<std::string> defaultHeldOut(const ExperimentSet &set);
 
 /// Runs the whole pipeline on measured `set` with the catalogue's diagnosable `effects`.
