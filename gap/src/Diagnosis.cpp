@@ -73,7 +73,7 @@ ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidat
             continue;
         if (!c.by_gap || R.held_out.gap < c.by_gap->held_out.gap)
             c.by_gap = &R;
-        if (!c.by_p_value || R.p_value < c.by_p_value->p_value)
+        if (!c.by_p_value || R.versus_null.p_value < c.by_p_value->versus_null.p_value)
             c.by_p_value = &R;
     }
     return c;
@@ -413,8 +413,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // (`strength_var`), as the null model's carries its posterior: each predicts with what it
     // knows. The gap left with the model is judged without it.
     const auto evaluateModel = [&](const Eigen::MatrixXd &rows, HeldOutScore &score,
-                                   double &p_value, GapVerdict &after, Eigen::VectorXd &mean,
-                                   const Eigen::VectorXd &strength_var) {
+                                   DensityComparison &versus_null, GapVerdict &after,
+                                   Eigen::VectorXd &mean, const Eigen::VectorXd &strength_var) {
         const auto mv = meanAndVariance(rows, bed_sd);
         mean = mv.first;
         if (!coversBase(mean, V.simulated, meas.keys)) { // its runs failed somewhere: it predicts nothing there
@@ -422,7 +422,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             score = HeldOutScore{};
             score.gap = score.relative_rmse = score.smse = inf;
             score.log_density = -inf;
-            p_value = 1.0;
+            versus_null = DensityComparison{};
             after.gap = true;
             after.summary = "its confirming runs failed on some experiment";
             return false;
@@ -430,9 +430,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const Eigen::VectorXd var = u2_fixed + mv.second;
         const Eigen::VectorXd predictive = var + strength_var;
         score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);
-        const DensityComparison c = compareDensities(meas.value, mean, predictive, null_mean,
-                                                     null_var, D.held_out, meas.keys);
-        p_value = c.p_value;
+        versus_null = compareDensities(meas.value, mean, predictive, null_mean, null_var,
+                                       D.held_out, meas.keys);
+        const DensityComparison &c = versus_null;
         Eigen::VectorXd e = (meas.value - mean).array() / var.array().sqrt();
         for (Eigen::Index k = 0; k < e.size(); ++k)
             e[k] = normalEquivalent(e[k], V.dof[k]);
@@ -532,9 +532,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         for (Eigen::Index k = 0; k < strength_var.size(); ++k)
             if (!std::isfinite(strength_var[k]))
                 strength_var[k] = 0.0;
-        const bool better = evaluateModel(final_rows[c], R.held_out, R.p_value, R.after,
+        const bool better = evaluateModel(final_rows[c], R.held_out, R.versus_null, R.after,
                                           R.confirmed_mean, strength_var);
-        R.beats_null = better && R.p_value < level && !D.held_out.empty();
+        R.beats_null = better && R.versus_null.p_value < level && !D.held_out.empty();
         // A strength at its prior's edge may stand in for something the catalogue lacks (LIGGGHTS'
         // 5x softer soil fitted by the softest grains allowed): it may beat the null, it is
         // still not claimed as the cause.
@@ -598,10 +598,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         for (std::size_t i = 0; i < confirm_pairs; ++i) {
             PairResult &P = pairs[i];
             P.confirmed = true;
-            const bool better = evaluateModel(pair_rows[i], P.held_out, P.p_value, P.after,
+            const bool better = evaluateModel(pair_rows[i], P.held_out, P.versus_null, P.after,
                                               P.confirmed_mean, Eigen::VectorXd::Zero(n));
-            P.explains = better && P.p_value < pair_level && !P.after.gap && !D.held_out.empty() &&
-                         !P.fit.a.at_prior_edge && !P.fit.b.at_prior_edge && resolved;
+            P.explains = better && P.versus_null.p_value < pair_level && !P.after.gap &&
+                         !D.held_out.empty() && !P.fit.a.at_prior_edge && !P.fit.b.at_prior_edge &&
+                         resolved;
         }
         D.pairs = pairs;
     }
@@ -614,13 +615,14 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     if (winner) {
         D.outcome = Diagnosis::Outcome::Explained;
         const Effect &e = winner->effect;
-        claim << "explained by " << e.name << " (" << e.description << "): "
-              << strengthText(e, winner->fit.strength) << " [" << fmt(winner->fit.lo) << ", "
-              << fmt(winner->fit.hi) << "] (base " << fmt(e.prior.off) << "); held-out gap "
+        claim << "explained by " << e.name << " (" << e.description
+              << "): " << strengthText(e, winner->fit.strength) << " [" << fmt(winner->fit.lo)
+              << ", " << fmt(winner->fit.hi) << "] (base " << fmt(e.prior.off) << "); held-out gap "
               << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
-              << fmt(100.0 * winner->held_out.gap, 2) << " % (" << fmt(reduction(winner->held_out), 2)
-              << " % smaller; null model " << fmt(100.0 * D.held_out_null.gap, 2)
-              << " %, p = " << fmt(winner->p_value, 2) << ")";
+              << fmt(100.0 * winner->held_out.gap, 2) << " % ("
+              << fmt(reduction(winner->held_out), 2) << " % smaller; null model "
+              << fmt(100.0 * D.held_out_null.gap, 2)
+              << " %, p = " << fmt(winner->versus_null.p_value, 2) << ")";
         for (const CandidateResult &R : D.candidates)
             if (&R != winner && R.explains)
                 D.indistinguishable.push_back(R.name);
@@ -634,9 +636,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         if (pair) {
             D.outcome = Diagnosis::Outcome::ExplainedByPair;
             claim << "explained by " << pair->a << " + " << pair->b << ": " << pair->a << " "
-                  << fmt(pair->fit.a.strength) << ", " << pair->b << " " << fmt(pair->fit.b.strength)
-                  << "; held-out gap " << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
-                  << fmt(100.0 * pair->held_out.gap, 2) << " % (p = " << fmt(pair->p_value, 2) << ")";
+                  << fmt(pair->fit.a.strength) << ", " << pair->b << " "
+                  << fmt(pair->fit.b.strength) << "; held-out gap "
+                  << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
+                  << fmt(100.0 * pair->held_out.gap, 2)
+                  << " % (p = " << fmt(pair->versus_null.p_value, 2) << ")";
             D.best_model = pair->a + " + " + pair->b;
             D.best_model_mean = pair->confirmed_mean;
         } else {
@@ -663,11 +667,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 D.best_model_mean = best->confirmed_mean;
             }
             if (best)
-                claim << "; closest: " << best->name << " at " << strengthText(best->effect, best->fit.strength)
-                      << " (held-out gap " << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
+                claim << "; closest: " << best->name << " at "
+                      << strengthText(best->effect, best->fit.strength) << " (held-out gap "
+                      << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
                       << fmt(100.0 * best->held_out.gap, 2) << " %, " << best->after.flagged
-                      << " features still beyond " << fmt(opt.flag_at, 2) << " u_val, p = "
-                      << fmt(best->p_value, 2)
+                      << " features still beyond " << fmt(opt.flag_at, 2)
+                      << " u_val, p = " << fmt(best->versus_null.p_value, 2)
                       << (best->fit.beyond_prior ? ", pinned at its prior's edge: the data ask for "
                                                    "more of it than is plausible"
                           : best->fit.at_prior_edge ? ", at its prior's edge: not claimed"
@@ -678,7 +683,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 claim << "; nearest to a claim: " << nearest->name << " at "
                       << strengthText(nearest->effect, nearest->fit.strength) << " (held-out gap "
                       << fmt(100.0 * nearest->held_out.gap, 2)
-                      << " %, p = " << fmt(nearest->p_value, 3) << " against the level "
+                      << " %, p = " << fmt(nearest->versus_null.p_value, 3) << " against the level "
                       << fmt(level, 3) << ")";
             }
         }

@@ -25,6 +25,14 @@ Json score(const HeldOutScore &s) {
             {"log_predictive_density", number(s.log_density)}};
 }
 
+/// The held-out log-density gain over the null, and what its p value rests on.
+Json gain(const DensityComparison &c) {
+    return {{"mean_per_feature", number(c.mean_gain)},
+            {"features", c.features},
+            {"experiments", c.experiments},
+            {"share_between_experiments", number(c.gain_correlation)}};
+}
+
 Json verdict(const GapVerdict &g) {
     return {{"gap", g.gap},
             {"flagged_features", g.flagged},
@@ -103,7 +111,8 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
             cj["confirmed"] = c.confirmed;
             if (c.confirmed) {
                 cj["held_out"] = score(c.held_out);
-                cj["p_value_against_null"] = number(c.p_value);
+                cj["p_value_against_null"] = number(c.versus_null.p_value);
+                cj["held_out_gain"] = gain(c.versus_null);
                 cj["beats_null"] = c.beats_null;
                 cj["gap_test_with_effect"] = verdict(c.after);
                 cj["explains"] = c.explains;
@@ -119,7 +128,8 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
                 {"confirmed", p.confirmed}};
         if (p.confirmed) {
             pj["held_out"] = score(p.held_out);
-            pj["p_value_against_null"] = number(p.p_value);
+            pj["p_value_against_null"] = number(p.versus_null.p_value);
+            pj["held_out_gain"] = gain(p.versus_null);
             pj["gap_test_with_effects"] = verdict(p.after);
             pj["explains"] = p.explains;
         }
@@ -169,11 +179,13 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
         r << c.effect.parameter << " = " << c.fit.strength << " [" << c.fit.lo << ", " << c.fit.hi
           << "] " << c.effect.unit << ", chi^2 " << c.fit.chi2 << " (off: " << c.fit.chi2_off << ")";
         if (c.confirmed)
-            r << "; confirmed: held-out gap " << pct(c.held_out.gap) << ", p = " << c.p_value
-              << (c.explains                          ? ", EXPLAINS"
-                  : c.beats_null && c.fit.at_prior_edge ? ", beats the null but only at its prior's edge"
-                  : c.beats_null                       ? ", beats the null but leaves a gap"
-                                                       : ", does not beat the null");
+            r << "; confirmed: held-out gap " << pct(c.held_out.gap)
+              << ", p = " << c.versus_null.p_value
+              << (c.explains ? ", EXPLAINS"
+                  : c.beats_null && c.fit.at_prior_edge
+                      ? ", beats the null but only at its prior's edge"
+                  : c.beats_null ? ", beats the null but leaves a gap"
+                                 : ", does not beat the null");
         if (c.fit.beyond_prior)
             r << "; pinned at its prior's edge (the data ask for more than " << c.effect.prior.lo
               << "-" << c.effect.prior.hi << " allows)";

@@ -177,7 +177,12 @@ TEST_CASE("diagnosis on an analytic soil names the hidden effect and its strengt
     for (const Truth &t : truths) {
         const Diagnosis d = run(t);
         INFO(t.effect << ": " << d.claim << " | null gap " << d.held_out_null.gap << " smse " << d.held_out_null.smse << " base smse " << d.held_out_base.smse);
-        for (const auto &c : d.candidates) if (c.confirmed) UNSCOPED_INFO(c.name << " smse " << c.held_out.smse << " n " << c.held_out.features << " p " << c.p_value << " fit " << c.fit.strength << " [" << c.fit.lo << "," << c.fit.hi << "] birge " << c.fit.birge << " after " << c.after.summary);
+        for (const auto &c : d.candidates)
+            if (c.confirmed)
+                UNSCOPED_INFO(c.name << " smse " << c.held_out.smse << " n " << c.held_out.features
+                                     << " p " << c.versus_null.p_value << " fit " << c.fit.strength
+                                     << " [" << c.fit.lo << "," << c.fit.hi << "] birge "
+                                     << c.fit.birge << " after " << c.after.summary);
         REQUIRE(d.outcome == Diagnosis::Outcome::Explained);
         const CandidateResult *winner = nullptr;
         for (const auto &c : d.candidates)
@@ -234,6 +239,14 @@ TEST_CASE("the diagnosis writes diagnosis.json, features.csv, report.txt and a s
     CHECK(j["outcome"] == "explained");
     CHECK(j["claim"].get<std::string>().find("cohesion") != std::string::npos);
     CHECK(j["candidates"].size() == d.candidates.size());
+    // The claimed candidate's held-out gain and what its p value rests on: the four held-out
+    // plates, eight features each.
+    for (const auto &c : j["candidates"])
+        if (c["effect"] == "cohesion") {
+            CHECK(c["held_out_gain"]["experiments"] == 4);
+            CHECK(c["held_out_gain"]["features"] == 32);
+            CHECK(c["held_out_gain"]["mean_per_feature"].get<double>() > 0.0);
+        }
     std::ifstream features(dir / "features.csv");
     std::string line;
     int lines = 0;
@@ -485,7 +498,7 @@ TEST_CASE("when nothing is claimed the closest by held-out gap and the nearest t
         R.name = name;
         R.confirmed = confirmed;
         R.held_out.gap = gap;
-        R.p_value = p;
+        R.versus_null.p_value = p;
         return R;
     };
     const std::vector<CandidateResult> candidates{candidate("rig_compliance", true, 1.20, 0.82),

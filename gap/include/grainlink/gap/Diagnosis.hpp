@@ -80,7 +80,7 @@ struct CandidateResult {
     HeldOutScore predicted;    ///< held-out score from the signature (before confirmation)
     bool confirmed = false;    ///< re-simulated at the fitted strength
     HeldOutScore held_out;     ///< held-out score of the confirming simulation
-    double p_value = 1.0;      ///< sample-split test against the null
+    DensityComparison versus_null; ///< sample-split test against the null (held-out)
     bool beats_null = false;
     bool explains = false;     ///< beats the null and leaves no gap on any feature
     GapVerdict after;          ///< the gap test with the effect added (confirmed)
@@ -92,7 +92,7 @@ struct PairResult {
     PairFit fit;
     bool confirmed = false;
     HeldOutScore held_out;
-    double p_value = 1.0;
+    DensityComparison versus_null;
     bool explains = false;
     GapVerdict after;
     Eigen::VectorXd confirmed_mean;
