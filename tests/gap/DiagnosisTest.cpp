@@ -142,18 +142,24 @@ public:
     }
 };
 
+/// Four base seeds, three per signature; by default calibrated on the 50 and 70 mm plates and
+/// predicting the 90 and 110 mm ones: a generic discrepancy must extrapolate in plate size, the
+/// physics of an effect carries over.
+DiagnosisOptions analyticOptions(std::vector<std::string> held_out = {"large_90", "large_110",
+                                                                      "small_90", "small_110"}) {
+    DiagnosisOptions o;
+    o.seeds = 4;
+    o.signature_seeds = 3;
+    o.held_out = std::move(held_out);
+    return o;
+}
+
 Diagnosis run(const Truth &t, unsigned seed = 7,
               std::vector<std::string> held_out = {"large_90", "large_110", "small_90",
                                                    "small_110"}) {
     const EffectCatalogue c = shippedEffects();
     AnalyticSimulator sim;
-    DiagnosisOptions o;
-    o.seeds = 4;
-    o.signature_seeds = 3;
-    // Calibrate on the 50 and 70 mm plates, predict the 90 and 110 mm ones: a generic
-    // discrepancy must extrapolate in plate size, the physics of an effect carries over.
-    o.held_out = held_out;
-    return diagnose(measuredSet(t, seed), c.diagnosable(), sim, o);
+    return diagnose(measuredSet(t, seed), c.diagnosable(), sim, analyticOptions(held_out));
 }
 
 } // namespace
@@ -394,9 +400,7 @@ TEST_CASE("diagnosis: without a held-out experiment a gap is found but nothing i
           "[gap][diagnosis]") {
     const EffectCatalogue c = shippedEffects();
     AnalyticSimulator sim;
-    DiagnosisOptions o;
-    o.seeds = 4;
-    o.signature_seeds = 3;
+    const DiagnosisOptions o = analyticOptions({});
     ExperimentSet set = measuredSet({"cohesion", 6.0e4}, 7);
     set.experiments.resize(1); // one plate: nothing to hold out
     const Diagnosis d = diagnose(set, c.diagnosable(), sim, o);
@@ -416,10 +420,7 @@ TEST_CASE("diagnosis: on a base that its numerical check moves by over half, a g
     const EffectCatalogue c = shippedEffects();
     AnalyticSimulator sim;
     sim.resolution_factor = 1.6;
-    DiagnosisOptions o;
-    o.seeds = 4;
-    o.signature_seeds = 3;
-    o.held_out = {"large_90", "large_110", "small_90", "small_110"};
+    const DiagnosisOptions o = analyticOptions();
     const Diagnosis d = diagnose(measuredSet({"cohesion", 1.5e5}, 7), c.diagnosable(), sim, o);
     INFO(d.claim);
     REQUIRE(d.verdict.gap);
@@ -447,10 +448,7 @@ TEST_CASE("diagnosis: an effect whose runs failed is not fitted as if it agreed"
     // cohesion still named.
     const EffectCatalogue c = shippedEffects();
     FailingEffectSimulator sim("polydispersity", {"large_50", "large_70"});
-    DiagnosisOptions o;
-    o.seeds = 4;
-    o.signature_seeds = 3;
-    o.held_out = {"large_90", "large_110", "small_90", "small_110"};
+    const DiagnosisOptions o = analyticOptions();
     const Diagnosis d = diagnose(measuredSet({"cohesion", 4.0e4}, 7), c.diagnosable(), sim, o);
     INFO(d.claim);
     const CandidateResult *poly = nullptr;
@@ -468,10 +466,7 @@ TEST_CASE("diagnosis: a candidate whose confirming runs failed is replaced by th
     // The hidden cohesion leads; its confirming runs fail on a held-out plate. It is not
     // claimed, and one more candidate than otherwise is confirmed in its place.
     const EffectCatalogue c = shippedEffects();
-    DiagnosisOptions o;
-    o.seeds = 4;
-    o.signature_seeds = 3;
-    o.held_out = {"large_90", "large_110", "small_90", "small_110"};
+    const DiagnosisOptions o = analyticOptions();
     const ExperimentSet set = measuredSet({"cohesion", 4.0e4}, 7);
     const auto confirmed = [](const Diagnosis &d) {
         int n = 0;

@@ -19,6 +19,18 @@ Measured oneFeature(double value, double u_D, bool repeats) {
     return m;
 }
 
+/// Six bins of one experiment, each measured at 100 from three repeats.
+Measured sixBinMeasurement() {
+    Measured m;
+    for (int b = 0; b < 6; ++b)
+        m.keys.push_back({"e", "p", "k", 0.001 * b, 0.001 * (b + 1)});
+    m.value = Eigen::VectorXd::Constant(6, 100.0);
+    m.u_D = Eigen::VectorXd::Constant(6, 1.0);
+    m.trials = Eigen::VectorXi::Constant(6, 3);
+    m.from_repeats.assign(6, true);
+    return m;
+}
+
 } // namespace
 
 TEST_CASE("u_val combines the seeds, one bed's scatter, the checks and the measurement",
@@ -53,13 +65,7 @@ TEST_CASE("a numerical check's systematic part: found when it shifts or reshapes
     // one that raises the first three bins by 30 % and lowers the last three by 30 % (a signed
     // mean of the differences saw none of it); one that changes nothing contributes about half
     // the noise of the difference on average (the positive part of d^2 - var d), not the noise.
-    Measured m;
-    for (int b = 0; b < 6; ++b)
-        m.keys.push_back({"e", "p", "k", 0.001 * b, 0.001 * (b + 1)});
-    m.value = Eigen::VectorXd::Constant(6, 100.0);
-    m.u_D = Eigen::VectorXd::Constant(6, 1.0);
-    m.trials = Eigen::VectorXi::Constant(6, 3);
-    m.from_repeats.assign(6, true);
+    const Measured m = sixBinMeasurement();
     std::mt19937 rng(5);
     std::normal_distribution<double> z;
     double shifted = 0.0, still = 0.0, reshaped = 0.0;
@@ -94,13 +100,7 @@ TEST_CASE("a numerical check's systematic part is not set by a bin near zero",
     // Six bins, the first at 1 (a plate's first millimetre), the rest at 100; the check moves
     // the first by 1 (100 % of it) and nothing else. Its part is sqrt(1 / (1 + 5 * 100^2)) of
     // each bin's value: 0.45 at 100 (a mean of relative differences gave 41 %, 41 at 100).
-    Measured m;
-    for (int b = 0; b < 6; ++b)
-        m.keys.push_back({"e", "p", "k", 0.001 * b, 0.001 * (b + 1)});
-    m.value = Eigen::VectorXd::Constant(6, 100.0);
-    m.u_D = Eigen::VectorXd::Constant(6, 1.0);
-    m.trials = Eigen::VectorXd::Constant(6, 3).cast<int>();
-    m.from_repeats.assign(6, true);
+    const Measured m = sixBinMeasurement();
     Eigen::MatrixXd base = Eigen::MatrixXd::Constant(3, 6, 100.0), check(2, 6);
     base.col(0).setConstant(1.0);
     check = base.topRows(2);
