@@ -98,15 +98,6 @@ bool beyondPrior(F chi2, const Profile &p, double t0, double t1, double t_off) {
     return std::isfinite(c) && c < p.chi2 - std::max(kDeltaChi2_95, 0.1 * p.chi2);
 }
 
-/// Whether every sample of a response has feature k.
-std::vector<bool> everywhere(Eigen::Index n, const std::vector<Eigen::VectorXd> &samples) {
-    std::vector<bool> all(std::size_t(n), true);
-    for (const Eigen::VectorXd &m : samples)
-        for (Eigen::Index k = 0; k < n; ++k)
-            all[std::size_t(k)] = all[std::size_t(k)] && std::isfinite(m[k]);
-    return all;
-}
-
 /// `mean` with every feature a response lacks somewhere taken at the base (`off`): one missing
 /// at some strengths (a bin a softer soil never reaches) would drop out of chi^2 only there and
 /// make those strengths look better; dropped everywhere, the effect's chi^2 would be summed over
@@ -127,6 +118,18 @@ std::vector<double> profilePoints(double t0, double t1, double t_off) {
     for (int k = 0; k < kGrid; ++k)
         t.push_back(t0 + (t1 - t0) * k / double(kGrid - 1));
     return t;
+}
+
+/// Whether `response` has feature k at every point a profile over `prior` looks at.
+std::vector<bool> hasEverywhere(const Response &response, const Prior &prior, Eigen::Index n) {
+    std::vector<bool> all(std::size_t(n), true);
+    const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi);
+    for (double t : profilePoints(t0, t1, prior.toScale(prior.off))) {
+        const Eigen::VectorXd m = response.mean(prior.fromScale(t));
+        for (Eigen::Index k = 0; k < n; ++k)
+            all[std::size_t(k)] = all[std::size_t(k)] && std::isfinite(m[k]);
+    }
+    return all;
 }
 
 } // namespace
@@ -209,22 +212,18 @@ double chiSquare(const Eigen::VectorXd &measured, const Eigen::VectorXd &mean,
 
 StrengthFit fitStrength(const Response &response, const Prior &prior,
                         const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
-                        const FeatureSet &all_features, const BlockCorrelation &correlation) {
+                        const FeatureSet &use, const BlockCorrelation &correlation) {
     const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi);
-    std::vector<Eigen::VectorXd> samples;
-    for (double t : profilePoints(t0, t1, prior.toScale(prior.off)))
-        samples.push_back(response.mean(prior.fromScale(t)));
-    const std::vector<bool> has = everywhere(measured.size(), samples);
+    const std::vector<bool> has = hasEverywhere(response, prior, measured.size());
     const Eigen::VectorXd off_mean = response.mean(prior.off),
                           off_var = response.variance(prior.off);
     const auto chi2 = [&](double t) {
         const double s = prior.fromScale(t);
         return chiSquare(measured, atBaseWhereMissing(response.mean(s), has, off_mean),
-                         atBaseWhereMissing(response.variance(s), has, off_var), u2_fixed,
-                         all_features, correlation);
+                         atBaseWhereMissing(response.variance(s), has, off_var), u2_fixed, use,
+                         correlation);
     };
     StrengthFit fit;
-    const FeatureSet &use = all_features;
     fit.features = int(use.size());
     // A first pass gives the Birge ratio that widens the interval of a poor best fit.
     const Profile first = minimiseProfile(chi2, t0, t1, 1.0);
@@ -254,19 +253,17 @@ Eigen::VectorXd PairResponse::variance(double sa, double sb) const {
 PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Prior &pb,
                 const Eigen::VectorXd &base_mean, const Eigen::VectorXd &base_variance,
                 const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
-                const FeatureSet &all_features, const BlockCorrelation &correlation) {
+                const FeatureSet &use, const BlockCorrelation &correlation) {
     PairResponse pair(a, b, base_mean, base_variance);
     const double a0 = pa.toScale(pa.lo), a1 = pa.toScale(pa.hi);
     const double b0 = pb.toScale(pb.lo), b1 = pb.toScale(pb.hi);
     constexpr int n = 41;
     // A pair's mean is the sum of its two responses' changes: its features are those both
     // have; the others are taken at the base, as for one effect.
-    std::vector<Eigen::VectorXd> samples;
-    for (const auto &[r, p] : {std::pair{&a, &pa}, std::pair{&b, &pb}})
-        for (double t : profilePoints(p->toScale(p->lo), p->toScale(p->hi), p->toScale(p->off)))
-            samples.push_back(r->mean(p->fromScale(t)));
-    const std::vector<bool> has = everywhere(measured.size(), samples);
-    const FeatureSet &use = all_features;
+    std::vector<bool> has = hasEverywhere(a, pa, measured.size());
+    const std::vector<bool> has_b = hasEverywhere(b, pb, measured.size());
+    for (std::size_t k = 0; k < has.size(); ++k)
+        has[k] = has[k] && has_b[k];
     const auto chi2 = [&](double ta, double tb) {
         const double sa = pa.fromScale(ta), sb = pb.fromScale(tb);
         return chiSquare(measured, atBaseWhereMissing(pair.mean(sa, sb), has, base_mean),

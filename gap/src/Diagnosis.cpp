@@ -432,12 +432,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);
         versus_null = compareDensities(meas.value, mean, predictive, null_mean, null_var,
                                        D.held_out, meas.keys);
-        const DensityComparison &c = versus_null;
         Eigen::VectorXd e = (meas.value - mean).array() / var.array().sqrt();
         for (Eigen::Index k = 0; k < e.size(); ++k)
             e[k] = normalEquivalent(e[k], V.dof[k]);
         after = testGap(meas.keys, e, opt.alpha, opt.flag_at);
-        return c.mean_gain > 0.0;
+        return versus_null.mean_gain > 0.0;
     };
     std::vector<std::size_t> to_confirm;
     if (!applicable.empty()) {
