@@ -414,7 +414,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // knows. The gap left with the model is judged without it.
     const auto evaluateModel = [&](const Eigen::MatrixXd &rows, HeldOutScore &score,
                                    DensityComparison &versus_null, GapVerdict &after,
-                                   Eigen::VectorXd &mean, const Eigen::VectorXd &strength_var) {
+                                   Eigen::VectorXd &mean, Eigen::VectorXd &z,
+                                   const Eigen::VectorXd &strength_var) {
         const auto mv = meanAndVariance(rows, bed_sd);
         mean = mv.first;
         if (!coversBase(mean, V.simulated, meas.keys)) { // its runs failed somewhere: it predicts nothing there
@@ -432,10 +433,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);
         versus_null = compareDensities(meas.value, mean, predictive, null_mean, null_var,
                                        D.held_out, meas.keys);
-        Eigen::VectorXd e = (meas.value - mean).array() / var.array().sqrt();
-        for (Eigen::Index k = 0; k < e.size(); ++k)
-            e[k] = normalEquivalent(e[k], V.dof[k]);
-        after = testGap(meas.keys, e, opt.alpha, opt.flag_at);
+        z = (meas.value - mean).array() / var.array().sqrt();
+        for (Eigen::Index k = 0; k < z.size(); ++k)
+            z[k] = normalEquivalent(z[k], V.dof[k]);
+        after = testGap(meas.keys, z, opt.alpha, opt.flag_at);
         return versus_null.mean_gain > 0.0;
     };
     std::vector<std::size_t> to_confirm;
@@ -532,7 +533,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             if (!std::isfinite(strength_var[k]))
                 strength_var[k] = 0.0;
         const bool better = evaluateModel(final_rows[c], R.held_out, R.versus_null, R.after,
-                                          R.confirmed_mean, strength_var);
+                                          R.confirmed_mean, R.confirmed_z, strength_var);
         R.beats_null = better && R.versus_null.p_value < level && !D.held_out.empty();
         // A strength at its prior's edge may stand in for something the catalogue lacks (LIGGGHTS'
         // 5x softer soil fitted by the softest grains allowed): it may beat the null, it is
@@ -597,8 +598,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         for (std::size_t i = 0; i < confirm_pairs; ++i) {
             PairResult &P = pairs[i];
             P.confirmed = true;
-            const bool better = evaluateModel(pair_rows[i], P.held_out, P.versus_null, P.after,
-                                              P.confirmed_mean, Eigen::VectorXd::Zero(n));
+            const bool better =
+                evaluateModel(pair_rows[i], P.held_out, P.versus_null, P.after, P.confirmed_mean,
+                              P.confirmed_z, Eigen::VectorXd::Zero(n));
             P.explains = better && P.versus_null.p_value < pair_level && !P.after.gap &&
                          !D.held_out.empty() && !P.fit.a.at_prior_edge && !P.fit.b.at_prior_edge &&
                          resolved;
@@ -627,6 +629,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 D.indistinguishable.push_back(R.name);
         D.best_model = winner->name;
         D.best_model_mean = winner->confirmed_mean;
+        D.best_model_z = winner->confirmed_z;
     } else {
         const PairResult *pair = nullptr;
         for (const PairResult &P : D.pairs)
@@ -642,6 +645,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                   << " % (p = " << fmt(pair->versus_null.p_value, 2) << ")";
             D.best_model = pair->a + " + " + pair->b;
             D.best_model_mean = pair->confirmed_mean;
+            D.best_model_z = pair->confirmed_z;
         } else {
             D.outcome = Diagnosis::Outcome::Unexplained;
             if (!resolved)
@@ -664,6 +668,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             if (best) {
                 D.best_model = best->name;
                 D.best_model_mean = best->confirmed_mean;
+                D.best_model_z = best->confirmed_z;
             }
             if (best)
                 claim << "; closest: " << best->name << " at "
@@ -692,24 +697,20 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         D.outcome == Diagnosis::Outcome::ExplainedByPair)
         D.explained_by = D.best_model;
 
-    // What remains after the chosen (or closest) model, in words.
-    {
-        const Eigen::VectorXd *mean = D.best_model.empty() ? nullptr : &D.best_model_mean;
-        if (mean) {
-            ValidationResult after = V;
-            after.simulated = *mean;
-            after.residual = meas.value - *mean;
-            after.standardised = after.residual.array() / V.u_val.array();
-            for (Eigen::Index k = 0; k < n; ++k)
-                after.z[k] = normalEquivalent(after.standardised[k], V.dof[k]);
-            after.ratio = mean->array() / meas.value.array();
-            std::ostringstream rest;
-            for (const RegimeFinding &f :
-                 localise(meas.keys, after, {}, axisLabels(set), opt.flag_at))
-                if (f.sign != 0)
-                    rest << (rest.tellp() > 0 ? "; " : "") << f.text;
-            D.unexplained = rest.str();
-        }
+    // What remains after the chosen (or closest) model, in words: its residuals as its own gap
+    // test judged them (its runs' scatter, not the base's), so the words and `after` agree.
+    if (!D.best_model.empty() && D.best_model_z.size() == n) {
+        ValidationResult after = V;
+        after.simulated = D.best_model_mean;
+        after.residual = meas.value - D.best_model_mean;
+        after.standardised = D.best_model_z;
+        after.z = D.best_model_z;
+        after.ratio = D.best_model_mean.array() / meas.value.array();
+        std::ostringstream rest;
+        for (const RegimeFinding &f : localise(meas.keys, after, {}, axisLabels(set), opt.flag_at))
+            if (f.sign != 0)
+                rest << (rest.tellp() > 0 ? "; " : "") << f.text;
+        D.unexplained = rest.str();
     }
 
     // 5. Effects the design cannot tell apart from the leader: the experiment that would.

@@ -85,6 +85,7 @@ struct CandidateResult {
     bool explains = false;     ///< beats the null and leaves no gap on any feature
     GapVerdict after;          ///< the gap test with the effect added (confirmed)
     Eigen::VectorXd confirmed_mean; ///< features of the confirming runs
+    Eigen::VectorXd confirmed_z;    ///< their normal-equivalent residuals, as `after` judged them
 };
 
 struct PairResult {
@@ -96,6 +97,7 @@ struct PairResult {
     bool explains = false;
     GapVerdict after;
     Eigen::VectorXd confirmed_mean;
+    Eigen::VectorXd confirmed_z;
 };
 
 struct Diagnosis {
@@ -131,6 +133,7 @@ struct Diagnosis {
     /// closest confirmed candidate when unexplained (empty when nothing was confirmed).
     std::string best_model;
     Eigen::VectorXd best_model_mean; ///< its confirming runs' features (empty with no model)
+    Eigen::VectorXd best_model_z;    ///< their residuals as its gap test judged them
     std::string explained_by; ///< best_model when the outcome is an explanation, else empty
     /// Unexplained: the confirmed candidate nearest to a claim by its p value against the null,
     /// when that is not best_model (the closest by held-out gap); else empty.
