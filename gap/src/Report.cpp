@@ -79,6 +79,10 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     j["outcome"] = outcomeName(d.outcome);
     j["claim"] = d.claim;
     j["numerical_warning"] = d.numerical_warning;
+    // The parts of u_val, each a median share of the simulated value (null where undefined).
+    j["uncertainty_budget"] = Json::object();
+    for (const auto &[part, share] : uncertaintyBudget(d.validation))
+        j["uncertainty_budget"][part] = std::isfinite(share) ? Json(share) : Json(nullptr);
     j["explained_by"] = d.explained_by;
     j["best_model"] = d.best_model;
     j["nearest_to_claim"] = d.nearest_to_claim;
@@ -154,6 +158,23 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
     if (!d.numerical_warning.empty())
         r << "Warning: " << d.numerical_warning << "\n\n";
     r << "Numerical uncertainty and the gap test: " << d.verdict.summary << "\n";
+    {
+        // V&V 20's budget: which part of u_val a finer base model would shrink.
+        std::ostringstream parts;
+        std::string total;
+        for (const auto &[part, share] : uncertaintyBudget(d.validation)) {
+            if (!std::isfinite(share))
+                continue;
+            char pct[32];
+            std::snprintf(pct, sizeof pct, share < 0.01 ? "%.1f %%" : "%.0f %%", 100.0 * share);
+            if (part == "u_val")
+                total = pct;
+            else
+                parts << (parts.tellp() > 0 ? ", " : "") << part << ' ' << pct;
+        }
+        r << "Validation uncertainty by part (median share of the simulated value): " << parts.str()
+          << "; u_val " << total << "\n";
+    }
     r << "Where the gap lies:\n";
     for (const RegimeFinding &f : d.findings)
         r << "  - " << f.text << '\n';
@@ -223,7 +244,10 @@ std::vector<std::string> writeDiagnosis(const Diagnosis &d, const ExperimentSet 
     std::ostringstream csv;
     csv.precision(10);
     csv << "experiment,observable,kind,x_lo,x_hi,held_out,measured,u_D,simulated,u_seed,u_bed,"
-           "u_num,u_val,dof,z,ratio,null_mean,null_sd,best_model,best_model_mean\n";
+           "u_num,u_val,dof,z,ratio,null_mean,null_sd,best_model,best_model_mean";
+    for (const auto &[name, u] : d.validation.u_checks)
+        csv << ",u_check_" << name;
+    csv << '\n';
     const std::set<Eigen::Index> held(d.held_out.begin(), d.held_out.end());
     const auto &v = d.validation;
     for (std::size_t i = 0; i < d.design.keys.size(); ++i) {
@@ -243,7 +267,10 @@ std::vector<std::string> writeDiagnosis(const Diagnosis &d, const ExperimentSet 
             << num(v.dof[k]) << ',' << num(v.z[k]) << ',' << num(v.ratio[k]) << ','
             << (held.count(k) && d.null_mean.size() ? num(d.null_mean[k]) : "") << ','
             << (held.count(k) && d.null_variance.size() ? num(std::sqrt(d.null_variance[k])) : "")
-            << ',' << best_name << ',' << (best ? num((*best)[k]) : "") << '\n';
+            << ',' << best_name << ',' << (best ? num((*best)[k]) : "");
+        for (const auto &[name, u] : v.u_checks)
+            csv << ',' << num(u[k]);
+        csv << '\n';
     }
     writeAtomically(dir / "features.csv", csv.str());
     files.push_back("features.csv");

@@ -29,6 +29,7 @@ struct Plan {
     int nulls = 3;
     std::vector<std::pair<std::string, double>> out_of_catalogue; ///< effect, strength
     double noise = 0.01, level_noise = 0.02;
+    StrengthDraw strengths = StrengthDraw::Prior; ///< `strengths: prior | far_half`
 };
 
 Plan loadPlan(const std::string &path) {
@@ -49,6 +50,14 @@ Plan loadPlan(const std::string &path) {
             p.out_of_catalogue.emplace_back(e["effect"].text(), e["strength"].number());
             e.finish();
         }
+    if (const auto d = root.optional("strengths")) {
+        const std::string w = d->text();
+        if (w == "far_half")
+            p.strengths = StrengthDraw::FarHalf;
+        else if (w != "prior")
+            d->fail("must be prior (uniform over each prior) or far_half (over the half of each "
+                    "side of off that lies farther from it)");
+    }
     p.noise = root.number("noise", p.noise);
     p.level_noise = root.number("level_noise", p.level_noise);
     root.finish();
@@ -124,7 +133,8 @@ SelftestResult runSelftest(const SelftestOptions &o) {
         if (p.strength)
             to.strength = *p.strength;
         else if (!p.effect.empty())
-            to.strength = drawStrength(resolveAgainst(o.catalogue.find(p.effect), reference), to.seed);
+            to.strength = drawStrength(resolveAgainst(o.catalogue.find(p.effect), reference),
+                                       to.seed, plan.strengths);
         std::fprintf(stderr, "[selftest] twin %u/%zu: %s%s\n", k, planned.size(), p.name.c_str(),
                      to.strength ? (" at " + std::to_string(*to.strength)).c_str() : "");
         TwinKey key;

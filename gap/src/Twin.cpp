@@ -103,11 +103,19 @@ Design loadDesign(const std::string &path) {
     return d;
 }
 
-double drawStrength(const Effect &effect, unsigned seed) {
+double drawStrength(const Effect &effect, unsigned seed, StrengthDraw draw) {
     std::mt19937 rng(seed * 2654435761u + 17u);
-    std::uniform_real_distribution<double> u(effect.prior.toScale(effect.prior.lo),
-                                             effect.prior.toScale(effect.prior.hi));
-    return effect.prior.fromScale(u(rng));
+    const Prior &p = effect.prior;
+    const double lo = p.toScale(p.lo), hi = p.toScale(p.hi);
+    std::uniform_real_distribution<double> u(lo, hi);
+    double t = u(rng);
+    if (draw == StrengthDraw::FarHalf) {
+        const double off = std::clamp(p.toScale(p.off), lo, hi);
+        const double side = t < off ? off - lo : hi - off;
+        const double d = std::abs(t - off);
+        t = off + std::copysign(0.5 * side + 0.5 * d, t - off);
+    }
+    return p.fromScale(t);
 }
 
 TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySimulator &simulator,

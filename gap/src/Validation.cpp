@@ -341,20 +341,41 @@ std::vector<RegimeFinding> localise(const std::vector<FeatureKey> &keys,
     return findings;
 }
 
+namespace {
+
+/// The median over features of |u| / |simulated| (features without a finite value left out);
+/// NaN when there is none.
+double medianRelative(const Eigen::VectorXd &u, const Eigen::VectorXd &simulated) {
+    std::vector<double> rel;
+    for (Eigen::Index k = 0; k < u.size(); ++k)
+        if (std::isfinite(u[k]) && std::isfinite(simulated[k]) && std::abs(simulated[k]) > 0.0)
+            rel.push_back(std::abs(u[k]) / std::abs(simulated[k]));
+    if (rel.empty())
+        return std::numeric_limits<double>::quiet_NaN();
+    std::nth_element(rel.begin(), rel.begin() + std::ptrdiff_t(rel.size() / 2), rel.end());
+    return rel[rel.size() / 2];
+}
+
+} // namespace
+
+std::vector<std::pair<std::string, double>> uncertaintyBudget(const ValidationResult &V) {
+    std::vector<std::pair<std::string, double>> b{
+        {"measurement", medianRelative(V.u_D, V.simulated)},
+        {"beds", medianRelative(V.u_bed, V.simulated)},
+        {"seeds", medianRelative(V.u_seed, V.simulated)}};
+    for (const auto &[name, u] : V.u_checks)
+        b.emplace_back(name, medianRelative(u, V.simulated));
+    b.emplace_back("u_val", medianRelative(V.u_val, V.simulated));
+    return b;
+}
+
 std::string unresolvedCheck(const ValidationResult &V) {
     constexpr double kUnresolved = 0.5;
     std::string worst;
     double worst_median = kUnresolved;
     for (const auto &[name, u] : V.u_checks) {
-        std::vector<double> rel;
-        for (Eigen::Index k = 0; k < u.size(); ++k)
-            if (std::isfinite(u[k]) && std::abs(V.simulated[k]) > 0.0)
-                rel.push_back(u[k] / std::abs(V.simulated[k]));
-        if (rel.empty())
-            continue;
-        std::nth_element(rel.begin(), rel.begin() + std::ptrdiff_t(rel.size() / 2), rel.end());
-        const double median = rel[rel.size() / 2];
-        if (median > worst_median)
+        const double median = medianRelative(u, V.simulated);
+        if (median > worst_median) // false for NaN: a check with no value moves nothing
             worst_median = median, worst = name;
     }
     if (worst.empty())

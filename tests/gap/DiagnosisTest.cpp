@@ -283,9 +283,19 @@ TEST_CASE("the diagnosis writes diagnosis.json, features.csv, report.txt and a s
             CHECK(c["held_out_gain"]["features"] == 32);
             CHECK(c["held_out_gain"]["mean_per_feature"].get<double>() > 0.0);
         }
+    // The budget of u_val: the analytic simulator's one check, the seeds, the measurement.
+    CHECK(j["uncertainty_budget"].contains("resolution"));
+    CHECK(j["uncertainty_budget"]["u_val"].get<double>() >=
+          j["uncertainty_budget"]["resolution"].get<double>());
+    std::ifstream report(dir / "report.txt");
+    const std::string report_text((std::istreambuf_iterator<char>(report)),
+                                  std::istreambuf_iterator<char>());
+    CHECK(report_text.find("Validation uncertainty by part") != std::string::npos);
     std::ifstream features(dir / "features.csv");
     std::string line;
-    int lines = 0;
+    std::getline(features, line);
+    CHECK(line.find(",u_check_resolution") != std::string::npos);
+    int lines = 1;
     while (std::getline(features, line))
         ++lines;
     CHECK(lines == int(d.design.size()) + 1);

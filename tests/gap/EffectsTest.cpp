@@ -1,8 +1,10 @@
 #include "grainlink/gap/Effects.hpp"
 #include "ShippedEffects.hpp"
+#include "grainlink/gap/Twin.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 using namespace grainlink::gap;
@@ -177,4 +179,48 @@ TEST_CASE("an effects file with a bad expression or no signature is refused with
           "[gap][effects]") {
     CHECK_THROWS_WITH(evaluate("2 * s +", 1.0, 0.0), Catch::Contains("expression '2 * s +'"));
     CHECK(evaluate("min(1, 1 / sqrt(s))", 4.0, 0.0) == Approx(0.5));
+}
+
+TEST_CASE("a twin's strength drawn from the far half of its prior lies there and fills it",
+          "[gap][effects][twin]") {
+    // The reference is the rule in words: on each side of off, the half of that side farther
+    // from off, on the prior's own scale; both sides drawn in proportion to their length.
+    struct Case {
+        Prior prior;
+        double far_lo_below, far_hi_above; ///< the far halves: s <= below, s >= above
+    };
+    const std::vector<Case> cases{
+        {{0.2, 5.0, 1.0, true}, std::sqrt(0.2), std::sqrt(5.0)}, // log, off in the middle
+        {{0.0, 4.0e5, 0.0, false}, -1.0, 2.0e5},                 // off at the low end
+        {{-0.002, 0.002, 0.0, false}, -0.001, 0.001},            // symmetric
+        {{3.0, 20.0, 1.0, true}, -1.0, std::sqrt(60.0)},         // off below the prior
+    };
+    for (const Case &c : cases) {
+        Effect e;
+        e.name = "x";
+        e.prior = c.prior;
+        int below = 0, above = 0;
+        double lowest = c.prior.hi, highest = c.prior.lo;
+        for (unsigned seed = 1; seed <= 2000; ++seed) {
+            const double s = drawStrength(e, seed, StrengthDraw::FarHalf);
+            INFO("prior [" << c.prior.lo << ", " << c.prior.hi << "] off " << c.prior.off
+                           << ": drew " << s);
+            REQUIRE(s >= c.prior.lo - 1e-9 * std::abs(c.prior.lo));
+            REQUIRE(s <= c.prior.hi + 1e-9 * std::abs(c.prior.hi));
+            const bool in_low = s <= c.far_lo_below * (1 + 1e-9),
+                       in_high = s >= c.far_hi_above * (1 - 1e-9);
+            REQUIRE((in_low || in_high));
+            below += in_low;
+            above += in_high;
+            lowest = std::min(lowest, s);
+            highest = std::max(highest, s);
+        }
+        // Sides in proportion to their length (2000 draws: sd of a share about 0.011).
+        const double t_lo = c.prior.toScale(c.prior.lo), t_hi = c.prior.toScale(c.prior.hi);
+        const double t_off = std::clamp(c.prior.toScale(c.prior.off), t_lo, t_hi);
+        CHECK(double(below) / 2000.0 == Approx((t_off - t_lo) / (t_hi - t_lo)).margin(0.04));
+        CHECK(highest == Approx(c.prior.hi).epsilon(0.01));
+        if (below > 0)
+            CHECK(lowest == Approx(c.prior.lo).epsilon(0.01).margin(1e-5));
+    }
 }

@@ -253,6 +253,39 @@ TEST_CASE("a check that moves the base by over half its value makes the base unr
               .empty());
 }
 
+TEST_CASE("the uncertainty budget gives each part of u_val as its median share of the value",
+          "[gap][validation]") {
+    // By hand, on the first test's numbers: seeds 1.0 1.2 0.8 1.0 (mean 1, sd 0.1633), no
+    // repeats, u_D 0.1, a resolution check at 1.3: measurement 0.1, beds sd = 0.1633, seeds
+    // sd/2, resolution sqrt(0.09 - 0.015) = 0.2739, u_val their root sum of squares 0.3531.
+    // A feature the check could not reach (NaN) is left out of that part's median.
+    Eigen::MatrixXd base(4, 2);
+    base << 1.0, 2.0, 1.2, 2.4, 0.8, 1.6, 1.0, 2.0;
+    Eigen::MatrixXd check(2, 2);
+    check << 1.3, std::nan(""), 1.3, std::nan("");
+    Measured m = oneFeature(1.5, 0.1, false);
+    m.keys.push_back({"e1", "pressure_Pa", "plate/pressure_Pa", 0.002, 0.004});
+    m.value = Eigen::Vector2d(1.5, 3.0);
+    m.u_D = Eigen::Vector2d(0.1, 0.1); // 5 % of the second feature's value 2
+    m.trials = Eigen::Vector2i(1, 1);
+    m.from_repeats = {false, false};
+    const auto budget = uncertaintyBudget(validate(m, base, {{"resolution", check}}));
+    const double sd = std::sqrt(0.08 / 3.0);
+    REQUIRE(budget.size() == 5);
+    CHECK(budget[0].first == "measurement");
+    CHECK(budget[0].second == Approx(0.1)); // median of 0.1 and 0.05: the upper middle
+    CHECK(budget[1].first == "beds");
+    CHECK(budget[1].second == Approx(sd)); // relative sd is the same on both features
+    CHECK(budget[2].first == "seeds");
+    CHECK(budget[2].second == Approx(sd / 2.0));
+    CHECK(budget[3].first == "resolution");
+    CHECK(budget[3].second == Approx(std::sqrt(0.09 - 0.015)));
+    CHECK(budget[4].first == "u_val");
+    // u_val relative: feature 1 sqrt(0.01 + sd^2 + sd^2/4 + 0.075) = 0.3531; feature 2 has no
+    // resolution part: sqrt(0.0025 + 1.25 sd^2) = 0.1896; the upper middle of two is 0.3531.
+    CHECK(budget[4].second == Approx(std::sqrt(0.01 + 1.25 * sd * sd + 0.075)));
+}
+
 TEST_CASE("a check whose runs all failed is named as unknown and not read as none",
           "[gap][validation]") {
     // Its contribution to u_val stays 0 (u_val can only be too small, so a 'no gap' stands),

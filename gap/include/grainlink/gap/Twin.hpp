@@ -38,8 +38,16 @@ struct TwinOptions {
     double level_noise = 0.02;       ///< relative sd of a trial's level (its calibration)
 };
 
-/// Draws a strength uniformly on the effect's prior (on its own scale).
-double drawStrength(const Effect &effect, unsigned seed);
+/// Which part of an effect's prior a twin's strength is drawn from.
+enum class StrengthDraw {
+    Prior,   ///< uniformly over the whole prior
+    FarHalf, ///< over the half of each side of "off" that lies farther from it
+};
+
+/// Draws a strength uniformly on the effect's prior (on its own scale), or on its far half: a
+/// draw at distance d from off on a side of length L is moved to L/2 + d/2 (an off outside the
+/// prior counts from the nearer end).
+double drawStrength(const Effect &effect, unsigned seed, StrengthDraw draw = StrengthDraw::Prior);
 
 /// Writes a twin's measurements folder `out` (experiments.yaml + data/) from its simulated
 /// repeats (`curves[r]`: repeat r's curves per experiment id and observable) with the key's

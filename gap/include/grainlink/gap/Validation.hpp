@@ -74,6 +74,12 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
 /// plates tenfold softer at twice the time step). Empty when every check is below that.
 std::string unresolvedCheck(const ValidationResult &validation);
 
+/// The parts of u_val, each as the median over features of its size relative to the simulated
+/// value (V&V 20's budget): the measurement, the beds without repeats, the simulated mean's
+/// seeds, then each numerical check by name, then u_val itself. Says which choice of the base
+/// model would pay most to refine.
+std::vector<std::pair<std::string, double>> uncertaintyBudget(const ValidationResult &validation);
+
 /// Everything to warn about the numerical uncertainty, in words: the unresolved check above and
 /// the experiments where a check's runs all failed. Empty when there is nothing.
 std::string numericalWarning(const ValidationResult &validation);
