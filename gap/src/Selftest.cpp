@@ -81,6 +81,54 @@ std::string outcomeWord(const Diagnosis &d) {
 
 } // namespace
 
+void scoreTwin(const Diagnosis &d, const Effect *hidden, SelftestTwin &t, SelftestResult &R) {
+    const bool in_catalogue = hidden && hidden->in_catalogue;
+    if (!hidden) {
+        ++R.nulls;
+        R.null_false += !t.claimed.empty();
+        t.correct = d.outcome == Diagnosis::Outcome::NoGap;
+    } else if (!in_catalogue) {
+        ++R.oocs;
+        t.correct = t.weak ? d.outcome == Diagnosis::Outcome::NoGap
+                           : d.outcome == Diagnosis::Outcome::Unexplained;
+        R.ooc_unexplained += t.correct;
+    } else {
+        ++R.top1_of;
+        R.weak += t.weak;
+        if (t.weak) {
+            t.correct = d.outcome == Diagnosis::Outcome::NoGap;
+        } else {
+            t.correct = d.outcome == Diagnosis::Outcome::Explained && t.claimed == t.key.effect;
+            const CandidateResult *winner = nullptr;
+            for (const auto &c : d.candidates)
+                if (c.explains && c.name == t.claimed)
+                    winner = &c;
+            if (winner && d.held_out_base.gap > 0.0)
+                t.reduction_pct = 100.0 * (1.0 - winner->held_out.gap / d.held_out_base.gap);
+            if (t.correct) {
+                t.claimed_strength = winner->fit.strength;
+                ++R.strength_of;
+                t.strength_within_25 = std::abs(winner->fit.strength - t.key.strength) <=
+                                       0.25 * std::abs(t.key.strength);
+                R.strength_ok += t.strength_within_25;
+            }
+        }
+        R.top1 += t.correct;
+        if (!t.weak && !t.correct) {
+            ++R.named_of;
+            for (const CandidateResult &c : d.candidates)
+                if (c.name == t.key.effect &&
+                    (c.name == d.best_model || c.name == d.nearest_to_claim)) {
+                    t.named = true;
+                    t.named_strength = c.fit.strength;
+                }
+            R.named += t.named;
+            R.named_strength_ok += t.named && std::abs(t.named_strength - t.key.strength) <=
+                                                  0.25 * std::abs(t.key.strength);
+        }
+    }
+}
+
 SelftestResult runSelftest(const SelftestOptions &o) {
     const auto t0 = std::chrono::steady_clock::now();
     const BaseModel base = loadBaseModel(o.base_model);
@@ -188,40 +236,7 @@ SelftestResult runSelftest(const SelftestOptions &o) {
                 z[k] = normalEquivalent(z[k], d.validation.dof[k]);
             t.weak = !testGap(d.design.keys, z).gap;
         }
-        const Effect *hidden = key.effect.empty() ? nullptr : &o.catalogue.find(key.effect);
-        const bool in_catalogue = hidden && hidden->in_catalogue;
-        if (!hidden) {
-            ++R.nulls;
-            R.null_false += !t.claimed.empty();
-            t.correct = d.outcome == Diagnosis::Outcome::NoGap;
-        } else if (!in_catalogue) {
-            ++R.oocs;
-            t.correct = t.weak ? d.outcome == Diagnosis::Outcome::NoGap
-                               : d.outcome == Diagnosis::Outcome::Unexplained;
-            R.ooc_unexplained += t.correct;
-        } else {
-            ++R.top1_of;
-            R.weak += t.weak;
-            if (t.weak) {
-                t.correct = d.outcome == Diagnosis::Outcome::NoGap;
-            } else {
-                t.correct = d.outcome == Diagnosis::Outcome::Explained && t.claimed == key.effect;
-                const CandidateResult *winner = nullptr;
-                for (const auto &c : d.candidates)
-                    if (c.explains && c.name == t.claimed)
-                        winner = &c;
-                if (winner && d.held_out_base.gap > 0.0)
-                    t.reduction_pct = 100.0 * (1.0 - winner->held_out.gap / d.held_out_base.gap);
-                if (t.correct) {
-                    t.claimed_strength = winner->fit.strength;
-                    ++R.strength_of;
-                    t.strength_within_25 =
-                        std::abs(winner->fit.strength - key.strength) <= 0.25 * std::abs(key.strength);
-                    R.strength_ok += t.strength_within_25;
-                }
-            }
-            R.top1 += t.correct;
-        }
+        scoreTwin(d, key.effect.empty() ? nullptr : &o.catalogue.find(key.effect), t, R);
         R.twins.push_back(t);
     }
 
@@ -263,8 +278,16 @@ SelftestResult runSelftest(const SelftestOptions &o) {
     }
     std::ostringstream rep;
     rep << R.line << "\n";
-    rep << "weak twins (hidden effect within the validation uncertainty; correct only as 'no gap'): "
-        << R.weak << " of " << R.top1_of << "\n\nconfusion matrix (rows: hidden, columns: diagnosed)\n";
+    rep << "weak twins (hidden effect within the validation uncertainty; correct only as 'no "
+           "gap'): "
+        << R.weak << " of " << R.top1_of << "\n";
+    if (R.named_of > 0)
+        rep << "strong twins without a correct claim whose hidden effect the report named "
+               "(closest or nearest to a claim): "
+            << R.named << " of " << R.named_of
+            << ", within 25 % of its strength: " << R.named_strength_ok << " of " << R.named
+            << "\n";
+    rep << "\nconfusion matrix (rows: hidden, columns: diagnosed)\n";
     rep << "  " << std::string(22, ' ');
     for (const auto &c : columns)
         rep << " | " << c;
@@ -287,6 +310,12 @@ SelftestResult runSelftest(const SelftestOptions &o) {
         rep << "; diagnosed " << (t.claimed.empty() ? outcomeName(t.outcome) : t.claimed);
         if (t.correct && t.claimed_strength != 0.0)
             rep << " = " << t.claimed_strength << (t.strength_within_25 ? " (within 25 %)" : " (off by more than 25 %)");
+        if (t.named)
+            rep << " (named "
+                << (t.claim.find("closest: " + t.key.effect) != std::string::npos
+                        ? "closest"
+                        : "nearest to a claim")
+                << " at " << t.named_strength << ")";
         rep << (t.correct ? "  [correct]" : "  [WRONG]") << '\n';
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

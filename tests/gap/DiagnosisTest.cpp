@@ -4,6 +4,7 @@
 #include "grainlink/gap/Diagnosis.hpp"
 #include "ShippedEffects.hpp"
 #include "grainlink/gap/Report.hpp"
+#include "grainlink/gap/Selftest.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -595,4 +596,105 @@ TEST_CASE("the default held-out experiments: the last box, else the last half of
     CHECK(defaultHeldOut(set(3, false)) == std::vector<std::string>{"p2"});
     CHECK(defaultHeldOut(set(1, false)).empty());
     CHECK(defaultHeldOut(set(5, true)) == std::vector<std::string>{"p2", "p3", "p4"});
+}
+
+TEST_CASE("the self-test scores each twin against its key: claims, weak twins, nulls, effects "
+          "outside the catalogue, and the hidden effect named without a claim",
+          "[gap][selftest]") {
+    // Hand-built diagnoses, each scored against the rule in docs/gap.md ("The self-test").
+    Effect stiff, crust;
+    stiff.name = "grain_stiffness";
+    crust.name = "crust";
+    crust.in_catalogue = false;
+    const auto candidate = [](const std::string &name, double strength, bool explains) {
+        CandidateResult c;
+        c.name = name;
+        c.fit.strength = strength;
+        c.explains = explains;
+        c.held_out.gap = explains ? 0.1 : 0.5;
+        return c;
+    };
+    const auto twin = [](const std::string &effect, double strength, bool weak,
+                         Diagnosis::Outcome outcome, const std::string &claimed) {
+        SelftestTwin t;
+        t.key.effect = effect;
+        t.key.strength = strength;
+        t.key.in_catalogue = effect != "crust";
+        t.weak = weak;
+        t.outcome = outcome;
+        t.claimed = claimed;
+        return t;
+    };
+    SelftestResult R;
+    using O = Diagnosis::Outcome;
+
+    Diagnosis claimed; // claimed right, strength 10 % off
+    claimed.outcome = O::Explained;
+    claimed.held_out_base.gap = 1.0;
+    claimed.candidates = {candidate("grain_stiffness", 3.3, true)};
+    SelftestTwin a = twin("grain_stiffness", 3.0, false, O::Explained, "grain_stiffness");
+    scoreTwin(claimed, &stiff, a, R);
+    CHECK(a.correct);
+    CHECK(a.strength_within_25);
+    CHECK(a.reduction_pct == Approx(90.0));
+
+    Diagnosis closest; // unexplained, the hidden effect closest, 10 % off
+    closest.outcome = O::Unexplained;
+    closest.best_model = "grain_stiffness";
+    closest.candidates = {candidate("grain_stiffness", 2.7, false),
+                          candidate("cohesion", 1e5, false)};
+    SelftestTwin b = twin("grain_stiffness", 3.0, false, O::Unexplained, "");
+    scoreTwin(closest, &stiff, b, R);
+    CHECK_FALSE(b.correct);
+    CHECK(b.named);
+
+    Diagnosis nearest; // unexplained, another closest, the hidden one nearest to a claim, 2x off
+    nearest.outcome = O::Unexplained;
+    nearest.best_model = "cohesion";
+    nearest.nearest_to_claim = "grain_stiffness";
+    nearest.candidates = {candidate("cohesion", 1e5, false),
+                          candidate("grain_stiffness", 6.0, false)};
+    SelftestTwin c = twin("grain_stiffness", 3.0, false, O::Unexplained, "");
+    scoreTwin(nearest, &stiff, c, R);
+    CHECK(c.named);
+
+    Diagnosis wrong; // another effect closest, the hidden one not named
+    wrong.outcome = O::Unexplained;
+    wrong.best_model = "cohesion";
+    wrong.candidates = {candidate("cohesion", 1e5, false),
+                        candidate("grain_stiffness", 3.0, false)};
+    SelftestTwin d = twin("grain_stiffness", 3.0, false, O::Unexplained, "");
+    scoreTwin(wrong, &stiff, d, R);
+    CHECK_FALSE(d.named);
+
+    Diagnosis nogap; // a weak twin is right only as "no gap"
+    nogap.outcome = O::NoGap;
+    SelftestTwin e = twin("grain_stiffness", 1.1, true, O::NoGap, "");
+    scoreTwin(nogap, &stiff, e, R);
+    CHECK(e.correct);
+
+    Diagnosis false_claim; // a null twin with a claim
+    false_claim.outcome = O::Explained;
+    SelftestTwin f = twin("", 0.0, false, O::Explained, "cohesion");
+    scoreTwin(false_claim, nullptr, f, R);
+    CHECK_FALSE(f.correct);
+
+    Diagnosis ooc; // outside the catalogue, strong: right only as "unexplained"
+    ooc.outcome = O::Unexplained;
+    SelftestTwin g = twin("crust", 20.0, false, O::Unexplained, "");
+    scoreTwin(ooc, &crust, g, R);
+    CHECK(g.correct);
+
+    CHECK(R.top1 == 2);
+    CHECK(R.top1_of == 5);
+    CHECK(R.weak == 1);
+    CHECK(R.strength_ok == 1);
+    CHECK(R.strength_of == 1);
+    CHECK(R.null_false == 1);
+    CHECK(R.nulls == 1);
+    CHECK(R.ooc_unexplained == 1);
+    CHECK(R.oocs == 1);
+    CHECK(R.named_of == 3);
+    CHECK(R.named == 2);
+    CHECK(R.named_strength_ok == 1);
 }

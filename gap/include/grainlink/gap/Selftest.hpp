@@ -32,6 +32,10 @@ struct SelftestTwin {
     bool strength_within_25 = false;
     double reduction_pct = 0.0; ///< held-out gap reduction of the claimed model (0 if none)
     std::string claim;
+    /// Unclaimed: the candidate the report names as closest or nearest to a claim, when it is
+    /// the hidden effect, and its fitted strength (a ranking right, its evidence short).
+    bool named = false;
+    double named_strength = 0.0;
 };
 
 struct SelftestResult {
@@ -42,9 +46,17 @@ struct SelftestResult {
     bool passed = false; ///< every target of docs/gap.md met
     int top1 = 0, top1_of = 0, strength_ok = 0, strength_of = 0, null_false = 0, nulls = 0,
         ooc_unexplained = 0, oocs = 0, weak = 0;
+    /// Strong catalogue twins without a correct claim whose hidden effect the report named
+    /// (closest or nearest to a claim), and of those, named within 25 % of its strength.
+    int named = 0, named_of = 0, named_strength_ok = 0;
     double median_reduction_pct = 0.0;
 };
 
 SelftestResult runSelftest(const SelftestOptions &options);
+
+/// Scores one twin's diagnosis against its key and adds it to R's counts (docs/gap.md, "The
+/// self-test"): t.key, t.weak, t.outcome and t.claimed are set; `hidden` is the key's effect
+/// (null for a null twin).
+void scoreTwin(const Diagnosis &d, const Effect *hidden, SelftestTwin &t, SelftestResult &R);
 
 } // namespace grainlink::gap
