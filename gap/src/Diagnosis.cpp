@@ -306,12 +306,22 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // One bed's scatter from every group of seeds so far: every response below (signatures,
     // confirmations, pairs) carries it, so that a fit follows the means, not the few seeds'
     // chance scatter (a 2-seed variance at one strength drew fits to its neighbours).
+    // Only independent beds count: the measuring chain's variants are the base's own runs read
+    // through another sensor, and counted as groups of their own they multiplied the base's
+    // degrees of freedom and carried a compliance's force-dependent spread into every effect's
+    // variance (the CMU base's "one bed's scatter" was mostly that). Where fewer than ten
+    // degrees of freedom pool (one seed per signature), a feature takes its experiment's median
+    // relative scatter.
     PooledScatter pool(n);
     for (const auto &rows : first_rows)
         pool.add(rows);
-    for (const auto &rows : sig_rows)
-        pool.add(rows);
-    const Eigen::VectorXd bed_sd = pool.sd(V.seed_sd);
+    for (std::size_t k = 0; k < sig.size(); ++k)
+        if (sig[k].effect->kind != Effect::Kind::Measurement)
+            pool.add(sig_rows[k]);
+    std::vector<std::string> experiment_of;
+    for (const FeatureKey &key : meas.keys)
+        experiment_of.push_back(key.experiment);
+    const Eigen::VectorXd bed_sd = pool.sd(V.seed_sd, V.simulated, experiment_of, 10);
     for (std::size_t li = 0; li < live.size(); ++li) {
         Live &L = live[li];
         if (!L.result.applicability.empty())

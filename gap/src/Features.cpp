@@ -5,7 +5,9 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <stdexcept>
+#include <string>
 
 namespace grainlink::gap {
 
@@ -110,6 +112,26 @@ Eigen::VectorXd PooledScatter::sd(const Eigen::VectorXd &fallback) const {
     for (Eigen::Index c = 0; c < squares_.size(); ++c)
         if (dof_[c] > 0)
             out[c] = std::sqrt(squares_[c] / dof_[c]);
+    return out;
+}
+
+Eigen::VectorXd PooledScatter::sd(const Eigen::VectorXd &fallback, const Eigen::VectorXd &reference,
+                                  const std::vector<std::string> &groups, int min_dof) const {
+    Eigen::VectorXd out = sd(fallback);
+    std::map<std::string, std::vector<double>> relative;
+    for (Eigen::Index c = 0; c < squares_.size(); ++c)
+        if (dof_[c] > 0 && std::isfinite(reference[c]) && std::abs(reference[c]) > 0.0)
+            relative[groups[std::size_t(c)]].push_back(out[c] / std::abs(reference[c]));
+    for (Eigen::Index c = 0; c < squares_.size(); ++c) {
+        if (dof_[c] >= min_dof || !std::isfinite(reference[c]))
+            continue;
+        auto r = relative.find(groups[std::size_t(c)]);
+        if (r == relative.end())
+            continue;
+        std::vector<double> &v = r->second;
+        std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+        out[c] = v[v.size() / 2] * std::abs(reference[c]);
+    }
     return out;
 }
 

@@ -82,3 +82,32 @@ TEST_CASE("pooled scatter: squared deviations from each group's mean over their 
     CHECK(sd[1] == -2.0);
     CHECK(pool.dof()[1] == 0);
 }
+
+TEST_CASE("pooled scatter with few degrees of freedom takes its experiment's median relative "
+          "scatter",
+          "[gap][features]") {
+    // One group of two seeds over four features: experiment "a" has three features with sample
+    // sds 1, 4, 30 at reference values 10, 20, 100 (relative 0.1, 0.2, 0.3: median 0.2);
+    // experiment "b" one feature with no second value. With min_dof 2 (one dof here) each of
+    // a's features becomes 0.2 x |reference| (2, 4, 20); b keeps the fallback. With min_dof 1
+    // nothing changes.
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    Eigen::MatrixXd g(2, 4);
+    const double s2 = std::sqrt(2.0); // two values x +- d/2 have sample sd d / sqrt 2
+    g << 10, 20, 100, 5,              //
+        10 + 1 * s2, 20 + 4 * s2, 100 + 30 * s2, nan;
+    PooledScatter pool(4);
+    pool.add(g);
+    const Eigen::Vector4d reference(10, 20, 100, 5);
+    const std::vector<std::string> groups{"a", "a", "a", "b"};
+    const Eigen::Vector4d fallback(-1, -2, -3, -4);
+    const Eigen::VectorXd few = pool.sd(fallback, reference, groups, 2);
+    CHECK(few[0] == Approx(2.0));
+    CHECK(few[1] == Approx(4.0));
+    CHECK(few[2] == Approx(20.0));
+    CHECK(few[3] == -4.0);
+    const Eigen::VectorXd enough = pool.sd(fallback, reference, groups, 1);
+    CHECK(enough[0] == Approx(1.0));
+    CHECK(enough[1] == Approx(4.0));
+    CHECK(enough[2] == Approx(30.0));
+}

@@ -61,6 +61,13 @@ public:
     void add(const Eigen::MatrixXd &group);
     /// The pooled sd; `fallback` where no group had two values.
     Eigen::VectorXd sd(const Eigen::VectorXd &fallback) const;
+    /// The same where `min_dof` or more degrees of freedom pooled; elsewhere the median relative
+    /// scatter (sd / |reference|) of the features of its group (`groups[k]`, e.g. its
+    /// experiment) that have any, times |reference_k|: a bed moves a curve by a roughly fixed
+    /// share, and one or two seeds per feature give a sample sd that swings by factors of ten.
+    /// `fallback` where the group has none.
+    Eigen::VectorXd sd(const Eigen::VectorXd &fallback, const Eigen::VectorXd &reference,
+                       const std::vector<std::string> &groups, int min_dof) const;
     /// Degrees of freedom of each column's estimate.
     const Eigen::VectorXi &dof() const { return dof_; }
 
