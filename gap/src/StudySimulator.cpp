@@ -627,4 +627,10 @@ std::vector<ExperimentSet> StudySimulator::probes(const ExperimentSet &design) c
     return out;
 }
 
+std::string StudySimulator::bedGroup(const Experiment &experiment) const {
+    const auto box = experiment.labels.find("box");
+    return std::string(typeName(experiment.type)) +
+           (box != experiment.labels.end() ? " in box " + box->second : std::string());
+}
+
 } // namespace grainlink::gap

@@ -51,6 +51,10 @@ public:
     }
     /// The scenario effects are resolved against (their off values, their applicability).
     virtual YAML::Node referenceScenario() const = 0;
+    /// Experiments the simulator runs on the same beds (a seed's one packing) share a group:
+    /// held-out evidence is counted per group, since the model's error from its few beds is
+    /// shared by every experiment in them. Default: each experiment its own beds.
+    virtual std::string bedGroup(const Experiment &experiment) const { return experiment.id; }
 };
 
 struct DiagnosisOptions {

@@ -54,6 +54,8 @@ public:
                                           const std::vector<VariantRequest> &requests) override;
     std::vector<ExperimentSet> probes(const ExperimentSet &design) const override;
     YAML::Node referenceScenario() const override;
+    /// One type in one box: its runs at one seed share one cached packing.
+    std::string bedGroup(const Experiment &experiment) const override;
 
     /// The simulated curves of one variant and seed (measurement effects applied), per
     /// experiment; what `simulate` turns into features.
