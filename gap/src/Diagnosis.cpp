@@ -8,6 +8,7 @@
 #include <map>
 #include <set>
 #include <sstream>
+#include <stdexcept>
 
 namespace grainlink::gap {
 
@@ -20,8 +21,6 @@ std::string fmt(double v, int digits = 3) {
     return s.str();
 }
 
-/// The mean of `rows` (one per seed) and its variance, from one bed's scatter `sd` (pooled over
-/// the diagnosis' simulations, not these few rows' own: PooledScatter).
 /// The spread a fitted strength's 95 % interval gives its prediction, ((m(hi) - m(lo))/3.92)^2
 /// per feature (0 where the table has no value): a model predicts with what it knows.
 Eigen::VectorXd strengthSpread(const TabulatedResponse &table, const StrengthFit &fit) {
@@ -33,6 +32,8 @@ Eigen::VectorXd strengthSpread(const TabulatedResponse &table, const StrengthFit
     return var;
 }
 
+/// The mean of `rows` (one per seed) and its variance, from one bed's scatter `sd` (pooled over
+/// the diagnosis' simulations, not these few rows' own: PooledScatter).
 std::pair<Eigen::VectorXd, Eigen::VectorXd> meanAndVariance(const Eigen::MatrixXd &rows,
                                                             const Eigen::VectorXd &sd) {
     const ColumnStats s = columnStats(rows);
@@ -589,7 +590,6 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             if (int(pool.size()) < opt.pair_pool && live[i].result.calibration_gain > 0.0)
                 pool.push_back(i);
         std::vector<PairResult> pairs;
-        std::vector<std::pair<const Live *, const Live *>> pair_of;
         for (std::size_t a = 0; a < pool.size(); ++a)
             for (std::size_t b = a + 1; b < pool.size(); ++b) {
                 const Live &A = live[pool[a]], &B = live[pool[b]];
@@ -601,21 +601,15 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                                 B.result.effect.prior, off.first, off.second, meas.value,
                                 u2_fixed, D.calibration, correlation);
                 pairs.push_back(P);
-                pair_of.push_back({&A, &B});
             }
-        std::vector<std::size_t> order(pairs.size());
-        for (std::size_t i = 0; i < order.size(); ++i)
-            order[i] = i;
-        std::sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
-            return pairs[x].fit.chi2 < pairs[y].fit.chi2;
-        });
-        std::vector<PairResult> sorted;
-        std::vector<std::pair<const Live *, const Live *>> pair_live;
-        for (std::size_t i : order) {
-            sorted.push_back(pairs[i]);
-            pair_live.push_back(pair_of[i]);
-        }
-        pairs = std::move(sorted);
+        std::sort(pairs.begin(), pairs.end(),
+                  [](const PairResult &x, const PairResult &y) { return x.fit.chi2 < y.fit.chi2; });
+        const auto responseOf = [&](const std::string &name) -> const TabulatedResponse & {
+            for (const Live &L : live)
+                if (L.result.name == name)
+                    return *L.response;
+            throw std::logic_error("diagnose: a pair of an effect without a response: " + name);
+        };
         const std::size_t confirm_pairs = std::min<std::size_t>(2, pairs.size());
         std::vector<VariantRequest> pr;
         for (std::size_t i = 0; i < confirm_pairs; ++i) {
@@ -641,8 +635,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             // Each strength's interval spreads the prediction, as a single's does: without it a
             // pair predicted more sharply than any single, and a wrong pair beat the null at
             // p = 5e-7 on LIGGGHTS' rolling-friction twin.
-            const Eigen::VectorXd spread = strengthSpread(*pair_live[i].first->response, P.fit.a) +
-                                           strengthSpread(*pair_live[i].second->response, P.fit.b);
+            const Eigen::VectorXd spread =
+                strengthSpread(responseOf(P.a), P.fit.a) + strengthSpread(responseOf(P.b), P.fit.b);
             const bool better = evaluateModel(pair_rows[i], P.held_out, P.versus_null, P.after,
                                               P.confirmed_mean, P.confirmed_z, spread);
             P.explains = better && P.versus_null.p_value < pair_level && !P.after.gap &&

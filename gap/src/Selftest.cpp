@@ -82,6 +82,9 @@ std::string outcomeWord(const Diagnosis &d) {
 } // namespace
 
 void scoreTwin(const Diagnosis &d, const Effect *hidden, SelftestTwin &t, SelftestResult &R) {
+    const auto within25 = [&](double strength) {
+        return std::abs(strength - t.key.strength) <= 0.25 * std::abs(t.key.strength);
+    };
     const bool in_catalogue = hidden && hidden->in_catalogue;
     if (!hidden) {
         ++R.nulls;
@@ -108,8 +111,7 @@ void scoreTwin(const Diagnosis &d, const Effect *hidden, SelftestTwin &t, Selfte
             if (t.correct) {
                 t.claimed_strength = winner->fit.strength;
                 ++R.strength_of;
-                t.strength_within_25 = std::abs(winner->fit.strength - t.key.strength) <=
-                                       0.25 * std::abs(t.key.strength);
+                t.strength_within_25 = within25(winner->fit.strength);
                 R.strength_ok += t.strength_within_25;
             }
         }
@@ -123,8 +125,7 @@ void scoreTwin(const Diagnosis &d, const Effect *hidden, SelftestTwin &t, Selfte
                     t.named_strength = c.fit.strength;
                 }
             R.named += t.named;
-            R.named_strength_ok += t.named && std::abs(t.named_strength - t.key.strength) <=
-                                                  0.25 * std::abs(t.key.strength);
+            R.named_strength_ok += t.named && within25(t.named_strength);
         }
     }
 }
