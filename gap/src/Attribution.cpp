@@ -349,34 +349,64 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
     return s;
 }
 
-DensityComparison compareDensities(const Eigen::VectorXd &measured,
-                                   const Eigen::VectorXd &model_mean,
-                                   const Eigen::VectorXd &model_variance,
-                                   const Eigen::VectorXd &null_mean,
-                                   const Eigen::VectorXd &null_variance, const FeatureSet &use,
-                                   const std::vector<FeatureKey> &keys) {
+DensityComparison
+compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_mean,
+                 const Eigen::VectorXd &model_variance, const Eigen::VectorXd &null_mean,
+                 const Eigen::VectorXd &null_variance, const FeatureSet &use,
+                 const std::vector<FeatureKey> &bed_keys,
+                 const std::vector<FeatureKey> &experiment_keys, const LeaveOneSeedOut &jackknife) {
     const auto logDensity = [](double r, double v) {
         return -0.5 * (r * r / v + std::log(2.0 * M_PI * v));
     };
-    Eigen::VectorXd gain = Eigen::VectorXd::Constant(measured.size(), kNaN);
-    for (Eigen::Index k : use) {
-        const double rm = measured[k] - model_mean[k], rn = measured[k] - null_mean[k];
-        const double vm = model_variance[k], vn = null_variance[k];
-        if (std::isfinite(rm) && std::isfinite(rn) && vm > 0.0 && vn > 0.0)
-            gain[k] = logDensity(rm, vm) - logDensity(rn, vn);
-    }
-    const ClusteredMean g = clusteredMean(gain, use, keys);
+    const auto gains = [&](const Eigen::VectorXd &model, const Eigen::VectorXd &null) {
+        Eigen::VectorXd gain = Eigen::VectorXd::Constant(measured.size(), kNaN);
+        for (Eigen::Index k : use) {
+            const double rm = measured[k] - model[k], rn = measured[k] - null[k];
+            const double vm = model_variance[k], vn = null_variance[k];
+            if (std::isfinite(rm) && std::isfinite(rn) && vm > 0.0 && vn > 0.0)
+                gain[k] = logDensity(rm, vm) - logDensity(rn, vn);
+        }
+        return gain;
+    };
+    const Eigen::VectorXd gain = gains(model_mean, null_mean);
+    ClusteredMean g = clusteredMean(gain, use, bed_keys);
     DensityComparison c;
     c.features = g.values;
     c.experiments = g.experiments;
     c.mean_gain = g.mean;
     c.gain_correlation = g.icc;
+    double variance = g.variance, dof = g.dof;
+    const std::size_t seeds = jackknife.model_mean.size();
+    if (g.experiments == 1 && !experiment_keys.empty() && seeds >= 2 &&
+        jackknife.null_mean.size() == seeds) {
+        // One group of beds: its experiments' spread, plus how far the mean gain moves when
+        // one of the model's beds is left out (the jackknife: (S - 1)/S sum (g_j - g.)^2).
+        g = clusteredMean(gain, use, experiment_keys);
+        std::vector<double> left_out;
+        for (std::size_t j = 0; j < seeds; ++j)
+            left_out.push_back(clusteredMean(gains(jackknife.model_mean[j], jackknife.null_mean[j]),
+                                             use, experiment_keys)
+                                   .mean);
+        double centre = 0.0, spread = 0.0;
+        for (double x : left_out)
+            centre += x / double(seeds);
+        for (double x : left_out)
+            spread += (x - centre) * (x - centre);
+        c.seed_variance = spread * double(seeds - 1) / double(seeds);
+        c.one_group = true;
+        c.experiments = g.experiments;
+        c.gain_correlation = g.icc;
+        const double a = g.variance, b = c.seed_variance;
+        variance = a + b;
+        const double den = (g.dof > 0.0 ? a * a / g.dof : 0.0) + b * b / double(seeds - 1);
+        dof = den > 0.0 ? variance * variance / den : 0.0;
+    }
     // One held-out experiment, or gains without any spread, cannot tell a better model from
     // luck: no claim rests on them (p = 1; the t test would give 0 for any gain above zero).
-    if (g.experiments < 2 || !(g.variance > 0.0) || !std::isfinite(g.variance))
+    if (c.experiments < 2 || !(variance > 0.0) || !std::isfinite(variance) || !(dof > 0.0))
         return c;
-    const boost::math::students_t dist(g.dof);
-    c.p_value = boost::math::cdf(boost::math::complement(dist, g.mean / std::sqrt(g.variance)));
+    const boost::math::students_t dist(dof);
+    c.p_value = boost::math::cdf(boost::math::complement(dist, c.mean_gain / std::sqrt(variance)));
     return c;
 }
 

@@ -43,6 +43,34 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> meanAndVariance(const Eigen::MatrixX
     return {s.mean, var};
 }
 
+/// A model's and the null's means with seed j left out, j over the seeds both have (seed j
+/// of both is one bed: common random numbers). The null is the base times its discrepancy
+/// factor (`null_mean / base_mean`), the factor held at its fit to all seeds.
+LeaveOneSeedOut leaveOneSeedOut(const Eigen::MatrixXd &model_rows, const Eigen::MatrixXd &base_rows,
+                                const Eigen::VectorXd &base_mean,
+                                const Eigen::VectorXd &null_mean) {
+    LeaveOneSeedOut out;
+    const Eigen::Index seeds = std::min(model_rows.rows(), base_rows.rows());
+    if (seeds < 2)
+        return out;
+    const auto without = [&](const Eigen::MatrixXd &rows, Eigen::Index j) {
+        Eigen::MatrixXd rest(seeds - 1, rows.cols());
+        for (Eigen::Index i = 0, r = 0; i < seeds; ++i)
+            if (i != j)
+                rest.row(r++) = rows.row(i);
+        return columnStats(rest).mean;
+    };
+    for (Eigen::Index j = 0; j < seeds; ++j) {
+        out.model_mean.push_back(without(model_rows, j));
+        const Eigen::VectorXd base = without(base_rows, j);
+        Eigen::VectorXd null = null_mean;
+        for (Eigen::Index k = 0; k < null.size(); ++k)
+            null[k] = base_mean[k] != 0.0 ? null_mean[k] * base[k] / base_mean[k] : kNaN;
+        out.null_mean.push_back(null);
+    }
+    return out;
+}
+
 std::string joined(const std::vector<std::string> &items) {
     std::string list;
     for (const auto &item : items)
@@ -216,7 +244,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // beds (`Simulator::bedGroup`; grainlink's: one type in one box, whose seeds share one
     // packing), not per experiment. A model's error from its own few beds is shared by every
     // plate pressed into them: counted per plate, a pair that re-packed the beds
-    // (polydispersity) "beat" the null at p = 1e-6 on LIGGGHTS' rolling-friction twin.
+    // (polydispersity) "beat" the null at p = 1e-6 on LIGGGHTS' rolling-friction twin. One
+    // group held out is judged per experiment with that shared luck measured instead (the
+    // seed jackknife in `compareDensities`).
     std::vector<FeatureKey> bed_keys = meas.keys;
     for (FeatureKey &key : bed_keys)
         key.experiment = simulator.bedGroup(set.find(key.experiment));
@@ -466,7 +496,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const Eigen::VectorXd predictive = var + strength_var;
         score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);
         versus_null = compareDensities(meas.value, mean, predictive, null_mean, null_var,
-                                       D.held_out, bed_keys);
+                                       D.held_out, bed_keys, meas.keys,
+                                       leaveOneSeedOut(rows, base_rows, V.simulated, null_mean));
         z = (meas.value - mean).array() / var.array().sqrt();
         for (Eigen::Index k = 0; k < z.size(); ++k)
             z[k] = normalEquivalent(z[k], V.dof[k]);
@@ -577,14 +608,17 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             winner = &R;
 
     // Pairs, where no single effect explains the gap and a claim is possible at all (a
-    // resolved base, two or more held-out groups of beds compared).
-    const std::size_t held_out_compared = [&] {
+    // resolved base; two or more held-out groups of beds, or one group of two or more
+    // experiments simulated on two or more beds: `compareDensities`).
+    const auto distinct = [&](const std::vector<FeatureKey> &keys) {
         std::set<std::string> ids;
         for (Eigen::Index k : D.held_out)
-            ids.insert(bed_keys[std::size_t(k)].experiment);
+            ids.insert(keys[std::size_t(k)].experiment);
         return ids.size();
-    }();
-    if (!winner && resolved && held_out_compared >= 2) {
+    };
+    const bool claim_possible =
+        distinct(bed_keys) >= 2 || (distinct(meas.keys) >= 2 && base_rows.rows() >= 2);
+    if (!winner && resolved && claim_possible) {
         std::vector<std::size_t> pool;
         for (std::size_t i : applicable)
             if (int(pool.size()) < opt.pair_pool && live[i].result.calibration_gain > 0.0)
@@ -694,12 +728,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 claim << "unexplained: no held-out experiment to test a candidate on (a claim "
                          "needs experiments it was not fitted to: give two or more experiments "
                          "of a type, or name them with --hold-out)";
-            else if (held_out_compared < 2)
+            else if (!claim_possible)
                 claim << "unexplained: the held-out experiments are one piece of evidence: "
-                         "the model simulates them on the same beds (one type in one box), "
-                         "however many features and experiments they have (a claim needs two "
-                         "or more such groups held out: another box or another test type, "
-                         "named with --hold-out)";
+                         "one experiment, or one group the model simulates on a single bed "
+                         "(a claim needs two or more held-out experiments and two or more bed "
+                         "realisations, numerics.seeds)";
             else
                 claim << "unexplained: no catalogued effect, alone or in a pair, predicts the "
                          "held-out experiments better than the null model and leaves no gap";

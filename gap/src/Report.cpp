@@ -30,7 +30,9 @@ Json gain(const DensityComparison &c) {
     return {{"mean_per_feature", number(c.mean_gain)},
             {"features", c.features},
             {"experiments", c.experiments},
-            {"share_between_experiments", number(c.gain_correlation)}};
+            {"counted_by", c.one_group ? "experiment, one group of beds" : "group of beds"},
+            {"share_between_experiments", number(c.gain_correlation)},
+            {"seed_jackknife_variance", number(c.seed_variance)}};
 }
 
 Json verdict(const GapVerdict &g) {

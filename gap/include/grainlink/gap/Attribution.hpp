@@ -152,24 +152,39 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
                           const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_val,
                           const FeatureSet &use);
 
+/// The model's and the null's held-out predictions with one bed realisation left out in turn
+/// (seed j of both: common random numbers), for the jackknife of the model's own bed draw.
+struct LeaveOneSeedOut {
+    std::vector<Eigen::VectorXd> model_mean, null_mean;
+};
+
 /// Sample-split test that a model predicts held-out features better than the null, by the log
 /// predictive density (a proper score: a model gains nothing by widening its spread, nor by
 /// a confident miss): the per-feature differences of log density, their mean, and the
-/// one-sided p of a t test that it is > 0 with the variance of a mean over experiments whose
-/// gains may move together (`clusteredMean`); p = 1 with fewer than two held-out experiments
-/// or gains without spread.
+/// one-sided p of a t test that it is > 0.
+/// With two or more groups of beds held out (`bed_keys`), the mean's variance is that over
+/// groups whose gains may move together (`clusteredMean`). With one group, its experiments
+/// vary independently only on the measuring side; what they share is the model's (and the
+/// null's) few simulated beds, whose luck lifts every experiment at once: the variance is the
+/// clustered one over its experiments (`experiment_keys`) plus the seed jackknife of the mean
+/// gain (`jackknife`), with Welch-Satterthwaite degrees of freedom. p = 1 with one held-out
+/// experiment, one group and no jackknife, or gains without spread.
 struct DensityComparison {
     double mean_gain = 0.0; ///< mean log-density gain per feature (model - null)
     double p_value = 1.0;
     int features = 0;
-    int experiments = 0;           ///< held-out experiments with a gain
-    double gain_correlation = 0.0; ///< the share of the gains' variance between experiments
+    int experiments = 0; ///< held-out groups of beds (or experiments in the one group) with a gain
+    double gain_correlation = 0.0; ///< the share of the gains' variance between them
+    double seed_variance = 0.0;    ///< one group: the jackknife variance of the mean gain
+    bool one_group = false;        ///< one group of beds held out, judged as above
 };
 DensityComparison compareDensities(const Eigen::VectorXd &measured,
                                    const Eigen::VectorXd &model_mean,
                                    const Eigen::VectorXd &model_variance,
                                    const Eigen::VectorXd &null_mean,
                                    const Eigen::VectorXd &null_variance, const FeatureSet &use,
-                                   const std::vector<FeatureKey> &keys);
+                                   const std::vector<FeatureKey> &bed_keys,
+                                   const std::vector<FeatureKey> &experiment_keys = {},
+                                   const LeaveOneSeedOut &jackknife = {});
 
 } // namespace grainlink::gap
