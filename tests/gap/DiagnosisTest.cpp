@@ -773,3 +773,34 @@ TEST_CASE("the self-test scores each twin against its key: claims, weak twins, n
     CHECK(R.named == 2);
     CHECK(R.named_strength_ok == 1);
 }
+
+namespace fs = std::filesystem;
+
+TEST_CASE("selftest: a plan with an unknown strength draw is refused, naming the file, the key "
+          "and the line, before anything runs",
+          "[gap][selftest]") {
+    const fs::path dir = fs::temp_directory_path() / ("grainlink-plan-" + std::to_string(getpid()));
+    fs::create_directories(dir);
+    const fs::path plan = dir / "selftest.yaml";
+    std::ofstream(plan) << "nulls: 1\nstrengths: wide\n";
+    SelftestOptions o;
+    const std::string ci = GRAINLINK_SOURCE_DIR "/scenarios/gap/selftest-ci";
+    o.base_model = ci + "/base.yaml";
+    o.design = ci + "/design.yaml";
+    o.plan = plan.string();
+    o.out = (dir / "out").string();
+    o.catalogue = shippedEffects();
+    try {
+        runSelftest(o);
+        FAIL("a plan with strengths: wide was accepted");
+    } catch (const std::exception &e) {
+        const std::string what = e.what();
+        INFO(what);
+        CHECK(what.find(plan.string()) != std::string::npos);
+        CHECK(what.find("strengths") != std::string::npos);
+        CHECK(what.find(plan.string() + ":2:") != std::string::npos); // file:line
+        CHECK(what.find("far_half") != std::string::npos);
+    }
+    CHECK_FALSE(fs::exists(dir / "out" / "twins"));
+    fs::remove_all(dir);
+}
