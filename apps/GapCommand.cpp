@@ -99,6 +99,10 @@ GapCommand::GapCommand(CLI::App &app) {
         ->check(CLI::IsMember({"ci", "full"}));
     selftest_->add_option("--out", out_, "output folder (default out/gap/selftest-<scale>)");
     selftest_->add_option("--seed", seed_, "seed of the strengths and the twins' beds");
+    selftest_->add_option("--model", model_, "your base model YAML instead of the scale's");
+    selftest_->add_option("--design", design_, "your design YAML instead of the scale's");
+    selftest_->add_option("--plan", plan_,
+                          "selftest.yaml: the twins to make (default: beside the design)");
 
     executor_.progress_interval_s = 30.0; // a diagnosis runs for tens of minutes
     for (auto *c : {diagnose_, twin_, selftest_}) {
@@ -206,8 +210,11 @@ int GapCommand::selftest() const {
     o.out = out_.empty() ? "out/gap/selftest-" + scale_ : out_;
     o.sims = sims_;
     o.seed = seed_;
-    o.base_model = shipped("scenarios/gap/selftest-" + scale_ + "/base.yaml");
-    o.design = shipped("scenarios/gap/selftest-" + scale_ + "/design.yaml");
+    // A user's own base and design prove the diagnosis where it will be used.
+    const std::string suite = "scenarios/gap/selftest-" + scale_;
+    o.base_model = model_.empty() ? shipped(suite + "/base.yaml") : model_;
+    o.design = design_.empty() ? shipped(suite + "/design.yaml") : design_;
+    o.plan = plan_;
     o.catalogue = catalogueWith(effects_file_);
     o.executor = executorOptions(executor_);
     o.plot_tool = shipped("tools/gap_report.py");

@@ -38,7 +38,7 @@ private:
     unsigned seed_ = 1;
     double noise_ = 0.01, level_noise_ = 0.02;
     // selftest
-    std::string scale_ = "ci";
+    std::string scale_ = "ci", plan_;
     // import
     std::string source_, sinkage_ = "synced", csv_id_, csv_type_, csv_x_;
     std::vector<std::string> csv_y_, csv_conditions_;

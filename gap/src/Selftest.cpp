@@ -134,6 +134,8 @@ SelftestResult runSelftest(const SelftestOptions &o) {
     const auto t0 = std::chrono::steady_clock::now();
     const BaseModel base = loadBaseModel(o.base_model);
     const Design design = loadDesign(o.design);
+    if (!o.plan.empty() && !fs::exists(o.plan))
+        throw std::runtime_error(o.plan + ": no such self-test plan");
     const Plan plan = loadPlan(o.plan.empty() ? (fs::path(o.design).parent_path() / "selftest.yaml").string()
                                               : o.plan);
     const std::string sims = o.sims.empty() ? o.out + "/sims" : o.sims;
