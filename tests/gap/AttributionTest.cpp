@@ -120,6 +120,18 @@ TEST_CASE("held-out scores: a perfect model has no gap; a 10 % error is a 10 % r
                                   Eigen::VectorXd::Constant(4, 1e-6), all(4));
     CHECK(off.relative_rmse == Approx(0.1));
     CHECK(off.gap == Approx(0.1).epsilon(1e-6));
+    // Hand numbers with a feature measured near zero (a straight wheel's side force, 0.01 with
+    // u_val 0.5, hit): it counts (0 - 0.25)/(1e-4 + 0.25) = -0.9996, not -2500, and the other
+    // feature, 3x too high (r = 2, u_val 0.1, y = 1), (4 - 0.01)/(1 + 0.01) = 3.9505: the gap is
+    // sqrt((3.9505 - 0.9996)/2) = 1.2147, where dividing by y^2 gave 0.
+    Eigen::VectorXd y2(2), m2(2), u2(2);
+    y2 << 0.01, 1.0;
+    m2 << 0.01, 3.0;
+    u2 << 0.25, 0.01;
+    const auto near_zero = scoreHeldOut(y2, m2, u2, u2, all(2));
+    CHECK(near_zero.gap ==
+          Approx(std::sqrt((3.99 / 1.01 - 0.25 / (1e-4 + 0.25)) / 2.0)).epsilon(1e-12));
+    CHECK(near_zero.gap > 1.2);
 }
 
 TEST_CASE("block correlation: one per experiment when its features move together, about k when "

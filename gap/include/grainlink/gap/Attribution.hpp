@@ -142,8 +142,9 @@ Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const
 /// How well predictions match held-out features. `smse`: mean squared error standardised by
 /// the prediction's own variance; `relative_rmse`: root mean square of (measured - predicted)
 /// / measured; `gap`: that relative error in excess of the validation uncertainty `u2_val`
-/// (the same for every model compared), sqrt(max(0, mean((r^2 - u_val^2) / y^2))): 0 when the
-/// model is as good as the data can tell.
+/// (the same for every model compared), sqrt(max(0, mean((r^2 - u_val^2) / (y^2 + u_val^2)))):
+/// 0 when the model is as good as the data can tell; a feature measured near zero counts
+/// relative to its uncertainty, not to its value.
 struct HeldOutScore {
     double smse = 0.0, relative_rmse = 0.0, gap = 0.0, log_density = 0.0;
     int features = 0;
