@@ -111,7 +111,12 @@ ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidat
     for (const CandidateResult &R : candidates) {
         if (!R.confirmed)
             continue;
-        if (!c.by_gap || R.held_out.gap < c.by_gap->held_out.gap)
+        // Gaps tie where several leave none (it is clipped at 0): then the better held-out
+        // density (the plates self-test's domain-size twin: stiffness and the hidden domain size
+        // both at 0 %, the domain size's prediction the sharper, and stiffness was named).
+        if (!c.by_gap || R.held_out.gap < c.by_gap->held_out.gap ||
+            (R.held_out.gap == c.by_gap->held_out.gap &&
+             R.held_out.log_density > c.by_gap->held_out.log_density))
             c.by_gap = &R;
         // Nearest to a claim only with some evidence (p < 1) and a prediction everywhere.
         if (R.versus_null.p_value < 1.0 && std::isfinite(R.held_out.gap) &&

@@ -646,6 +646,13 @@ TEST_CASE("when nothing is claimed the closest by held-out gap and the nearest t
     const ClosestCandidates no_evidence = closestCandidates(without);
     CHECK(no_evidence.by_gap->name == "grain_stiffness");
     CHECK(no_evidence.by_p_value == nullptr);
+    // Two leave no gap at all: the sharper held-out prediction is the closest, whichever the
+    // calibration ranked first (the plates self-test's domain-size twin).
+    std::vector<CandidateResult> tied{candidate("grain_stiffness", true, 0.0, 0.047),
+                                      candidate("domain_size", true, 0.0, 0.072)};
+    tied[0].held_out.log_density = -270.7;
+    tied[1].held_out.log_density = -263.9;
+    CHECK(closestCandidates(tied).by_gap->name == "domain_size");
 }
 
 TEST_CASE("the default held-out experiments: the last box, else the last half of a type",

@@ -149,7 +149,8 @@ struct Diagnosis {
 const char *outcomeName(Diagnosis::Outcome outcome);
 
 /// When nothing is claimed, two confirmed candidates come closest: the one whose added effect
-/// leaves the smallest held-out gap, and the one nearest to a claim (the smallest p against the
+/// leaves the smallest held-out gap (of equal gaps, the best held-out density), and the one
+/// nearest to a claim (the smallest p against the
 /// null). Either is null when nothing was confirmed; they may be the same.
 struct ClosestCandidates {
     const CandidateResult *by_gap = nullptr;
