@@ -326,6 +326,11 @@ Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const
     return o;
 }
 
+namespace {
+/// log N(r | 0, v): one feature's log predictive density, the score both held-out measures use.
+double logDensity(double r, double v) { return -0.5 * (r * r / v + std::log(2.0 * M_PI * v)); }
+} // namespace
+
 HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd &predicted,
                           const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_val,
                           const FeatureSet &use) {
@@ -342,7 +347,7 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
         // near zero (a straight wheel's side force, traction at zero slip) weighted by 1/y^2
         // outweighed every other feature (the CMU wheels: 2.9x too much traction, gap "0 %").
         excess += (r * r - u2_val[k]) / (y * y + u2_val[k]);
-        s.log_density += -0.5 * (r * r / v + std::log(2.0 * M_PI * v));
+        s.log_density += logDensity(r, v);
     }
     if (s.features == 0)
         return s;
@@ -358,9 +363,6 @@ compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_m
                  const Eigen::VectorXd &null_variance, const FeatureSet &use,
                  const std::vector<FeatureKey> &bed_keys,
                  const std::vector<FeatureKey> &experiment_keys, const LeaveOneSeedOut &jackknife) {
-    const auto logDensity = [](double r, double v) {
-        return -0.5 * (r * r / v + std::log(2.0 * M_PI * v));
-    };
     const auto gains = [&](const Eigen::VectorXd &model, const Eigen::VectorXd &null) {
         Eigen::VectorXd gain = Eigen::VectorXd::Constant(measured.size(), kNaN);
         for (Eigen::Index k : use) {
