@@ -8,6 +8,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <set>
 #include <stdexcept>
 
 namespace grainlink::gap {
@@ -357,6 +358,22 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
     return s;
 }
 
+namespace {
+std::size_t distinctExperiments(const FeatureSet &use, const std::vector<FeatureKey> &keys) {
+    std::set<std::string> ids;
+    for (Eigen::Index k : use)
+        ids.insert(keys[std::size_t(k)].experiment);
+    return ids.size();
+}
+} // namespace
+
+bool canCarryClaim(const FeatureSet &use, const std::vector<FeatureKey> &bed_keys,
+                   const std::vector<FeatureKey> &experiment_keys, std::size_t seeds) {
+    return distinctExperiments(use, bed_keys) >= 2 ||
+           (!experiment_keys.empty() && distinctExperiments(use, experiment_keys) >= 2 &&
+            seeds >= 2);
+}
+
 DensityComparison
 compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_mean,
                  const Eigen::VectorXd &model_variance, const Eigen::VectorXd &null_mean,
@@ -374,16 +391,22 @@ compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_m
         return gain;
     };
     const Eigen::VectorXd gain = gains(model_mean, null_mean);
-    ClusteredMean g = clusteredMean(gain, use, bed_keys);
+    FeatureSet scored;
+    for (Eigen::Index k : use)
+        if (std::isfinite(gain[k]))
+            scored.push_back(k);
+    ClusteredMean g = clusteredMean(gain, scored, bed_keys);
     DensityComparison c;
     c.features = g.values;
     c.experiments = g.experiments;
     c.mean_gain = g.mean;
     c.gain_correlation = g.icc;
+    const std::size_t seeds =
+        jackknife.null_mean.size() == jackknife.model_mean.size() ? jackknife.model_mean.size() : 0;
+    if (!canCarryClaim(scored, bed_keys, experiment_keys, seeds))
+        return c; // one piece of evidence cannot tell a better model from luck: p = 1
     double variance = g.variance, dof = g.dof;
-    const std::size_t seeds = jackknife.model_mean.size();
-    if (g.experiments == 1 && !experiment_keys.empty() && seeds >= 2 &&
-        jackknife.null_mean.size() == seeds) {
+    if (g.experiments == 1) {
         // One group of beds: its experiments' spread, plus how far the mean gain moves when
         // one of the model's beds is left out (the jackknife: (S - 1)/S sum (g_j - g.)^2).
         g = clusteredMean(gain, use, experiment_keys);
@@ -406,9 +429,9 @@ compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_m
         const double den = (g.dof > 0.0 ? a * a / g.dof : 0.0) + b * b / double(seeds - 1);
         dof = den > 0.0 ? variance * variance / den : 0.0;
     }
-    // One held-out experiment, or gains without any spread, cannot tell a better model from
-    // luck: no claim rests on them (p = 1; the t test would give 0 for any gain above zero).
-    if (c.experiments < 2 || !(variance > 0.0) || !std::isfinite(variance) || !(dof > 0.0))
+    // Gains without any spread cannot tell a better model from luck either (p = 1; the t test
+    // would give 0 for any gain above zero).
+    if (!(variance > 0.0) || !std::isfinite(variance) || !(dof > 0.0))
         return c;
     const boost::math::students_t dist(dof);
     c.p_value = boost::math::cdf(boost::math::complement(dist, c.mean_gain / std::sqrt(variance)));

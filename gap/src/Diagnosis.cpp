@@ -615,14 +615,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // Pairs, where no single effect explains the gap and a claim is possible at all (a
     // resolved base; two or more held-out groups of beds, or one group of two or more
     // experiments simulated on two or more beds: `compareDensities`).
-    const auto distinct = [&](const std::vector<FeatureKey> &keys) {
-        std::set<std::string> ids;
-        for (Eigen::Index k : D.held_out)
-            ids.insert(keys[std::size_t(k)].experiment);
-        return ids.size();
-    };
     const bool claim_possible =
-        distinct(bed_keys) >= 2 || (distinct(meas.keys) >= 2 && base_rows.rows() >= 2);
+        canCarryClaim(D.held_out, bed_keys, meas.keys,
+                      std::size_t(std::min<Eigen::Index>(base_rows.rows(), opt.seeds)));
     if (!winner && resolved && claim_possible) {
         std::vector<std::size_t> pool;
         for (std::size_t i : applicable)

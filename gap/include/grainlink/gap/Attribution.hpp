@@ -179,6 +179,13 @@ struct DensityComparison {
     double seed_variance = 0.0;    ///< one group: the jackknife variance of the mean gain
     bool one_group = false;        ///< one group of beds held out, judged as above
 };
+/// Whether held-out features can be evidence for a claim at all (`compareDensities` gives
+/// p < 1 only then): two or more groups of beds, or one group of two or more experiments
+/// whose models were simulated on two or more beds (the seed jackknife measures the luck
+/// they share).
+bool canCarryClaim(const FeatureSet &use, const std::vector<FeatureKey> &bed_keys,
+                   const std::vector<FeatureKey> &experiment_keys, std::size_t seeds);
+
 DensityComparison compareDensities(const Eigen::VectorXd &measured,
                                    const Eigen::VectorXd &model_mean,
                                    const Eigen::VectorXd &model_variance,
