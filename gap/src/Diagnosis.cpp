@@ -318,6 +318,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     struct Live {
         CandidateResult result;
         std::unique_ptr<TabulatedResponse> response;
+        Eigen::MatrixXd confirmed_rows;      ///< the confirming runs, a row per seed
+        Eigen::VectorXd predictive_variance; ///< of their held-out prediction
     };
     std::vector<Live> live;
     std::vector<VariantRequest> sig;
@@ -481,6 +483,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // The held-out prediction of a fitted model carries the uncertainty of its fitted strength
     // (`strength_var`), as the null model's carries its posterior: each predicts with what it
     // knows. The gap left with the model is judged without it.
+    const auto predictiveVariance = [&](const Eigen::MatrixXd &rows,
+                                        const Eigen::VectorXd &strength_var) -> Eigen::VectorXd {
+        return u2_fixed + meanAndVariance(rows, bed_sd).second + strength_var;
+    };
     const auto evaluateModel = [&](const Eigen::MatrixXd &rows, HeldOutScore &score,
                                    DensityComparison &versus_null, GapVerdict &after,
                                    Eigen::VectorXd &mean, Eigen::VectorXd &z,
@@ -498,7 +504,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             return false;
         }
         const Eigen::VectorXd var = u2_fixed + mv.second;
-        const Eigen::VectorXd predictive = var + strength_var;
+        const Eigen::VectorXd predictive = predictiveVariance(rows, strength_var);
         score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);
         versus_null = compareDensities(meas.value, mean, predictive, null_mean, null_var,
                                        D.held_out, bed_keys, meas.keys,
@@ -593,11 +599,14 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     }
     const double level = opt.alpha / std::max<std::size_t>(1, confirm.size());
     for (std::size_t c = 0; c < to_confirm.size(); ++c) {
-        CandidateResult &R = live[to_confirm[c]].result;
+        Live &L = live[to_confirm[c]];
+        CandidateResult &R = L.result;
         R.confirmed = true;
-        const bool better =
-            evaluateModel(final_rows[c], R.held_out, R.versus_null, R.after, R.confirmed_mean,
-                          R.confirmed_z, strengthSpread(*live[to_confirm[c]].response, R.fit));
+        const Eigen::VectorXd spread = strengthSpread(*L.response, R.fit);
+        const bool better = evaluateModel(final_rows[c], R.held_out, R.versus_null, R.after,
+                                          R.confirmed_mean, R.confirmed_z, spread);
+        L.confirmed_rows = final_rows[c];
+        L.predictive_variance = predictiveVariance(final_rows[c], spread);
         R.beats_null = better && R.versus_null.p_value < level && !D.held_out.empty();
         // A strength at its prior's edge may stand in for something the catalogue lacks (LIGGGHTS'
         // 5x softer soil fitted by the softest grains allowed): it may beat the null, it is
@@ -696,9 +705,28 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
               << fmt(reduction(winner->held_out), 2) << " % smaller; null model "
               << fmt(100.0 * D.held_out_null.gap, 2)
               << " %, p = " << fmt(winner->versus_null.p_value, 2) << ")";
-        for (const CandidateResult &R : D.candidates)
-            if (&R != winner && R.explains)
+        // Its rivals: every other confirmed candidate that beats the null and leaves no gap,
+        // at its prior's edge too (on the CMU plates softer grains at the softest allowed
+        // predicted the small box as well as the claimed grain shape). The claimed model is
+        // told apart from one only where it predicts the held-out experiments better, by the
+        // test it passed against the null with the rival in the null's place.
+        const Live *W = nullptr;
+        for (const Live &L : live)
+            if (L.result.name == winner->name)
+                W = &L;
+        for (const Live &L : live) {
+            const CandidateResult &R = L.result;
+            if (&L == W || !R.confirmed || !R.beats_null || R.after.gap)
+                continue;
+            const Eigen::VectorXd &rival = R.confirmed_mean;
+            const DensityComparison c = compareDensities(
+                meas.value, W->result.confirmed_mean, W->predictive_variance, rival,
+                L.predictive_variance, D.held_out, bed_keys, meas.keys,
+                leaveOneSeedOut(W->confirmed_rows, L.confirmed_rows, rival, rival));
+            D.rivals.push_back({R.name, c.p_value, R.fit.at_prior_edge});
+            if (!(c.p_value < opt.alpha))
                 D.indistinguishable.push_back(R.name);
+        }
         D.best_model = winner->name;
         D.best_model_mean = winner->confirmed_mean;
         D.best_model_z = winner->confirmed_z;
@@ -765,7 +793,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             }
         }
     }
-    D.claim = claim.str() + notCompared();
+    D.claim = claim.str();
     if (D.outcome == Diagnosis::Outcome::Explained ||
         D.outcome == Diagnosis::Outcome::ExplainedByPair)
         D.explained_by = D.best_model;
@@ -845,6 +873,19 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             }
         }
     }
+    if (winner && !D.indistinguishable.empty()) {
+        std::ostringstream also;
+        also << "; these experiments do not tell it from";
+        for (const Diagnosis::Rival &r : D.rivals)
+            if (std::find(D.indistinguishable.begin(), D.indistinguishable.end(), r.name) !=
+                D.indistinguishable.end())
+                also << ' ' << r.name << " (p = " << fmt(r.p_value, 2)
+                     << (r.at_prior_edge ? ", at its prior's edge" : "") << ')';
+        if (!D.separating_experiment.empty())
+            also << "; the experiment that would separate them best: " << D.separating_experiment;
+        D.claim += also.str();
+    }
+    D.claim += notCompared();
     log(D.claim);
     return D;
 }

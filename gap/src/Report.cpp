@@ -146,6 +146,11 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
         if (c.applicability.empty())
             names.push_back(c.name);
     j["signature_overlap"] = {{"effects", names}, {"fraction", d.overlap}};
+    j["rivals"] = Json::array();
+    for (const Diagnosis::Rival &r : d.rivals)
+        j["rivals"].push_back({{"effect", r.name},
+                               {"p_value_claimed_over_it", r.p_value},
+                               {"at_prior_edge", r.at_prior_edge}});
     j["indistinguishable_from_leader"] = d.indistinguishable;
     j["separating_experiment"] = d.separating_experiment;
     j["unexplained"] = d.unexplained;

@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <random>
 #include <set>
 #include <unistd.h>
@@ -108,6 +109,8 @@ public:
     double sample_noise = 0.01;
     /// Report the plates of a box as simulated on the same beds (as grainlink's packing cache).
     bool beds_by_box = false;
+    /// Catalogue entries that are another entry's physics under a name of their own.
+    std::map<std::string, std::string> alias;
     std::string bedGroup(const Experiment &e) const override {
         return beds_by_box ? e.labels.at("box") : e.id;
     }
@@ -134,7 +137,7 @@ public:
                         if (eff->kind == Effect::Kind::Measurement)
                             measurement = eff, t.strength = str;
                         else
-                            t = {eff->name, str};
+                            t = {alias.count(eff->name) ? alias.at(eff->name) : eff->name, str};
                     }
                     const double d = e.numbers.at("plate_diameter_m");
                     const double bed = r.effect ? effect_bed_scatter : 0.03;
@@ -569,6 +572,39 @@ TEST_CASE("diagnosis: held-out plates that the model presses into the same beds 
             CHECK_FALSE(r.versus_null.one_group);
             CHECK(r.versus_null.experiments == 2);
         }
+}
+
+TEST_CASE("diagnosis: a claim names the rivals that its held-out experiments cannot tell it "
+          "from, at their prior's edge too",
+          "[gap][diagnosis]") {
+    // A second catalogue entry with cohesion's physics, its prior ending below the hidden
+    // strength: pinned at its edge it predicts the held-out plates almost as well. Never
+    // claimed (the edge), it is still a rival the claim must name (on the CMU plates softer
+    // grains at the softest allowed predicted the small box as well as the grain shape claimed).
+    EffectCatalogue c = shippedEffects();
+    Effect capped = c.find("cohesion");
+    capped.name = "cohesion_capped";
+    capped.prior.hi = 3.99e4; // the hidden 4e4 is fitted at 4.00e4 [3.97e4, 4.03e4]
+    capped.signature = {1.5e4, 3.0e4};
+    c.effects.push_back(capped);
+    AnalyticSimulator sim;
+    sim.alias["cohesion_capped"] = "cohesion";
+    const Diagnosis d =
+        diagnose(measuredSet({"cohesion", 4.0e4}, 7), c.diagnosable(), sim, analyticOptions());
+    INFO(d.claim);
+    REQUIRE(d.explained_by == "cohesion");
+    const auto rival = std::find_if(d.rivals.begin(), d.rivals.end(),
+                                    [](const auto &r) { return r.name == "cohesion_capped"; });
+    REQUIRE(rival != d.rivals.end());
+    CHECK(rival->at_prior_edge);
+    CHECK(rival->p_value >= 0.05);
+    CHECK(std::count(d.indistinguishable.begin(), d.indistinguishable.end(), "cohesion_capped") ==
+          1);
+    CHECK(d.claim.find("do not tell it from cohesion_capped") != std::string::npos);
+    // A rival the held-out plates do tell apart is named with its p, not as indistinguishable.
+    for (const Diagnosis::Rival &r : d.rivals)
+        if (r.p_value < 0.05)
+            CHECK(std::count(d.indistinguishable.begin(), d.indistinguishable.end(), r.name) == 0);
 }
 
 TEST_CASE("diagnosis: an effect whose runs failed is not fitted as if it agreed",

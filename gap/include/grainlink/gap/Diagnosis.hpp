@@ -123,6 +123,15 @@ struct Diagnosis {
     /// Signature overlap on the whole design: overlap[i][j] = how much of candidate i's
     /// signature candidate j reproduces (candidates in `candidates` order; applicable ones).
     std::vector<std::vector<double>> overlap;
+    /// A claim's rivals: other confirmed candidates that beat the null and leave no held-out
+    /// gap (at their prior's edge too), each with the p of the claimed model predicting the
+    /// held-out experiments better than it (the test against the null, the rival as null).
+    struct Rival {
+        std::string name;
+        double p_value = 1.0;
+        bool at_prior_edge = false;
+    };
+    std::vector<Rival> rivals;
     std::vector<std::string> indistinguishable; ///< candidates the design cannot tell from the leader
     std::string separating_experiment;         ///< the probe that would separate them best
     /// Unresolved: no gap is found, but only because a numerical check of the base model moves
