@@ -44,6 +44,16 @@ std::vector<std::pair<double, double>> scatterPoints(const Experiment &e,
     return p;
 }
 
+/// Whether a run at x falls in the key's bin: [lo, hi), the experiment's last bin [lo, hi],
+/// as `scatterBinMeans` bins (a run on an inner edge counts in one bin, where the simulated
+/// slips were chosen).
+bool inScatterBin(const FeatureDesign &design, const FeatureKey &key, double x) {
+    const auto edges = design.edges.find(slot(key.experiment, key.observable));
+    const bool last =
+        edges != design.edges.end() && !edges->second.empty() && key.x_hi == edges->second.back();
+    return x >= key.x_lo && (x < key.x_hi || (last && x == key.x_hi));
+}
+
 } // namespace
 
 FeatureDesign designFeatures(const ExperimentSet &set, int bins) {
@@ -84,7 +94,9 @@ FeatureDesign designFeatures(const ExperimentSet &set, int bins) {
             scatter_kind ? *std::min_element(starts[kind].begin(), starts[kind].end()) : 0.0;
         const double end = scatter_kind ? *std::max_element(r.begin(), r.end()) : lowerMedian(r);
         if (end > start)
-            kind_edges[kind] = roundBinEdges(start, end, bins);
+            kind_edges[kind] = roundBinEdges(start, end, bins, scatter_kind);
+        else if (scatter_kind)
+            kind_edges[kind] = {start, end}; // every run at one slip: that slip is the bin
     }
     for (const Experiment &e : set.experiments)
         for (const auto &o : e.observables) {
@@ -139,7 +151,7 @@ Measured measure(const ExperimentSet &set, const FeatureDesign &design) {
                     values.push_back(t.curves.at(key.observable).y[0]);
             } else if (e.scatter) {
                 for (const auto &[x, y] : scatterPoints(e, key.observable))
-                    if (x >= key.x_lo && x <= key.x_hi)
+                    if (inScatterBin(design, key, x))
                         values.push_back(y);
             } else {
                 for (const Curve &c : zeroedTrials(e, key.observable))
@@ -203,12 +215,13 @@ Eigen::VectorXd simulatedFeatures(const ExperimentSet &set, const FeatureDesign 
             if (e.x_name.empty()) {
                 row[k] = it->second.y[0];
             } else if (e.scatter) {
-                std::vector<std::pair<double, double>> pts;
+                double sum = 0.0;
+                int count = 0;
                 for (std::size_t i = 0; i < it->second.x.size(); ++i)
-                    pts.emplace_back(it->second.x[i], it->second.y[i]);
-                std::vector<int> counts;
-                const auto means = scatterBinMeans(pts, {key.x_lo, key.x_hi}, counts);
-                row[k] = means[0];
+                    if (inScatterBin(design, key, it->second.x[i]))
+                        sum += it->second.y[i], ++count;
+                if (count > 0)
+                    row[k] = sum / count;
             } else if (const auto v = binMean(applyZero(it->second, e.zero), key.x_lo, key.x_hi)) {
                 row[k] = *v;
             }

@@ -16,8 +16,8 @@ std::optional<double> binMean(const Curve &curve, double a, double b) {
     const auto &y = curve.y;
     if (y.empty() || x.size() != y.size())
         return std::nullopt;
-    if (y.size() == 1)
-        return y[0];
+    if (y.size() == 1) // a scalar's one bin is the point 0; a one-sample curve covers no bin
+        return b > a ? std::nullopt : std::optional<double>(y[0]);
     if (!(b > a) || x.front() > a || x.back() < b)
         return std::nullopt;
     // Trapezoid rule on the interpolant clipped to [a, b].
@@ -35,7 +35,7 @@ std::optional<double> binMean(const Curve &curve, double a, double b) {
     return integral / (b - a);
 }
 
-std::vector<double> roundBinEdges(double start, double typical_end, int count) {
+std::vector<double> roundBinEdges(double start, double typical_end, int count, bool cover_end) {
     if (count < 1 || !(typical_end > start))
         throw std::invalid_argument("roundBinEdges: need count >= 1 and end > start");
     const double raw = (typical_end - start) / count;
@@ -44,9 +44,11 @@ std::vector<double> roundBinEdges(double start, double typical_end, int count) {
     for (double m : {1.0, 2.0, 2.5, 5.0, 10.0})
         if (m * decade <= raw * 1.0000001)
             width = m * decade;
-    // As many bins of that width as fit before the end: at least `count`, since the width was
-    // rounded down.
-    const int bins = std::max(count, int(std::floor((typical_end - start) / width + 1e-9)));
+    // As many bins of that width as fit before the end (at least `count`, since the width was
+    // rounded down), or as reach past it.
+    const double fit = (typical_end - start) / width;
+    const int bins =
+        std::max(count, int(cover_end ? std::ceil(fit - 1e-9) : std::floor(fit + 1e-9)));
     std::vector<double> edges;
     for (int k = 0; k <= bins; ++k)
         edges.push_back(start + k * width);

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <unistd.h>
 
 using namespace grainlink::gap;
@@ -160,6 +161,55 @@ TEST_CASE("experiments.yaml: scalars and scatters", "[gap][experiments]") {
     CHECK_THROWS_WITH(loadExperiments(dir.string()),
                       Catch::Matches(".*experiments.yaml:11: .*y_sigma.*'traction_N' \\(force\\) "
                                      "cannot serve 'sinkage_m' \\(length\\).*"));
+}
+
+TEST_CASE("wheel runs without bins: the last slip is binned, a run on an inner edge counts once, "
+          "one slip is one bin",
+          "[gap][experiments]") {
+    // Runs at slips 0, 0.25, 0.45, 0.5 and 0.75 (traction 10 N per 0.25 of slip): raw bin 0.125 is
+    // rounded to 0.1, and the bins must reach 0.75 (they stopped at 0.7: the 0.75 runs were
+    // dropped). Edges fall on 0.5: its run belongs to [0.5, 0.6) alone, not to [0.4, 0.5] too.
+    const fs::path dir = folder("slips");
+    write(dir / "wheel.csv", "slip,F\n0,0\n0.25,10\n0.45,18\n0.5,20\n0.75,30\n0.5,22\n");
+    write(dir / "experiments.yaml",
+          "experiments:\n"
+          "  - id: w\n    type: wheel_steady_state\n"
+          "    data:\n      files: [wheel.csv]\n      scatter: true\n"
+          "      x: {column: slip, unit: '-'}\n      y: {traction_N: {column: F, unit: N}}\n");
+    const ExperimentSet set = loadExperiments(dir.string());
+    const FeatureDesign d = designFeatures(set);
+    const Measured m = measure(set, d);
+    std::map<double, double> by_bin; // bin start -> mean traction
+    int runs = 0;
+    for (std::size_t k = 0; k < d.keys.size(); ++k) {
+        by_bin[std::round(d.keys[k].x_lo * 10.0) / 10.0] = m.value[Eigen::Index(k)];
+        runs += m.trials[Eigen::Index(k)];
+    }
+    CHECK(runs == 6); // every run counted, once
+    REQUIRE(by_bin.count(0.7) == 1);
+    CHECK(by_bin[0.7] == Approx(30.0));
+    CHECK(by_bin[0.5] == Approx(21.0));
+    CHECK(by_bin[0.4] == Approx(18.0));
+    // The simulated side bins a run as the measured side does.
+    SimulatedCurves sim;
+    sim["w"]["traction_N"] = Curve{{0.0, 0.25, 0.45, 0.5, 0.75}, {1.0, 2.0, 2.8, 3.0, 4.0}};
+    const Eigen::VectorXd row = simulatedFeatures(set, d, sim);
+    for (std::size_t k = 0; k < d.keys.size(); ++k) {
+        const double lo = std::round(d.keys[k].x_lo * 10.0) / 10.0;
+        if (lo == 0.4)
+            CHECK(row[Eigen::Index(k)] == Approx(2.8)); // not (2.8 + 3.0) / 2
+        if (lo == 0.5)
+            CHECK(row[Eigen::Index(k)] == Approx(3.0));
+    }
+
+    // Every run at one slip: that slip is the bin (there was none, and the wheel test stopped
+    // with "no slip bin to simulate").
+    write(dir / "wheel.csv", "slip,F\n0.2,10\n0.2,12\n");
+    const ExperimentSet one = loadExperiments(dir.string());
+    const FeatureDesign d1 = designFeatures(one);
+    REQUIRE(d1.keys.size() == 1);
+    CHECK(d1.keys[0].x_lo == Approx(0.2));
+    CHECK(measure(one, d1).value[0] == Approx(11.0));
 }
 
 TEST_CASE("experiments.yaml: bad input names the file, the key and the line",

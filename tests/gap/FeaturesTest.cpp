@@ -38,6 +38,8 @@ TEST_CASE("a bin the curve does not cover has no mean; a scalar is its own value
     CHECK_FALSE(binMean(c, 0.005, 0.02).has_value());
     CHECK_FALSE(binMean(c, -0.001, 0.005).has_value());
     CHECK(*binMean(Curve{{0.0}, {31.5}}, 0.0, 0.0) == 31.5);
+    // A curve cut to one sample is no curve: it gave its value to every bin.
+    CHECK_FALSE(binMean(Curve{{0.004}, {31.5}}, 0.0, 0.002).has_value());
 }
 
 TEST_CASE("bin edges have a round width", "[gap][features]") {
@@ -47,6 +49,10 @@ TEST_CASE("bin edges have a round width", "[gap][features]") {
     CHECK(e.back() == Approx(0.02));
     const auto f = roundBinEdges(1.0, 2.0, 5); // 0.2 exactly
     CHECK(f[1] == Approx(1.2));
+    // Runs scattered to 0.75: 0.1 wide, to 0.7 before the end, to 0.8 to cover it.
+    CHECK(roundBinEdges(0.0, 0.75, 6).back() == Approx(0.7));
+    CHECK(roundBinEdges(0.0, 0.75, 6, true).back() == Approx(0.8));
+    CHECK(roundBinEdges(1.0, 2.0, 5, true).back() == Approx(2.0)); // an end on an edge: no more
 }
 
 TEST_CASE("feature rows and their column statistics skip what a curve does not reach",

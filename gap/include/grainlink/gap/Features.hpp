@@ -19,7 +19,8 @@ struct Curve {
 
 /// Mean of the piecewise-linear interpolant of `curve` over [a, b] (the integral over the
 /// range divided by its width); nullopt when the curve's samples do not cover [a, b].
-/// For a scalar curve (one point) the value itself.
+/// For a scalar curve (one point) the value itself in the point bin a = b, and nothing in a
+/// bin of some width (a curve cut to one sample covers none).
 std::optional<double> binMean(const Curve &curve, double a, double b);
 
 /// Which feature: the experiment, its observable, and the x-range averaged over.
@@ -35,8 +36,10 @@ struct FeatureKey {
 
 /// Bin edges shared by every experiment of one observable kind: equal bins from `start` with a
 /// round width (1, 2, 2.5 or 5 times a power of ten, the largest not above (end - start) /
-/// count), as many as fit before `typical_end` (so at least `count`).
-std::vector<double> roundBinEdges(double start, double typical_end, int count);
+/// count), as many as fit before `typical_end` (so at least `count`), or with `cover_end` as
+/// many as reach it (a scatter of runs: the last edge at or beyond the last run).
+std::vector<double> roundBinEdges(double start, double typical_end, int count,
+                                  bool cover_end = false);
 
 /// Features of a set of curves (trials or seeds) on `edges`: one row per curve, one column
 /// per bin; NaN where a curve does not cover the bin. A scalar curve gives one column.
