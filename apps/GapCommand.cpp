@@ -154,6 +154,8 @@ int GapCommand::diagnose() const {
     const gap::ExperimentSet set = gap::simulable(gap::loadExperiments(measurements_), base, left_out);
     for (const std::string &why : left_out)
         std::fprintf(stderr, "[gap] left out: %s\n", why.c_str());
+    for (const std::string &note : set.notes)
+        std::fprintf(stderr, "[gap] read: %s\n", note.c_str());
     const gap::EffectCatalogue catalogue = catalogueWith(effects_file_);
     std::vector<const gap::Effect *> effects;
     for (const gap::Effect *e : catalogue.diagnosable())

@@ -81,18 +81,53 @@ bool endsWith(const std::string &s, const std::string &tail) {
     return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-std::vector<std::string> splitCsv(const std::string &line) {
+/// How a data file's cells are separated (`data.delimiter`): a character, or runs of blanks.
+struct Delimiter {
+    char sep = ',';
+    bool blanks = false;
+};
+
+Delimiter parseDelimiter(const ConfigNode &data) {
+    const std::string d =
+        data.has("delimiter") ? data["delimiter"].choice({",", ";", "tab", "whitespace"}) : ",";
+    return d == "whitespace" ? Delimiter{' ', true} : Delimiter{d == "tab" ? '\t' : d[0], false};
+}
+
+std::vector<std::string> splitCsv(const std::string &line, const Delimiter &delimiter) {
     std::vector<std::string> out;
-    std::string cell;
-    std::istringstream in(line);
-    while (std::getline(in, cell, ',')) {
-        while (!cell.empty() && (cell.back() == '\r' || cell.back() == ' '))
+    const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
+    const auto push = [&](std::string cell) {
+        while (!cell.empty() && blank(cell.back()))
             cell.pop_back();
-        while (!cell.empty() && cell.front() == ' ')
+        while (!cell.empty() && blank(cell.front()))
             cell.erase(cell.begin());
+        if (cell.size() >= 2 && cell.front() == '"' && cell.back() == '"') // a quoted name
+            cell = cell.substr(1, cell.size() - 2);
         out.push_back(cell);
+    };
+    std::string cell;
+    for (char c : line) {
+        const bool split = delimiter.blanks ? blank(c) : c == delimiter.sep;
+        if (!split) {
+            cell += c;
+            continue;
+        }
+        if (!delimiter.blanks || !cell.empty())
+            push(cell);
+        cell.clear();
     }
+    if (!delimiter.blanks || !cell.empty())
+        push(cell);
     return out;
+}
+
+/// A cell that holds no value: empty, or a missing-value mark of a spreadsheet or of numpy.
+bool missingCell(const std::string &cell) {
+    std::string low;
+    for (char c : cell)
+        low += char(std::tolower(static_cast<unsigned char>(c)));
+    return low.empty() || low == "nan" || low == "-nan" || low == "na" || low == "n/a" ||
+           low == "null" || low == "none";
 }
 
 /// A CSV table: header names and rows of text cells, with the file line of every row.
@@ -107,9 +142,17 @@ struct Table {
             std::string have;
             for (const auto &h : header)
                 have += (have.empty() ? "" : ", ") + h;
-            where.fail("column '" + name + "' is not in " + file + " (its columns: " + have + ")");
+            const bool one =
+                header.size() == 1 && header[0].find_first_of(";\t ") != std::string::npos;
+            where.fail("column '" + name + "' is not in " + file + " (its columns: " + have + ")" +
+                       (one ? "; its cells may be separated otherwise: give data.delimiter "
+                              "(; tab whitespace)"
+                            : ""));
         }
         return std::size_t(it - header.begin());
+    }
+    bool missing(std::size_t row, std::size_t col) const {
+        return col >= rows[row].size() || missingCell(rows[row][col]);
     }
     double number(std::size_t row, std::size_t col) const {
         const std::string &cell = col < rows[row].size() ? rows[row][col] : std::string();
@@ -122,7 +165,8 @@ struct Table {
     }
 };
 
-Table readTable(const fs::path &path, char comment, const ConfigNode &where) {
+Table readTable(const fs::path &path, char comment, const Delimiter &delimiter,
+                const ConfigNode &where) {
     std::ifstream in(path);
     if (!in)
         where.fail("cannot read data file " + path.string());
@@ -131,14 +175,18 @@ Table readTable(const fs::path &path, char comment, const ConfigNode &where) {
     std::string line;
     int number = 0;
     while (std::getline(in, line)) {
-        ++number;
-        if (line.empty() || line[0] == comment || line == "\r")
+        if (++number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0)
+            line.erase(0, 3); // a spreadsheet's byte-order mark
+        if (line.empty() || line[0] == comment)
             continue;
+        std::vector<std::string> cells = splitCsv(line, delimiter);
+        if (std::all_of(cells.begin(), cells.end(), [](const std::string &c) { return c.empty(); }))
+            continue; // blank, or a spreadsheet's row of empty cells
         if (t.header.empty()) {
-            t.header = splitCsv(line);
+            t.header = std::move(cells);
             continue;
         }
-        t.rows.push_back(splitCsv(line));
+        t.rows.push_back(std::move(cells));
         t.lines.push_back(number);
     }
     if (t.header.empty())
@@ -418,9 +466,11 @@ ExperimentSet loadExperiments(const std::string &directory) {
             std::replace(e.observables.begin(), e.observables.end(), std::string("force_N"),
                          std::string("pressure_Pa"));
             const auto filter = data.optional("filter");
+            const Delimiter delimiter = parseDelimiter(data);
             for (const ConfigNode &f : files.items()) {
                 const fs::path path = dir / f.text();
-                const Table table = readTable(path, comment.empty() ? '#' : comment[0], f);
+                const Table table =
+                    readTable(path, comment.empty() ? '#' : comment[0], delimiter, f);
                 const auto [xcol, xfac] = axisColumn(data["x"], table, e.x_name);
                 std::vector<std::tuple<std::string, std::size_t, double>> ycols;
                 for (const auto &o : obs_names) {
@@ -437,25 +487,44 @@ ExperimentSet loadExperiments(const std::string &directory) {
                                           (*filter)[key].number());
                 Trial whole;
                 whole.source = path.string();
+                // A value missing (empty, NaN) leaves that sample out, and is said: a sensor's
+                // dropout is no reason to refuse the file; a word where a number belongs is.
+                std::vector<int> gaps;
                 for (std::size_t r = 0; r < table.rows.size(); ++r) {
                     bool selected = true;
                     for (const auto &[c, v] : keep)
-                        selected = selected && std::abs(table.number(r, c) - v) <= 1e-9 * (1 + std::abs(v));
+                        selected = selected && !table.missing(r, c) &&
+                                   std::abs(table.number(r, c) - v) <= 1e-9 * (1 + std::abs(v));
                     if (!selected)
                         continue;
-                    const double x = table.number(r, xcol) * xfac;
-                    if (e.scatter) {
-                        Trial t;
-                        t.source = path.string() + ":" + std::to_string(table.lines[r]);
-                        for (const auto &[o, c, fac] : ycols)
-                            t.curves[o] = Curve{{x}, {table.number(r, c) * fac}};
-                        e.trials.push_back(std::move(t));
-                    } else {
-                        for (const auto &[o, c, fac] : ycols) {
-                            whole.curves[o].x.push_back(x);
-                            whole.curves[o].y.push_back(table.number(r, c) * fac);
+                    bool gap = table.missing(r, xcol);
+                    Trial t;
+                    t.source = path.string() + ":" + std::to_string(table.lines[r]);
+                    for (const auto &[o, c, fac] : ycols) {
+                        if (gap || table.missing(r, c)) {
+                            gap = true;
+                            continue;
                         }
+                        const double x = table.number(r, xcol) * xfac;
+                        const double y = table.number(r, c) * fac;
+                        Curve &curve = e.scatter ? t.curves[o] : whole.curves[o];
+                        curve.x.push_back(x);
+                        curve.y.push_back(y);
                     }
+                    if (gap)
+                        gaps.push_back(table.lines[r]);
+                    if (e.scatter && !t.curves.empty())
+                        e.trials.push_back(std::move(t));
+                }
+                if (!gaps.empty()) {
+                    std::string where;
+                    for (std::size_t i = 0; i < gaps.size() && i < 5; ++i)
+                        where += (i ? ", " : "") + std::to_string(gaps[i]);
+                    set.notes.push_back(path.string() + ": " + std::to_string(gaps.size()) +
+                                        " of " + std::to_string(table.rows.size()) +
+                                        " rows miss a value (empty or NaN) in a column read; "
+                                        "those samples are left out (lines " +
+                                        where + (gaps.size() > 5 ? ", ..." : "") + ")");
                 }
                 if (!e.scatter) {
                     // No row passed the filter: no curve was started at all.

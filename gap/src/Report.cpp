@@ -78,6 +78,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     j["format"] = "grainlink-gap-diagnosis";
     j["version"] = 1;
     j["measurements"] = set.name;
+    j["measurement_notes"] = set.notes;
     j["outcome"] = outcomeName(d.outcome);
     j["claim"] = d.claim;
     j["numerical_warning"] = d.numerical_warning;
@@ -164,6 +165,10 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
     r << "Result: " << d.claim << "\n\n";
     if (!d.numerical_warning.empty())
         r << "Warning: " << d.numerical_warning << "\n\n";
+    for (const std::string &note : set.notes)
+        r << "Read: " << note << '\n';
+    if (!set.notes.empty())
+        r << '\n';
     r << "Numerical uncertainty and the gap test: " << d.verdict.summary << "\n";
     {
         // V&V 20's budget: which part of u_val a finer base model would shrink.

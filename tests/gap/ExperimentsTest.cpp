@@ -212,6 +212,39 @@ TEST_CASE("wheel runs without bins: the last slip is binned, a run on an inner e
     CHECK(measure(one, d1).value[0] == Approx(11.0));
 }
 
+TEST_CASE("data files as other tools write them: a byte-order mark, quoted names, another "
+          "delimiter, empty rows and missing values",
+          "[gap][experiments]") {
+    const fs::path dir = folder("tools");
+    // A spreadsheet's export: BOM, quoted header, ';', a row of empty cells, a blank line, and a
+    // sensor dropout (NaN) and an empty cell in the pressure column.
+    write(dir / "a1.csv", "\xEF\xBB\xBF\"sinkage_mm\";\"pressure_kPa\"\n0;0\n1;1\n;\n\n"
+                          "2;NaN\n3;\n4;4\n");
+    linearTrial(dir / "a2.csv", 1.0);
+    linearTrial(dir / "a3.csv", 1.0);
+    std::string yaml = plateYaml();
+    yaml.replace(yaml.find("      x:"), 0, "      delimiter: ;\n");
+    // Only a1.csv is ';'-separated: read it alone.
+    yaml.replace(yaml.find("[a1.csv, a2.csv, a3.csv]"), 24, "[a1.csv]");
+    write(dir / "experiments.yaml", yaml);
+    const ExperimentSet set = loadExperiments(dir.string());
+    const Curve &c = set.experiments[0].trials[0].curves.at("pressure_Pa");
+    CHECK(c.x == std::vector<double>{0.0, 0.001, 0.004});
+    CHECK(c.y == std::vector<double>{0.0, 1000.0, 4000.0});
+    REQUIRE(set.notes.size() == 1);
+    CHECK_THAT(set.notes[0], Catch::Contains("a1.csv: 2 of 5 rows miss a value") &&
+                                 Catch::Contains("lines 6, 7"));
+    // A word where a number belongs is still refused, with its file and line.
+    write(dir / "a1.csv", "sinkage_mm;pressure_kPa\n0;0\n1;high\n");
+    CHECK_THROWS_WITH(
+        loadExperiments(dir.string()),
+        Catch::Contains("a1.csv:3: column 'pressure_kPa': 'high' is not a finite number"));
+    // The wrong delimiter is named as the likely cause of a column not found.
+    write(dir / "experiments.yaml",
+          plateYaml().replace(plateYaml().find("[a1.csv, a2.csv, a3.csv]"), 24, "[a1.csv]"));
+    CHECK_THROWS_WITH(loadExperiments(dir.string()), Catch::Contains("give data.delimiter"));
+}
+
 TEST_CASE("experiments.yaml: bad input names the file, the key and the line",
           "[gap][experiments]") {
     const fs::path dir = folder("bad");

@@ -81,6 +81,8 @@ struct ExperimentSet {
     std::string name;
     std::string directory;
     std::vector<Experiment> experiments;
+    /// What reading left out and why (samples missing a value), a line each, to be shown.
+    std::vector<std::string> notes;
     const Experiment &find(const std::string &id) const;
 };
 
