@@ -402,7 +402,9 @@ ExperimentSet loadExperiments(const std::string &directory) {
         if (const auto cond = node.optional("conditions")) {
             for (const auto &key : cond->keys()) {
                 const ConfigNode c = (*cond)[key];
-                if (dimensionOf(key) == "dimensionless" && !c.isNumber())
+                // A box or a preparation is a name even when it reads as a number (`box: 1`).
+                const bool label = key == "box" || key == "preparation";
+                if (label || (dimensionOf(key) == "dimensionless" && !c.isNumber()))
                     e.labels[key] = c.text();
                 else
                     e.numbers[key] = c.number();

@@ -213,7 +213,7 @@ TEST_CASE("wheel runs without bins: the last slip is binned, a run on an inner e
 }
 
 TEST_CASE("data files as other tools write them: a byte-order mark, quoted names, another "
-          "delimiter, empty rows and missing values",
+          "delimiter, empty rows, missing values and a box named by a number",
           "[gap][experiments]") {
     const fs::path dir = folder("tools");
     // A spreadsheet's export: BOM, quoted header, ';', a row of empty cells, a blank line, and a
@@ -234,6 +234,11 @@ TEST_CASE("data files as other tools write them: a byte-order mark, quoted names
     REQUIRE(set.notes.size() == 1);
     CHECK_THAT(set.notes[0], Catch::Contains("a1.csv: 2 of 5 rows miss a value") &&
                                  Catch::Contains("lines 6, 7"));
+    // A box named by a number is a name (the base's `boxes: {"1": ...}`, and a group of beds).
+    write(dir / "experiments.yaml", yaml.replace(yaml.find("box: large"), 10, "box: 1"));
+    const ExperimentSet numbered = loadExperiments(dir.string());
+    CHECK(numbered.experiments[0].labels.at("box") == "1");
+    CHECK(numbered.experiments[0].numbers.count("box") == 0);
     // A word where a number belongs is still refused, with its file and line.
     write(dir / "a1.csv", "sinkage_mm;pressure_kPa\n0;0\n1;high\n");
     CHECK_THROWS_WITH(
