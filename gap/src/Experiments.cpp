@@ -215,24 +215,47 @@ std::pair<std::size_t, double> axisColumn(const ConfigNode &node, const Table &t
     return {col, factor * scale};
 }
 
-/// Refuses a plate test that reads as pulled out of the soil: grainlink takes a plate's pressure
-/// as positive and its sinkage as growing into the soil, and a curve with another code's signs
-/// (z up) would otherwise read as an enormous gap. Judged at the most loaded sample, which must
-/// push (pressure > 0) and lie deeper than the first.
-void checkPlateSigns(const Curve &curve, const ConfigNode &data, const std::string &file) {
-    if (curve.y.size() < 2)
+/// Refuses a curve that reads with another code's signs: grainlink takes a plate's pressure and
+/// a shear box's stress as positive, and their sinkage or displacement as growing, and a curve
+/// with z up (or the box pulled the other way) would otherwise read as an enormous gap. Judged
+/// at the most loaded sample, which must push (y > 0) and lie further on than the first.
+void checkSigns(ExperimentType type, const Curve &curve, const ConfigNode &data,
+                const std::string &file) {
+    if (curve.y.size() < 2 ||
+        (type != ExperimentType::PlateSinkage && type != ExperimentType::DirectShear &&
+         type != ExperimentType::BevameterShear))
         return;
+    const bool plate = type == ExperimentType::PlateSinkage;
     std::size_t peak = 0;
     for (std::size_t i = 1; i < curve.y.size(); ++i)
         if (std::abs(curve.y[i]) > std::abs(curve.y[peak]))
             peak = i;
-    const std::string fix = "; grainlink takes a plate's pressure as positive and its sinkage as "
-                            "growing into the soil (add `scale: -1` where this code's axis "
-                            "points up)";
+    const std::string fix =
+        plate ? "; grainlink takes a plate's pressure as positive and its sinkage as growing into "
+                "the soil (add `scale: -1` where this code's axis points up)"
+              : "; grainlink takes the shear stress as positive and the shear displacement as "
+                "growing (add `scale: -1` to a column of the opposite sign)";
     if (curve.y[peak] < 0.0)
-        data["y"].fail(file + ": the largest pressure is negative" + fix);
+        data["y"].fail(file + ": the largest " + (plate ? "pressure" : "shear stress") +
+                       " is negative" + fix);
     if (curve.x[peak] < curve.x.front())
-        data["x"].fail(file + ": the sinkage falls as the plate is loaded" + fix);
+        data["x"].fail(file +
+                       (plate ? ": the sinkage falls as the plate is loaded"
+                              : ": the shear displacement falls as the stress builds") +
+                       fix);
+}
+
+/// Refuses a wheel's sinkage given z up: every run's sinkage at or below zero, one below.
+void checkWheelSinkage(const Experiment &e, const ConfigNode &data) {
+    bool below = false, above = false;
+    for (const Trial &t : e.trials)
+        if (const auto c = t.curves.find("sinkage_m"); c != t.curves.end())
+            for (double y : c->second.y)
+                below = below || y < 0.0, above = above || y > 0.0;
+    if (below && !above)
+        data["y"]["sinkage_m"].fail("every run's sinkage is negative; grainlink takes a wheel's "
+                                    "sinkage as positive into the soil (add `scale: -1` where "
+                                    "this code's axis points up)");
 }
 
 double siValue(const ConfigNode &parent, const std::string &value_key, const std::string &unit_key,
@@ -532,13 +555,14 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     // No row passed the filter: no curve was started at all.
                     if (whole.curves.empty() || whole.curves.begin()->second.empty())
                         f.fail("no rows of " + path.string() + " pass the filter");
-                    if (e.type == ExperimentType::PlateSinkage)
-                        checkPlateSigns(whole.curves.begin()->second, data, path.string());
+                    checkSigns(e.type, whole.curves.begin()->second, data, path.string());
                     e.trials.push_back(std::move(whole));
                 }
             }
             if (e.trials.empty())
                 files.fail("no data: give at least one file (and rows that pass the filter)");
+            if (e.scatter && y.has("sinkage_m"))
+                checkWheelSinkage(e, data);
             if (filter)
                 filter->finish();
             data.finish();

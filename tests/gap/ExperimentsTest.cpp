@@ -329,4 +329,29 @@ TEST_CASE("experiments.yaml: a plate force with z up becomes its pressure", "[ga
           "      y: {force_N: {column: Fz_N, unit: N, scale: -1}}\n");
     CHECK_THROWS_WITH(loadExperiments(dir.string()),
                       Catch::Contains("needs conditions.plate_diameter_m"));
+
+    // A shear box and a wheel from a code whose axes point the other way: refused with the fix
+    // (a shear curve of negative displacement had no bins and was silently not compared; a
+    // negative wheel sinkage read as a gap no effect explains).
+    write(dir / "s1.csv", "dx_mm,tau_kPa\n0,0\n-1,-2\n-2,-3\n-3,-3.2\n");
+    checkRefused(dir,
+                 "experiments:\n  - id: s4\n    type: direct_shear\n"
+                 "    conditions: {normal_stress_Pa: 4000}\n"
+                 "    data:\n      files: [s1.csv]\n      x: {column: dx_mm, unit: mm}\n"
+                 "      y: {shear_stress_Pa: {column: tau_kPa, unit: kPa}}\n",
+                 "the largest shear stress is negative");
+    checkRefused(dir,
+                 "experiments:\n  - id: s4\n    type: direct_shear\n"
+                 "    conditions: {normal_stress_Pa: 4000}\n"
+                 "    data:\n      files: [s1.csv]\n      x: {column: dx_mm, unit: mm}\n"
+                 "      y: {shear_stress_Pa: {column: tau_kPa, unit: kPa, scale: -1}}\n",
+                 "the shear displacement falls");
+    write(dir / "w.csv", "slip,F,z_mm\n0.1,10,-5\n0.3,20,-9\n");
+    checkRefused(
+        dir,
+        "experiments:\n  - id: w\n    type: wheel_steady_state\n"
+        "    data:\n      files: [w.csv]\n      scatter: true\n"
+        "      x: {column: slip, unit: '-'}\n"
+        "      y: {traction_N: {column: F, unit: N}, sinkage_m: {column: z_mm, unit: mm}}\n",
+        "every run's sinkage is negative");
 }
