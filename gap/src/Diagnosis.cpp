@@ -146,25 +146,48 @@ std::vector<std::string> defaultHeldOut(const ExperimentSet &set) {
     std::map<ExperimentType, std::vector<const Experiment *>> by_type;
     for (const Experiment &e : set.experiments)
         by_type[e.type].push_back(&e);
-    std::vector<std::string> held;
-    for (const auto &[type, list] : by_type) {
-        if (list.size() < 2)
-            continue;
-        std::set<std::string> boxes;
+    const auto boxOf = [](const Experiment *e) {
+        return e->labels.count("box") ? e->labels.at("box") : std::string();
+    };
+    // One split per type: `wide` asks for two held-out experiments where the type has three or
+    // more, so that a claim is possible at all.
+    const auto split = [&](const std::vector<const Experiment *> &list, bool wide) {
+        std::map<std::string, int> boxes;
         for (const Experiment *e : list)
-            boxes.insert(e->labels.count("box") ? e->labels.at("box") : "");
+            ++boxes[boxOf(e)];
+        std::string box = boxes.size() >= 2 ? boxes.rbegin()->first : std::string();
+        if (wide && boxes.size() >= 2 && boxes[box] < 2) // the fullest box, the last of a tie
+            for (const auto &[name, count] : boxes)
+                if (count >= boxes[box] && count < int(list.size()))
+                    box = name;
+        std::vector<std::string> held;
         if (boxes.size() >= 2) {
             // A whole box held out: the discrepancy model must carry over to a new container.
-            const std::string last = *boxes.rbegin();
             for (const Experiment *e : list)
-                if ((e->labels.count("box") ? e->labels.at("box") : "") == last)
+                if (boxOf(e) == box)
                     held.push_back(e->id);
-        } else {
-            // Its last half, rounded down: two held-out experiments are the fewest a claim can
-            // rest on (one is one piece of evidence), and the calibration keeps the rest.
-            for (std::size_t i = list.size() - list.size() / 2; i < list.size(); ++i)
-                held.push_back(list[i]->id);
+            return held;
         }
+        // Its last half, rounded down (rounded up where that is needed for two): two held-out
+        // experiments are the fewest a claim can rest on, and the calibration keeps the rest.
+        const std::size_t n = list.size(), half = wide ? std::max<std::size_t>(n / 2, 2) : n / 2;
+        for (std::size_t i = n - half; i < n; ++i)
+            held.push_back(list[i]->id);
+        return held;
+    };
+    std::vector<std::string> held;
+    for (const auto &[type, list] : by_type)
+        if (list.size() >= 2)
+            for (const std::string &id : split(list, false))
+                held.push_back(id);
+    if (held.size() < 2) { // one held-out experiment can carry no claim: widen where possible
+        std::vector<std::string> wider;
+        for (const auto &[type, list] : by_type)
+            if (list.size() >= 2)
+                for (const std::string &id : split(list, list.size() >= 3))
+                    wider.push_back(id);
+        if (wider.size() >= 2)
+            held = wider;
     }
     return held;
 }

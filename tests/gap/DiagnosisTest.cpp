@@ -691,7 +691,8 @@ TEST_CASE("when nothing is claimed the closest by held-out gap and the nearest t
     CHECK(closestCandidates(tied).by_gap->name == "domain_size");
 }
 
-TEST_CASE("the default held-out experiments: the last box, else the last half of a type",
+TEST_CASE("the default held-out experiments: the last box, else the last half of a type, "
+          "widened to two where one would be all",
           "[gap][diagnosis]") {
     const auto set = [](int plates, bool boxes) {
         ExperimentSet s;
@@ -711,9 +712,13 @@ TEST_CASE("the default held-out experiments: the last box, else the last half of
     };
     CHECK(defaultHeldOut(set(4, false)) == std::vector<std::string>{"p2", "p3"});
     CHECK(defaultHeldOut(set(5, false)) == std::vector<std::string>{"p3", "p4"});
-    CHECK(defaultHeldOut(set(3, false)) == std::vector<std::string>{"p2"});
+    // Three plates: the last half rounded down would hold out one, which can carry no claim.
+    CHECK(defaultHeldOut(set(3, false)) == std::vector<std::string>{"p1", "p2"});
+    CHECK(defaultHeldOut(set(2, false)) == std::vector<std::string>{"p1"}); // as much as it can
     CHECK(defaultHeldOut(set(1, false)).empty());
     CHECK(defaultHeldOut(set(5, true)) == std::vector<std::string>{"p2", "p3", "p4"});
+    // Two boxes, the last with one plate: the fuller box is held out instead.
+    CHECK(defaultHeldOut(set(3, true)) == std::vector<std::string>{"p0", "p1"});
 }
 
 TEST_CASE("the self-test scores each twin against its key: claims, weak twins, nulls, effects "
