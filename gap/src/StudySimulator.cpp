@@ -221,6 +221,26 @@ bool close(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::
 
 } // namespace
 
+/// The conditions the lab's test of a type is set up from (besides `box`); any other is
+/// described, not simulated.
+std::vector<std::string> simulatedConditions(ExperimentType type) {
+    switch (type) {
+    case ExperimentType::PlateSinkage:
+        return {"plate_diameter_m"};
+    case ExperimentType::DirectShear:
+        return {"normal_stress_Pa"};
+    case ExperimentType::BevameterShear:
+        return {"normal_pressure_Pa"};
+    case ExperimentType::WheelSteadyState: {
+        std::vector<std::string> keys(std::begin(kWheelConditions), std::end(kWheelConditions));
+        keys.push_back("slip_angle_deg");
+        return keys;
+    }
+    default:
+        return {};
+    }
+}
+
 ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                         std::vector<std::string> &left_out) {
     ExperimentSet out = set;
@@ -231,8 +251,26 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                                typeName(e.type) + ")");
         else if (const std::string why = unsupported(e); !why.empty())
             left_out.push_back(e.id + " (" + typeName(e.type) + ": " + why + ")");
-        else
+        else {
+            // A condition the simulation does not read is said: `wheel_diameter_m` for
+            // `wheel_radius_m` would otherwise leave the base's wheel in silence.
+            const std::vector<std::string> used = simulatedConditions(e.type);
+            std::string unused;
+            for (const auto &[key, value] : e.conditionText())
+                if (key != "box" && std::find(used.begin(), used.end(), key) == used.end())
+                    unused += (unused.empty() ? "" : ", ") + key;
+            if (!unused.empty()) {
+                std::string reads;
+                for (const std::string &k : used)
+                    reads += (reads.empty() ? "" : ", ") + k;
+                out.notes.push_back("experiment '" + e.id +
+                                    "': conditions not simulated (the "
+                                    "base's own stand): " +
+                                    unused + "; a " + typeName(e.type) + " test is set up from " +
+                                    (reads.empty() ? "none" : reads) + " and box");
+            }
             out.experiments.push_back(e);
+        }
     if (out.experiments.empty())
         throw std::invalid_argument(base.path + ": no test in `tests` simulates any experiment of " +
                                     set.directory);

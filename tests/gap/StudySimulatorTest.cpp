@@ -132,6 +132,18 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     REQUIRE(kept.experiments.size() == 2);
     REQUIRE(left_out.size() == 1);
     CHECK(left_out[0].find("smooth_beta30 (wheel_steady_state: slip angle 30") == 0);
+    CHECK(kept.notes.empty()); // every condition of these wheels sets up their test
+    // A condition the simulation does not read is said, with the ones it does: a diameter
+    // given for the radius left the base's wheel in its place without a word.
+    ExperimentSet renamed = set;
+    renamed.experiments = {set.experiments.front()};
+    renamed.experiments[0].numbers.erase("wheel_radius_m");
+    renamed.experiments[0].numbers["wheel_diameter_m"] = 0.116;
+    const ExperimentSet said = simulable(renamed, base, left_out);
+    REQUIRE(said.notes.size() == 1);
+    CHECK_THAT(said.notes[0], Catch::Contains("'smooth_beta0': conditions not simulated") &&
+                                  Catch::Contains("wheel_diameter_m;") &&
+                                  Catch::Contains("wheel_radius_m"));
 
     const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-wheel-test";
     fs::remove_all(scratch);
