@@ -339,7 +339,28 @@ const Experiment &ExperimentSet::find(const std::string &id) const {
     throw std::invalid_argument("no experiment '" + id + "' in " + directory);
 }
 
-Curve applyZero(const Curve &curve, const ZeroConvention &zero) {
+/// How many samples a recorded curve keeps: all, unless it was recorded in time order (x rising
+/// at four in five steps up to its largest x) and then ran back (an unloading, a retraction):
+/// then the loading branch up to its largest x, since the two branches binned together would
+/// read low against a loading-only simulation.
+std::size_t loadingBranch(const Curve &curve) {
+    const std::size_t n = curve.x.size();
+    if (n < 3)
+        return n;
+    const std::size_t peak =
+        std::size_t(std::max_element(curve.x.begin(), curve.x.end()) - curve.x.begin());
+    if (peak + 1 >= n || peak < 2)
+        return n;
+    std::size_t rising = 0;
+    for (std::size_t i = 1; i <= peak; ++i)
+        rising += curve.x[i] > curve.x[i - 1];
+    return 5 * rising >= 4 * peak ? peak + 1 : n;
+}
+
+Curve applyZero(const Curve &recorded, const ZeroConvention &zero) {
+    Curve curve = recorded;
+    curve.x.resize(loadingBranch(recorded));
+    curve.y.resize(curve.x.size());
     std::vector<std::size_t> order(curve.x.size());
     for (std::size_t i = 0; i < order.size(); ++i)
         order[i] = i;

@@ -95,7 +95,8 @@ TEST_CASE("experiments.yaml: repeats in SI, and their mean and scatter per bin",
     CHECK((sim - m.value).cwiseAbs().maxCoeff() < 1e-6);
 }
 
-TEST_CASE("experiments.yaml: a force-threshold zero moves x to the first sample reaching it",
+TEST_CASE("experiments.yaml: a force-threshold zero moves x to the first sample reaching it; an "
+          "unloading branch is left out",
           "[gap][experiments]") {
     // p = 0 until 3 mm, then rises: with a 0.5 kPa threshold the zero is at 3.5 mm.
     Curve c{{0.0, 0.001, 0.002, 0.003, 0.0035, 0.004}, {0.0, 0.0, 0.0, 0.0, 600.0, 1200.0}};
@@ -109,6 +110,20 @@ TEST_CASE("experiments.yaml: a force-threshold zero moves x to the first sample 
     const Curve shifted = applyZero(Curve{{0.002, 0.001, 0.003}, {2.0, 1.0, 3.0}}, z);
     CHECK(shifted.x.front() == 0.0);
     CHECK(shifted.y.front() == 1.0); // sorted by x
+
+    // Loaded to 10 mm (p = z kPa/mm) and unloaded to 8 mm (p falling to 0): the unloading
+    // samples interleaved with the loading ones and halved the deepest bins.
+    Curve cycle;
+    for (int i = 0; i <= 20; ++i)
+        cycle.x.push_back(0.0005 * i), cycle.y.push_back(500.0 * i);
+    for (int i = 1; i <= 4; ++i)
+        cycle.x.push_back(0.010 - 0.0005 * i), cycle.y.push_back(10000.0 * (1.0 - 0.25 * i));
+    const Curve loading = applyZero(cycle, ZeroConvention{});
+    CHECK(loading.x.size() == 21);
+    CHECK(*binMean(loading, 0.008, 0.010) == Approx(9000.0));
+    // A file sorted by x the other way round is no unloading: every sample stays.
+    Curve descending{{0.003, 0.002, 0.001, 0.0}, {3.0, 2.0, 1.0, 0.0}};
+    CHECK(applyZero(descending, ZeroConvention{}).x.size() == 4);
 }
 
 TEST_CASE("experiments.yaml: stated uncertainty and the zero's uncertainty enter u_D",

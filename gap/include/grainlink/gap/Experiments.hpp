@@ -92,7 +92,8 @@ struct ExperimentSet {
 ExperimentSet loadExperiments(const std::string &directory);
 
 /// A curve sorted by x with equal x merged (their mean), then shifted by the zero convention;
-/// used for measured and simulated curves alike.
+/// used for measured and simulated curves alike. A curve recorded in time order that runs back
+/// after its largest x (an unloading) keeps its loading branch only.
 Curve applyZero(const Curve &curve, const ZeroConvention &zero);
 
 /// The SI dimension an observable's name implies by its unit suffix ("pressure_Pa" ->
