@@ -18,14 +18,17 @@ std::optional<double> binMean(const Curve &curve, double a, double b) {
         return std::nullopt;
     if (y.size() == 1) // a scalar's one bin is the point 0; a one-sample curve covers no bin
         return b > a ? std::nullopt : std::optional<double>(y[0]);
-    if (!(b > a) || x.front() > a || x.back() < b)
+    // A curve that starts a little into its first bin (a recording's first sample at 0.2 mm of
+    // a 2.5 mm bin: every CMU plate's first bin was lost) is held at its first value back to
+    // the bin's start; further in, the bin is not covered.
+    if (!(b > a) || x.front() > a + 0.1 * (b - a) || x.back() < b)
         return std::nullopt;
     // Trapezoid rule on the interpolant clipped to [a, b].
     const auto interpolate = [&](std::size_t i, double t) {
         const double w = (t - x[i]) / (x[i + 1] - x[i]);
         return y[i] + w * (y[i + 1] - y[i]);
     };
-    double integral = 0.0;
+    double integral = x.front() > a ? y.front() * (x.front() - a) : 0.0;
     for (std::size_t i = 0; i + 1 < x.size(); ++i) {
         const double lo = std::max(a, x[i]), hi = std::min(b, x[i + 1]);
         if (hi <= lo || x[i + 1] <= x[i])

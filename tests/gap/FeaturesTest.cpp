@@ -38,6 +38,13 @@ TEST_CASE("a bin the curve does not cover has no mean; a scalar is its own value
     CHECK_FALSE(binMean(c, 0.005, 0.02).has_value());
     CHECK_FALSE(binMean(c, -0.001, 0.005).has_value());
     CHECK(*binMean(Curve{{0.0}, {31.5}}, 0.0, 0.0) == 31.5);
+    // A recording whose first sample lies a little into the first bin (the CMU plates: 0.22 mm
+    // of 2.5 mm) covers it, held at its first value back to the bin's start; p = z from 0.2:
+    // (0.2 * 0.2 + (2.5^2 - 0.2^2) / 2) / 2.5 = 1.258, against 1.25 from 0.
+    const Curve late{{0.2, 2.5}, {0.2, 2.5}};
+    REQUIRE(binMean(late, 0.0, 2.5).has_value());
+    CHECK(*binMean(late, 0.0, 2.5) == Approx(1.258).epsilon(1e-9));
+    CHECK_FALSE(binMean(Curve{{0.3, 2.5}, {0.3, 2.5}}, 0.0, 2.5).has_value()); // 12 % in
     // A curve cut to one sample is no curve: it gave its value to every bin.
     CHECK_FALSE(binMean(Curve{{0.004}, {31.5}}, 0.0, 0.002).has_value());
 }

@@ -18,7 +18,8 @@ struct Curve {
 };
 
 /// Mean of the piecewise-linear interpolant of `curve` over [a, b] (the integral over the
-/// range divided by its width); nullopt when the curve's samples do not cover [a, b].
+/// range divided by its width); nullopt when the curve's samples do not cover [a, b]. A curve
+/// starting within a tenth of the width past a is held at its first value back to a.
 /// For a scalar curve (one point) the value itself in the point bin a = b, and nothing in a
 /// bin of some width (a curve cut to one sample covers none).
 std::optional<double> binMean(const Curve &curve, double a, double b);
