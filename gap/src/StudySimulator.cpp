@@ -245,6 +245,9 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                         std::vector<std::string> &left_out) {
     ExperimentSet out = set;
     out.experiments.clear();
+    // A condition the simulation does not read is said, once with its experiments:
+    // `wheel_diameter_m` for `wheel_radius_m` would otherwise leave the base's wheel in silence.
+    std::map<std::string, std::vector<std::string>> unused;
     for (const Experiment &e : set.experiments)
         if (!base.tests.count(typeName(e.type)))
             left_out.push_back(e.id + " (" + typeName(e.type) + ": " + base.path + " has no tests." +
@@ -252,25 +255,24 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
         else if (const std::string why = unsupported(e); !why.empty())
             left_out.push_back(e.id + " (" + typeName(e.type) + ": " + why + ")");
         else {
-            // A condition the simulation does not read is said: `wheel_diameter_m` for
-            // `wheel_radius_m` would otherwise leave the base's wheel in silence.
             const std::vector<std::string> used = simulatedConditions(e.type);
-            std::string unused;
             for (const auto &[key, value] : e.conditionText())
                 if (key != "box" && std::find(used.begin(), used.end(), key) == used.end())
-                    unused += (unused.empty() ? "" : ", ") + key;
-            if (!unused.empty()) {
-                std::string reads;
-                for (const std::string &k : used)
-                    reads += (reads.empty() ? "" : ", ") + k;
-                out.notes.push_back("experiment '" + e.id +
-                                    "': conditions not simulated (the "
-                                    "base's own stand): " +
-                                    unused + "; a " + typeName(e.type) + " test is set up from " +
-                                    (reads.empty() ? "none" : reads) + " and box");
-            }
+                    unused[key].push_back(e.id);
             out.experiments.push_back(e);
         }
+    for (const auto &[key, ids] : unused) {
+        std::string list;
+        for (std::size_t i = 0; i < ids.size() && i < 4; ++i)
+            list += (i ? ", " : "") + ids[i];
+        out.notes.push_back("condition '" + key +
+                            "' is not simulated (the base's own value stands) in " + list +
+                            (ids.size() > 4 ? ", ..." : "") + " (" + std::to_string(ids.size()) +
+                            (ids.size() == 1 ? " experiment" : " experiments") +
+                            "; the tests are set up from plate_diameter_m, normal_stress_Pa, "
+                            "normal_pressure_Pa, the wheel's radius, width, grouser count and "
+                            "height, load_N, slip_angle_deg, and box)");
+    }
     if (out.experiments.empty())
         throw std::invalid_argument(base.path + ": no test in `tests` simulates any experiment of " +
                                     set.directory);

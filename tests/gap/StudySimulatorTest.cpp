@@ -141,9 +141,9 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     renamed.experiments[0].numbers["wheel_diameter_m"] = 0.116;
     const ExperimentSet said = simulable(renamed, base, left_out);
     REQUIRE(said.notes.size() == 1);
-    CHECK_THAT(said.notes[0], Catch::Contains("'smooth_beta0': conditions not simulated") &&
-                                  Catch::Contains("wheel_diameter_m;") &&
-                                  Catch::Contains("wheel_radius_m"));
+    CHECK_THAT(said.notes[0], Catch::Contains("condition 'wheel_diameter_m' is not simulated") &&
+                                  Catch::Contains("in smooth_beta0 (1 experiment") &&
+                                  Catch::Contains("radius"));
 
     const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-wheel-test";
     fs::remove_all(scratch);
