@@ -798,11 +798,16 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 std::string which;
                 for (const CandidateResult &R : D.candidates)
                     if (R.explains)
-                        which += (which.empty() ? "" : ", ") + R.name;
-                claim << which << " beat" << (which.find(',') == std::string::npos ? "s" : "")
-                      << " the null model and leave"
-                      << (which.find(',') == std::string::npos ? "s" : "") << " no gap, but "
-                      << best_no_gap->name
+                        which += (which.empty() ? "" : ", ") + R.name + " (" +
+                                 strengthText(R.effect, R.fit.strength) + ", held-out gap " +
+                                 fmt(100.0 * R.held_out.gap, 2) +
+                                 " %, p = " + fmt(R.versus_null.p_value, 2) + ")";
+                const auto explaining =
+                    std::count_if(D.candidates.begin(), D.candidates.end(),
+                                  [](const CandidateResult &R) { return R.explains; });
+                const char *verb_s = explaining == 1 ? "s" : "";
+                claim << which << " beat" << verb_s << " the null model and leave" << verb_s
+                      << " no gap, but " << best_no_gap->name
                       << " predicts the held-out experiments better still and is not claimable ("
                       << (best_no_gap->fit.at_prior_edge
                               ? std::string("at its prior's edge")
