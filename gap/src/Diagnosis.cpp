@@ -222,14 +222,24 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     const ValidationResult &V = D.validation;
     // Nothing compared is no evidence of agreement: a diagnosis whose base runs all failed, or
     // reached none of the measured range, stops here instead of reporting "no gap".
+    // One compared only in part (its runs stop short of some measured bins) is named with how
+    // much: the gap test and the fits see only the rest.
     for (const Experiment &e : set.experiments) {
-        bool any = false;
+        int measured = 0, compared = 0;
         if (const auto it = design.by_experiment.find(e.id); it != design.by_experiment.end())
-            for (Eigen::Index k : it->second)
-                any = any || std::isfinite(V.standardised[k]);
-        if (!any)
+            for (Eigen::Index k : it->second) {
+                measured += std::isfinite(meas.value[k]);
+                compared += std::isfinite(V.standardised[k]);
+            }
+        if (compared == 0)
             D.not_compared.push_back(e.id);
+        else if (compared < measured)
+            D.partly_compared.push_back(e.id + " (" + std::to_string(measured - compared) + " of " +
+                                        std::to_string(measured) + " measured bins)");
     }
+    if (!D.partly_compared.empty())
+        log("compared in part (no simulated value in some measured bins): " +
+            joined(D.partly_compared));
     if (D.not_compared.size() == set.experiments.size())
         throw std::runtime_error(
             "no experiment could be compared with the base model: its simulations failed or "
@@ -310,9 +320,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     D.null_variance = null_var;
 
     const auto notCompared = [&] {
-        return D.not_compared.empty()
-                   ? std::string()
-                   : "; not compared (no simulated feature): " + joined(D.not_compared);
+        return (D.not_compared.empty()
+                    ? std::string()
+                    : "; not compared (no simulated feature): " + joined(D.not_compared)) +
+               (D.partly_compared.empty()
+                    ? std::string()
+                    : "; compared in part (no simulated value): " + joined(D.partly_compared));
     };
     D.numerical_warning = numericalWarning(V);
     if (!D.numerical_warning.empty())

@@ -79,6 +79,8 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     j["version"] = 1;
     j["measurements"] = set.name;
     j["measurement_notes"] = set.notes;
+    j["not_compared"] = d.not_compared;
+    j["partly_compared"] = d.partly_compared;
     j["outcome"] = outcomeName(d.outcome);
     j["claim"] = d.claim;
     j["numerical_warning"] = d.numerical_warning;

@@ -115,6 +115,8 @@ struct Diagnosis {
     /// Experiments with no simulated feature to compare (their runs failed or fell short):
     /// named in the claim, never counted as agreeing.
     std::vector<std::string> not_compared;
+    /// Experiments compared in some measured bins only ("id (k of n measured bins)"): named too.
+    std::vector<std::string> partly_compared;
     HeldOutScore held_out_base;  ///< the base model on the held-out features
     HeldOutScore held_out_null;  ///< base + the fitted discrepancy
     Eigen::VectorXd null_mean, null_variance; ///< the null model's prediction (held-out features)
