@@ -543,19 +543,20 @@ ExperimentSet loadExperiments(const std::string &directory) {
                                    std::abs(table.number(r, c) - v) <= 1e-9 * (1 + std::abs(v));
                     if (!selected)
                         continue;
-                    bool gap = table.missing(r, xcol);
+                    // No x: the row gives nothing; no y: that observable's sample is left out.
+                    const bool no_x = table.missing(r, xcol);
+                    bool gap = no_x;
+                    const double x = no_x ? 0.0 : table.number(r, xcol) * xfac;
                     Trial t;
                     t.source = path.string() + ":" + std::to_string(table.lines[r]);
                     for (const auto &[o, c, fac] : ycols) {
-                        if (gap || table.missing(r, c)) {
+                        if (no_x || table.missing(r, c)) {
                             gap = true;
                             continue;
                         }
-                        const double x = table.number(r, xcol) * xfac;
-                        const double y = table.number(r, c) * fac;
                         Curve &curve = e.scatter ? t.curves[o] : whole.curves[o];
                         curve.x.push_back(x);
-                        curve.y.push_back(y);
+                        curve.y.push_back(table.number(r, c) * fac);
                     }
                     if (gap)
                         gaps.push_back(table.lines[r]);

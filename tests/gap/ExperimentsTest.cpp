@@ -249,6 +249,17 @@ TEST_CASE("data files as other tools write them: a byte-order mark, quoted names
     REQUIRE(set.notes.size() == 1);
     CHECK_THAT(set.notes[0], Catch::Contains("a1.csv: 2 of 5 rows miss a value") &&
                                  Catch::Contains("lines 6, 7"));
+    // A wheel run without its sinkage keeps its traction, whichever column comes first.
+    write(dir / "w.csv", "slip,S,F\n0.1,,10\n0.3,9,20\n");
+    write(dir / "experiments.yaml",
+          "experiments:\n  - id: w\n    type: wheel_steady_state\n"
+          "    data:\n      files: [w.csv]\n      scatter: true\n"
+          "      x: {column: slip, unit: '-'}\n"
+          "      y: {sinkage_m: {column: S, unit: mm}, traction_N: {column: F, unit: N}}\n");
+    const ExperimentSet wheel = loadExperiments(dir.string());
+    REQUIRE(wheel.experiments[0].trials.size() == 2);
+    CHECK(wheel.experiments[0].trials[0].curves.count("traction_N") == 1);
+    CHECK(wheel.experiments[0].trials[0].curves.count("sinkage_m") == 0);
     // A box named by a number is a name (the base's `boxes: {"1": ...}`, and a group of beds).
     write(dir / "experiments.yaml", yaml.replace(yaml.find("box: large"), 10, "box: 1"));
     const ExperimentSet numbered = loadExperiments(dir.string());
