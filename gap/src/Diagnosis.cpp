@@ -809,15 +809,13 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 // held-out experiments better still without being claimable: not told apart.
                 claim << "unexplained: ";
                 std::string which;
+                int explaining = 0;
                 for (const CandidateResult &R : D.candidates)
                     if (R.explains)
-                        which += (which.empty() ? "" : ", ") + R.name + " (" +
+                        which += (explaining++ ? ", " : "") + R.name + " (" +
                                  strengthText(R.effect, R.fit.strength) + ", held-out gap " +
                                  fmt(100.0 * R.held_out.gap, 2) +
                                  " %, p = " + fmt(R.versus_null.p_value, 2) + ")";
-                const auto explaining =
-                    std::count_if(D.candidates.begin(), D.candidates.end(),
-                                  [](const CandidateResult &R) { return R.explains; });
                 const char *verb_s = explaining == 1 ? "s" : "";
                 claim << which << " beat" << verb_s << " the null model and leave" << verb_s
                       << " no gap, but " << best_no_gap->name
@@ -955,8 +953,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         std::ostringstream also;
         also << "; these experiments do not tell it from";
         for (const Diagnosis::Rival &r : D.rivals)
-            if (std::find(D.indistinguishable.begin(), D.indistinguishable.end(), r.name) !=
-                D.indistinguishable.end())
+            if (!(r.p_value < opt.alpha)) // the ones put in `indistinguishable` above
                 also << ' ' << r.name << " (p = " << fmt(r.p_value, 2)
                      << (r.at_prior_edge ? ", at its prior's edge" : "") << ')';
         if (!D.separating_experiment.empty())
