@@ -379,7 +379,7 @@ compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_m
                  const Eigen::VectorXd &model_variance, const Eigen::VectorXd &null_mean,
                  const Eigen::VectorXd &null_variance, const FeatureSet &use,
                  const std::vector<FeatureKey> &bed_keys,
-                 const std::vector<FeatureKey> &experiment_keys, const LeaveOneSeedOut &jackknife) {
+                 const std::vector<FeatureKey> &experiment_keys, const SharedLuck &shared) {
     const auto gains = [&](const Eigen::VectorXd &model, const Eigen::VectorXd &null) {
         Eigen::VectorXd gain = Eigen::VectorXd::Constant(measured.size(), kNaN);
         for (Eigen::Index k : use) {
@@ -395,25 +395,26 @@ compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_m
     for (Eigen::Index k : use)
         if (std::isfinite(gain[k]))
             scored.push_back(k);
-    ClusteredMean g = clusteredMean(gain, scored, bed_keys);
+    const std::size_t seeds =
+        shared.null_mean.size() == shared.model_mean.size() ? shared.model_mean.size() : 0;
+    const bool per_experiment = seeds >= 2 && !experiment_keys.empty();
+    ClusteredMean g = clusteredMean(gain, scored, per_experiment ? experiment_keys : bed_keys);
     DensityComparison c;
     c.features = g.values;
     c.experiments = g.experiments;
     c.mean_gain = g.mean;
     c.gain_correlation = g.icc;
-    const std::size_t seeds =
-        jackknife.null_mean.size() == jackknife.model_mean.size() ? jackknife.model_mean.size() : 0;
+    c.per_experiment = per_experiment;
     if (!canCarryClaim(scored, bed_keys, experiment_keys, seeds))
         return c; // one piece of evidence cannot tell a better model from luck: p = 1
     double variance = g.variance, dof = g.dof;
-    if (g.experiments == 1) {
-        // One group of beds: its experiments' spread, plus how far the mean gain moves when
-        // one of the model's beds is left out (the jackknife: (S - 1)/S sum (g_j - g.)^2).
-        g = clusteredMean(gain, use, experiment_keys);
+    if (per_experiment) {
+        // The model's own bed draw: how far the mean gain moves when one of its beds is left
+        // out (the jackknife: (S - 1)/S sum (g_j - g.)^2).
         std::vector<double> left_out;
         for (std::size_t j = 0; j < seeds; ++j)
-            left_out.push_back(clusteredMean(gains(jackknife.model_mean[j], jackknife.null_mean[j]),
-                                             use, experiment_keys)
+            left_out.push_back(clusteredMean(gains(shared.model_mean[j], shared.null_mean[j]),
+                                             scored, experiment_keys)
                                    .mean);
         double centre = 0.0, spread = 0.0;
         for (double x : left_out)
@@ -421,12 +422,21 @@ compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_m
         for (double x : left_out)
             spread += (x - centre) * (x - centre);
         c.seed_variance = spread * double(seeds - 1) / double(seeds);
-        c.one_group = true;
-        c.experiments = g.experiments;
-        c.gain_correlation = g.icc;
-        const double a = g.variance, b = c.seed_variance;
-        variance = a + b;
-        const double den = (g.dof > 0.0 ? a * a / g.dof : 0.0) + b * b / double(seeds - 1);
+        // The measured beds' luck, one shift per group of beds: d gain / d y times its scatter.
+        std::map<std::string, double> shift;
+        if (shared.measured_sd.size() == measured.size())
+            for (Eigen::Index k : scored) {
+                const double d_gain = (measured[k] - null_mean[k]) / null_variance[k] -
+                                      (measured[k] - model_mean[k]) / model_variance[k];
+                if (std::isfinite(shared.measured_sd[k]))
+                    shift[bed_keys[std::size_t(k)].experiment] += d_gain * shared.measured_sd[k];
+            }
+        for (const auto &[group, s] : shift)
+            c.measured_variance += s * s / (double(g.values) * double(g.values));
+        const double a = g.variance, b = c.seed_variance, m = c.measured_variance;
+        variance = a + b + m;
+        const double den = (g.dof > 0.0 ? a * a / g.dof : 0.0) + b * b / double(seeds - 1) +
+                           (shared.measured_dof > 0.0 ? m * m / shared.measured_dof : 0.0);
         dof = den > 0.0 ? variance * variance / den : 0.0;
     }
     // Gains without any spread cannot tell a better model from luck either (p = 1; the t test

@@ -45,11 +45,12 @@ std::pair<Eigen::VectorXd, Eigen::VectorXd> meanAndVariance(const Eigen::MatrixX
 
 /// A model's and the null's means with seed j left out, j over the seeds both have (seed j
 /// of both is one bed: common random numbers). The null is the base times its discrepancy
-/// factor (`null_mean / base_mean`), the factor held at its fit to all seeds.
-LeaveOneSeedOut leaveOneSeedOut(const Eigen::MatrixXd &model_rows, const Eigen::MatrixXd &base_rows,
-                                const Eigen::VectorXd &base_mean,
-                                const Eigen::VectorXd &null_mean) {
-    LeaveOneSeedOut out;
+/// factor (`null_mean / base_mean`), the factor held at its fit to all seeds. The measured
+/// side's shared luck comes with them (`measured`).
+SharedLuck leaveOneSeedOut(const Eigen::MatrixXd &model_rows, const Eigen::MatrixXd &base_rows,
+                           const Eigen::VectorXd &base_mean, const Eigen::VectorXd &null_mean,
+                           const SharedLuck &measured) {
+    SharedLuck out = measured;
     const Eigen::Index seeds = std::min(model_rows.rows(), base_rows.rows());
     if (seeds < 2)
         return out;
@@ -288,6 +289,22 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     std::vector<FeatureKey> bed_keys = meas.keys;
     for (FeatureKey &key : bed_keys)
         key.experiment = simulator.bedGroup(set.find(key.experiment));
+    // What the measured beds of a group may share: a mean's scatter over rebuilt beds, or one
+    // simulated bed's where the measurement has no such repeats (`SharedLuck`).
+    SharedLuck measured_luck;
+    measured_luck.measured_sd = V.u_bed;
+    measured_luck.measured_dof = std::numeric_limits<double>::infinity();
+    for (Eigen::Index k : D.held_out) {
+        const bool repeats = meas.from_repeats[std::size_t(k)];
+        if (repeats)
+            measured_luck.measured_sd[k] = meas.u_repeats[k];
+        if (measured_luck.measured_sd[k] > 0.0)
+            measured_luck.measured_dof =
+                std::min(measured_luck.measured_dof,
+                         double(repeats ? meas.trials[k] - 1 : base_rows.rows() - 1));
+    }
+    if (!std::isfinite(measured_luck.measured_dof))
+        measured_luck.measured_dof = 0.0;
 
     // The null model: the base plus a discrepancy fitted on the calibration features.
     std::vector<bool> in_calibration(std::size_t(n), false);
@@ -542,9 +559,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const Eigen::VectorXd var = u2_fixed + mv.second;
         const Eigen::VectorXd predictive = predictiveVariance(rows, strength_var);
         score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);
-        versus_null = compareDensities(meas.value, mean, predictive, null_mean, null_var,
-                                       D.held_out, bed_keys, meas.keys,
-                                       leaveOneSeedOut(rows, base_rows, V.simulated, null_mean));
+        versus_null = compareDensities(
+            meas.value, mean, predictive, null_mean, null_var, D.held_out, bed_keys, meas.keys,
+            leaveOneSeedOut(rows, base_rows, V.simulated, null_mean, measured_luck));
         z = (meas.value - mean).array() / var.array().sqrt();
         for (Eigen::Index k = 0; k < z.size(); ++k)
             z[k] = normalEquivalent(z[k], V.dof[k]);
@@ -770,7 +787,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             const DensityComparison c = compareDensities(
                 meas.value, W->result.confirmed_mean, W->predictive_variance, rival,
                 L.predictive_variance, D.held_out, bed_keys, meas.keys,
-                leaveOneSeedOut(W->confirmed_rows, L.confirmed_rows, rival, rival));
+                leaveOneSeedOut(W->confirmed_rows, L.confirmed_rows, rival, rival, measured_luck));
             D.rivals.push_back({R.name, c.p_value, R.fit.at_prior_edge});
             if (!(c.p_value < opt.alpha))
                 D.indistinguishable.push_back(R.name);

@@ -30,9 +30,10 @@ Json gain(const DensityComparison &c) {
     return {{"mean_per_feature", number(c.mean_gain)},
             {"features", c.features},
             {"experiments", c.experiments},
-            {"counted_by", c.one_group ? "experiment, one group of beds" : "group of beds"},
+            {"counted_by", c.per_experiment ? "experiment, shared luck measured" : "group of beds"},
             {"share_between_experiments", number(c.gain_correlation)},
-            {"seed_jackknife_variance", number(c.seed_variance)}};
+            {"seed_jackknife_variance", number(c.seed_variance)},
+            {"measured_shared_variance", number(c.measured_variance)}};
 }
 
 Json verdict(const GapVerdict &g) {

@@ -300,14 +300,14 @@ TEST_CASE("one group of beds held out: judged per experiment with the model's ow
         return keys;
     };
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(4), unit = Eigen::VectorXd::Ones(4);
-    LeaveOneSeedOut hand;
+    SharedLuck hand;
     for (double c : {0.0, 1.0, 2.0}) {
         hand.model_mean.push_back(Eigen::VectorXd::Constant(4, c));
         hand.null_mean.push_back(zero);
     }
     const auto h = compareDensities(zero, Eigen::VectorXd::Constant(4, 0.1), unit, zero, unit,
                                     all(4), one_group(2, 2), blockKeys(2, 2), hand);
-    CHECK(h.one_group);
+    CHECK(h.per_experiment);
     CHECK(h.experiments == 2);
     CHECK(h.seed_variance == Approx(2.0 / 3.0 * 13.0 / 6.0).epsilon(1e-12));
     // Without the jackknife one group is one piece of evidence.
@@ -344,7 +344,7 @@ TEST_CASE("one group of beds held out: judged per experiment with the model's ow
                     base(s, k) = null_shift + base_bed + feature_sd * z(rng);
                 }
             }
-            LeaveOneSeedOut jack;
+            SharedLuck jack;
             for (int j = 0; j < S; ++j) {
                 Eigen::VectorXd m = Eigen::VectorXd::Zero(n), b = Eigen::VectorXd::Zero(n);
                 for (int s = 0; s < S; ++s)
@@ -378,6 +378,106 @@ TEST_CASE("one group of beds held out: judged per experiment with the model's ow
     const Rates power = claimRate(0.05, 0.1, 0.1, 0.2, 0.09, 0.5, 0.05 / 3.0, 2000);
     INFO("power " << power.jackknife);
     CHECK(power.jackknife > 0.3);
+}
+
+TEST_CASE("the measured beds' shared luck, carried through the gain, holds the level where the "
+          "held-out plates share their measured beds, and a right model is still found",
+          "[gap][attribution]") {
+    const auto groups = [](int experiments, int each, int per_group) {
+        std::vector<FeatureKey> keys = blockKeys(experiments, each);
+        for (std::size_t k = 0; k < keys.size(); ++k)
+            keys[k].experiment = "box" + std::to_string(int(k) / (each * per_group));
+        return keys;
+    };
+    // Hand numbers: measured 0, model 0, null 1, unit variances: d gain / d y = (y - null) -
+    // (y - model) = -1 on each of four features, sd 0.5: one group shifts the summed gain by
+    // -2 (variance 4 / 4^2), two groups of two by -1 each (2 / 4^2).
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(4), unit = Eigen::VectorXd::Ones(4);
+    SharedLuck hand;
+    for (int j = 0; j < 3; ++j) {
+        hand.model_mean.push_back(zero);
+        hand.null_mean.push_back(unit);
+    }
+    hand.measured_sd = Eigen::VectorXd::Constant(4, 0.5);
+    const auto in = [&](const std::vector<FeatureKey> &beds) {
+        return compareDensities(zero, zero, unit, unit, unit, all(4), beds, blockKeys(2, 2), hand);
+    };
+    CHECK(in(groups(2, 2, 2)).measured_variance == Approx(0.25).epsilon(1e-12));
+    CHECK(in(groups(2, 2, 1)).measured_variance == Approx(0.125).epsilon(1e-12));
+
+    // Three plates measured on the same three beds (trial t of every plate on bed t, whose
+    // luck, sd `luck`, moves all of them: as a twin's are), features of noise sd 0.3. The
+    // model predicts +c, the null -c, each from three beds of little luck: equally right on
+    // average, and the gain 2 c y / v moves with the measured beds. Judged per plate with the
+    // model's seeds jackknifed, the test claimed 27 % of the time at 5 %; with the measured
+    // beds' luck carried through it holds the level.
+    std::mt19937 rng(17);
+    std::normal_distribution<double> z;
+    const int E = 3, K = 6, T = 3, S = 3, n = E * K;
+    struct Rates {
+        double with = 0.0, without = 0.0;
+    };
+    const auto claimRate = [&](double luck, double c, double truth, int per_group, int draws) {
+        Rates r;
+        const auto beds = groups(E, K, per_group);
+        for (int d = 0; d < draws; ++d) {
+            Eigen::MatrixXd trials(T, n);
+            for (int t = 0; t < T; ++t) {
+                Eigen::VectorXd bed(E);
+                for (int e = 0; e < E; ++e)
+                    bed[e] = luck * z(rng);
+                for (int k = 0; k < n; ++k)
+                    trials(t, k) = truth + bed[per_group == E ? 0 : k / K] + 0.3 * z(rng);
+            }
+            const Eigen::VectorXd y = trials.colwise().mean().transpose();
+            SharedLuck shared;
+            shared.measured_sd =
+                ((trials.rowwise() - y.transpose()).array().square().colwise().sum() /
+                 double(T - 1))
+                    .sqrt()
+                    .transpose() /
+                std::sqrt(double(T));
+            shared.measured_dof = T - 1;
+            Eigen::VectorXd mm = Eigen::VectorXd::Zero(n), bm = Eigen::VectorXd::Zero(n);
+            Eigen::MatrixXd model(S, n), base(S, n);
+            for (int s = 0; s < S; ++s)
+                for (int k = 0; k < n; ++k) {
+                    model(s, k) = c + 0.05 * z(rng);
+                    base(s, k) = -c + 0.05 * z(rng);
+                }
+            for (int j = 0; j < S; ++j) {
+                Eigen::VectorXd m = Eigen::VectorXd::Zero(n), b = Eigen::VectorXd::Zero(n);
+                for (int s = 0; s < S; ++s)
+                    if (s != j) {
+                        m += model.row(s).transpose() / double(S - 1);
+                        b += base.row(s).transpose() / double(S - 1);
+                    }
+                shared.model_mean.push_back(m);
+                shared.null_mean.push_back(b);
+            }
+            mm = model.colwise().mean().transpose();
+            bm = base.colwise().mean().transpose();
+            const Eigen::VectorXd var = Eigen::VectorXd::Constant(n, 0.25);
+            r.with += compareDensities(y, mm, var, bm, var, all(n), beds, blockKeys(E, K), shared)
+                          .p_value < 0.05;
+            SharedLuck seeds_only = shared;
+            seeds_only.measured_sd.resize(0);
+            r.without +=
+                compareDensities(y, mm, var, bm, var, all(n), beds, blockKeys(E, K), seeds_only)
+                    .p_value < 0.05;
+        }
+        r.with /= draws;
+        r.without /= draws;
+        return r;
+    };
+    const Rates lucky = claimRate(0.3, 0.3, 0.0, E, 2000);
+    INFO("shared measured luck: claims " << lucky.with << " (without it " << lucky.without << ")");
+    CHECK(lucky.without > 0.1);
+    CHECK(lucky.with < 0.05);
+    // The model right, the null 0.3 off, each plate on beds of its own: found nearly always.
+    const Rates power = claimRate(0.05, 0.3, 0.3, 1, 500);
+    INFO("power " << power.with);
+    CHECK(power.with > 0.8);
 }
 
 TEST_CASE("a feature the response lacks at some strengths is taken at the base at all of them",

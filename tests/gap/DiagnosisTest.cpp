@@ -559,8 +559,8 @@ TEST_CASE("diagnosis: held-out plates that the model presses into the same beds 
           "per plate with those beds' luck measured",
           "[gap][diagnosis]") {
     // The simulator says the plates of a box share their beds (grainlink's packing cache does)
-    // and draws them so: the four plates of the small box held out are one group, judged per
-    // plate with the seed jackknife; held out across both boxes they are two groups.
+    // and draws them so: the four plates of the small box held out are one group, and two
+    // plates of each box two groups; either is judged per plate with the seed jackknife.
     const EffectCatalogue c = shippedEffects();
     AnalyticSimulator sim;
     sim.beds_by_box = true;
@@ -573,7 +573,7 @@ TEST_CASE("diagnosis: held-out plates that the model presses into the same beds 
     for (const CandidateResult &r : one.candidates)
         if (r.confirmed) {
             ++confirmed;
-            CHECK(r.versus_null.one_group);
+            CHECK(r.versus_null.per_experiment);
             CHECK(r.versus_null.experiments == 4);
             CHECK(r.versus_null.seed_variance > 0.0);
         }
@@ -584,9 +584,12 @@ TEST_CASE("diagnosis: held-out plates that the model presses into the same beds 
         diagnose(measuredSet({"cohesion", 4.0e4}, 7), c.diagnosable(), sim, analyticOptions());
     for (const CandidateResult &r : two.candidates)
         if (r.confirmed) {
-            CHECK_FALSE(r.versus_null.one_group);
-            CHECK(r.versus_null.experiments == 2);
+            CHECK(r.versus_null.per_experiment);
+            CHECK(r.versus_null.experiments == 4);
+            CHECK(r.versus_null.seed_variance > 0.0);
+            CHECK(r.versus_null.measured_variance > 0.0);
         }
+    CHECK(two.explained_by == "cohesion");
 }
 
 namespace {

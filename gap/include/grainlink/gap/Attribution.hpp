@@ -153,31 +153,40 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
                           const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_val,
                           const FeatureSet &use);
 
-/// The model's and the null's held-out predictions with one bed realisation left out in turn
-/// (seed j of both: common random numbers), for the jackknife of the model's own bed draw.
-struct LeaveOneSeedOut {
+/// What the held-out experiments of one group of beds share beyond their own scatter, for
+/// `compareDensities`: the model's and the null's predictions with one simulated bed left out
+/// in turn (seed j of both: common random numbers), and each measured mean's bed-to-bed
+/// scatter (`measured_sd`: its repeats' on rebuilt beds, else one simulated bed's), whose luck
+/// is taken to move every experiment of its group at once (as the beds of a twin do), with the
+/// degrees of freedom of that scatter.
+struct SharedLuck {
     std::vector<Eigen::VectorXd> model_mean, null_mean;
+    Eigen::VectorXd measured_sd; ///< empty: the measured values share nothing
+    double measured_dof = 0.0;   ///< 0: the scatter is exact
 };
 
 /// Sample-split test that a model predicts held-out features better than the null, by the log
 /// predictive density (a proper score: a model gains nothing by widening its spread, nor by
 /// a confident miss): the per-feature differences of log density, their mean, and the
 /// one-sided p of a t test that it is > 0.
-/// With two or more groups of beds held out (`bed_keys`), the mean's variance is that over
-/// groups whose gains may move together (`clusteredMean`). With one group, its experiments
-/// vary independently only on the measuring side; what they share is the model's (and the
-/// null's) few simulated beds, whose luck lifts every experiment at once: the variance is the
-/// clustered one over its experiments (`experiment_keys`) plus the seed jackknife of the mean
-/// gain (`jackknife`), with Welch-Satterthwaite degrees of freedom. p = 1 with one held-out
-/// experiment, one group and no jackknife, or gains without spread.
+/// Where the model was simulated on two or more beds (`shared.model_mean`), the held-out
+/// experiments (`experiment_keys`) are counted one by one and what each group of beds
+/// (`bed_keys`) shares is measured instead of counted: the variance is the clustered one over
+/// experiments, plus the seed jackknife of the mean gain, plus the measured beds' luck carried
+/// through the gain (d gain / d y times `measured_sd`, summed over a group), with
+/// Welch-Satterthwaite degrees of freedom. Without a jackknife the variance is that over
+/// groups of beds whose gains may move together (`clusteredMean`); two groups give a t of one
+/// degree of freedom, under which no gain could be claimed at the levels used. p = 1 with one
+/// held-out experiment, one group and no jackknife, or gains without spread.
 struct DensityComparison {
     double mean_gain = 0.0; ///< mean log-density gain per feature (model - null)
     double p_value = 1.0;
     int features = 0;
-    int experiments = 0; ///< held-out groups of beds (or experiments in the one group) with a gain
+    int experiments = 0; ///< held-out experiments (or groups of beds, without a jackknife)
     double gain_correlation = 0.0; ///< the share of the gains' variance between them
-    double seed_variance = 0.0;    ///< one group: the jackknife variance of the mean gain
-    bool one_group = false;        ///< one group of beds held out, judged as above
+    double seed_variance = 0.0;    ///< the jackknife variance of the mean gain
+    double measured_variance = 0.0; ///< the measured beds' shared luck in the mean gain
+    bool per_experiment = false;    ///< counted per experiment, the shared luck measured
 };
 /// Whether held-out features can be evidence for a claim at all (`compareDensities` gives
 /// p < 1 only then): two or more groups of beds, or one group of two or more experiments
@@ -193,6 +202,6 @@ DensityComparison compareDensities(const Eigen::VectorXd &measured,
                                    const Eigen::VectorXd &null_variance, const FeatureSet &use,
                                    const std::vector<FeatureKey> &bed_keys,
                                    const std::vector<FeatureKey> &experiment_keys = {},
-                                   const LeaveOneSeedOut &jackknife = {});
+                                   const SharedLuck &shared = {});
 
 } // namespace grainlink::gap
