@@ -72,6 +72,55 @@ SharedLuck leaveOneSeedOut(const Eigen::MatrixXd &model_rows, const Eigen::Matri
     return out;
 }
 
+} // namespace
+
+ProbeSeparation probeSeparation(const std::vector<Eigen::MatrixXd> &rows) {
+    ProbeSeparation p;
+    if (rows.empty())
+        return p;
+    PooledScatter pool(rows[0].cols());
+    for (const auto &r : rows)
+        pool.add(r);
+    const Eigen::VectorXd sd = pool.sd(Eigen::VectorXd::Constant(rows[0].cols(), kNaN));
+    std::vector<Eigen::VectorXd> var;
+    for (const auto &r : rows) {
+        auto [mean, v] = meanAndVariance(r, sd);
+        p.mean.push_back(mean);
+        p.sd.push_back(v.array().sqrt().matrix());
+        var.push_back(v);
+    }
+    p.chi2 = Eigen::VectorXd::Zero(rows[0].cols());
+    for (std::size_t a = 1; a < rows.size(); ++a)
+        for (std::size_t b = a + 1; b < rows.size(); ++b)
+            for (Eigen::Index k = 0; k < p.chi2.size(); ++k) {
+                const double d = p.mean[a][k] - p.mean[b][k];
+                const double v = var[a][k] + var[b][k] + var[0][k];
+                if (std::isfinite(d) && v > 0.0)
+                    p.chi2[k] += d * d / v;
+            }
+    return p;
+}
+
+namespace {
+
+/// A feature in words: "shear_stress_Pa at shear displacement 10-12 mm (normal_stress_Pa
+/// 10000)", or a scalar's observable alone.
+std::string featureText(const ExperimentSet &set, const FeatureKey &key) {
+    std::ostringstream t;
+    t << key.observable;
+    const auto axes = axisLabels(set);
+    if (const auto a = axes.find(key.kind); !key.scalar() && a != axes.end())
+        t << " at " << a->second.name << ' ' << fmt(key.x_lo * a->second.scale) << "-"
+          << fmt(key.x_hi * a->second.scale) << (a->second.unit.empty() ? "" : " ")
+          << a->second.unit;
+    std::string conditions;
+    for (const auto &[name, value] : set.find(key.experiment).conditionText())
+        conditions += (conditions.empty() ? "" : ", ") + name + " " + value;
+    if (!conditions.empty())
+        t << " (" << conditions << ')';
+    return t.str();
+}
+
 std::string joined(const std::vector<std::string> &items) {
     std::string list;
     for (const auto &item : items)
@@ -926,8 +975,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         double best_sep = -1.0;
         for (const ExperimentSet &probe : simulator.probes(set)) {
             const FeatureDesign pd = designFeatures(probe);
-            std::vector<VariantRequest> req{{"probe base", nullptr, 0.0, nullptr, 0.0, "", opt.signature_seeds}};
-            std::vector<std::string> names{leader};
+            // Two beds at least: the separation is measured against the probe's own scatter.
+            const int probe_seeds = std::max(2, opt.signature_seeds);
+            std::vector<VariantRequest> req{
+                {"probe base", nullptr, 0.0, nullptr, 0.0, "", probe_seeds}};
+            std::vector<std::string> names{leader}, model_names{"base"};
             for (const auto &o : D.indistinguishable)
                 names.push_back(o);
             for (const std::string &name : names)
@@ -938,31 +990,28 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                             if (e->name == name)
                                 raw = e;
                         req.push_back({"probe " + name, raw, live[i].result.fit.strength, nullptr,
-                                       0.0, "", opt.signature_seeds});
+                                       0.0, "", probe_seeds});
+                        model_names.push_back(
+                            raw ? name + " (" + strengthText(*raw, live[i].result.fit.strength) +
+                                      ")"
+                                : name);
                     }
             const auto rows = simulator.simulate(probe, pd, req);
             for (const auto &r : req)
                 D.simulations += r.seeds;
-            double sep = 0.0;
-            PooledScatter probe_pool(rows[0].cols());
-            for (const auto &r : rows)
-                probe_pool.add(r);
-            const Eigen::VectorXd probe_sd = probe_pool.sd(columnStats(rows[0]).sd);
-            const auto base = meanAndVariance(rows[0], probe_sd);
-            for (std::size_t a = 1; a < rows.size(); ++a)
-                for (std::size_t b = a + 1; b < rows.size(); ++b) {
-                    const auto ma = meanAndVariance(rows[a], probe_sd);
-                    const auto mb = meanAndVariance(rows[b], probe_sd);
-                    for (Eigen::Index k = 0; k < ma.first.size(); ++k) {
-                        const double d = ma.first[k] - mb.first[k];
-                        const double v = ma.second[k] + mb.second[k] + base.second[k];
-                        if (std::isfinite(d) && v > 0.0)
-                            sep += d * d / v;
-                    }
-                }
-            if (sep > best_sep) {
+            const ProbeSeparation ps = probeSeparation(rows);
+            const double sep = ps.chi2.size() > 0 ? ps.chi2.sum() : 0.0;
+            if (sep > best_sep && sep > 0.0) { // a probe that moves nothing names nothing
                 best_sep = sep;
                 D.separating_experiment = probe.name;
+                D.separating_chi2 = sep;
+                Eigen::Index k = 0;
+                ps.chi2.maxCoeff(&k);
+                D.separating_feature = featureText(probe, pd.keys[std::size_t(k)]);
+                D.separating_predictions.clear();
+                for (std::size_t i = 0; i < rows.size(); ++i)
+                    D.separating_predictions.push_back(
+                        {model_names[i], ps.mean[i][k], ps.sd[i][k]});
             }
         }
     }
@@ -973,9 +1022,17 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             if (!(r.p_value < opt.alpha)) // the ones put in `indistinguishable` above
                 also << ' ' << r.name << " (p = " << fmt(r.p_value, 2)
                      << (r.at_prior_edge ? ", at its prior's edge" : "") << ')';
-        if (!D.separating_experiment.empty())
-            also << "; the experiment that would separate them best: " << D.separating_experiment;
         D.claim += also.str();
+    }
+    if (!D.separating_experiment.empty()) {
+        std::ostringstream probe;
+        probe << "; the experiment that would separate them best: " << D.separating_experiment
+              << ", " << D.separating_feature << ':';
+        for (std::size_t i = 1; i < D.separating_predictions.size(); ++i)
+            probe << (i > 1 ? "," : "") << ' ' << D.separating_predictions[i].model << ' '
+                  << fmt(D.separating_predictions[i].mean) << " +- "
+                  << fmt(D.separating_predictions[i].sd, 2);
+        D.claim += probe.str();
     }
     D.claim += notCompared();
     log(D.claim);

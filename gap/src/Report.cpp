@@ -157,6 +157,12 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
                                {"at_prior_edge", r.at_prior_edge}});
     j["indistinguishable_from_leader"] = d.indistinguishable;
     j["separating_experiment"] = d.separating_experiment;
+    j["separating_chi2"] = number(d.separating_chi2);
+    j["separating_feature"] = d.separating_feature;
+    j["separating_predictions"] = Json::array();
+    for (const auto &p : d.separating_predictions)
+        j["separating_predictions"].push_back(
+            {{"model", p.model}, {"mean", number(p.mean)}, {"sd", number(p.sd)}});
     j["unexplained"] = d.unexplained;
     j["simulations"] = d.simulations;
     return j;
@@ -235,8 +241,17 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
         for (const auto &n : d.indistinguishable)
             r << n << ' ';
         r << '\n';
-        if (!d.separating_experiment.empty())
-            r << "The experiment that would separate them best: " << d.separating_experiment << '\n';
+        if (!d.separating_experiment.empty()) {
+            r << "The experiment that would separate them best: " << d.separating_experiment
+              << " (chi^2 between them " << d.separating_chi2 << ")\n";
+            if (!d.separating_predictions.empty()) {
+                r << "  where they differ most, " << d.separating_feature << ":";
+                for (const auto &p : d.separating_predictions)
+                    r << (&p == &d.separating_predictions.front() ? " " : "; ") << p.model << ' '
+                      << p.mean << " +- " << p.sd;
+                r << '\n';
+            }
+        }
     }
     if (!d.unexplained.empty())
         r << "\nWhat remains beyond 2 u_val with the best model: " << d.unexplained << '\n';

@@ -632,7 +632,7 @@ std::vector<ExperimentSet> StudySimulator::probes(const ExperimentSet &design) c
         if (present.count(type) || !node["probe"])
             continue;
         ExperimentSet p;
-        p.name = type + " (" + std::to_string(node["probe"]["conditions"].size()) + " conditions)";
+        p.name = type; // its conditions are named with the feature that separates most
         p.directory = base_.path;
         int k = 0;
         for (const auto &cond : node["probe"]["conditions"]) {

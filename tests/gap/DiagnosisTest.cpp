@@ -907,3 +907,24 @@ TEST_CASE("selftest: a plan with an unknown strength draw is refused, naming the
     CHECK_FALSE(fs::exists(dir / "out" / "twins"));
     fs::remove_all(dir);
 }
+
+TEST_CASE("the separating experiment: a probe's features scored by how far the candidates' "
+          "means lie apart in the probe's own scatter",
+          "[gap][diagnosis]") {
+    // Base, A and B on two seeds each. Feature 0 scatters by +-1 in every model (pooled
+    // variance (2 + 2 + 2) / 3 = 2, a two-seed mean's 1): A and B lie 10 apart, chi^2
+    // 10^2 / (1 + 1 + 1). Feature 1 differs (5 against 6) but never scatters: nothing says
+    // how far apart that is, and it counts nothing.
+    Eigen::MatrixXd base(2, 2), a(2, 2), b(2, 2);
+    base << 10, 5, 12, 5;
+    a << 20, 5, 22, 5;
+    b << 10, 6, 12, 6;
+    const ProbeSeparation p = probeSeparation({base, a, b});
+    CHECK(p.chi2[0] == Approx(100.0 / 3.0).epsilon(1e-12));
+    CHECK(p.chi2[1] == 0.0);
+    CHECK(p.mean[1][0] == Approx(21.0));
+    CHECK(p.sd[1][0] == Approx(1.0).epsilon(1e-12));
+    // One seed each: no scatter is known, so no separation either.
+    const ProbeSeparation one = probeSeparation({base.topRows(1), a.topRows(1), b.topRows(1)});
+    CHECK(one.chi2.sum() == 0.0);
+}

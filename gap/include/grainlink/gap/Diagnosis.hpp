@@ -136,6 +136,17 @@ struct Diagnosis {
     std::vector<Rival> rivals;
     std::vector<std::string> indistinguishable; ///< candidates the design cannot tell from the leader
     std::string separating_experiment;         ///< the probe that would separate them best
+    /// Where in that probe they differ most (`FeatureKey::label`), and what each predicts
+    /// there: the base first, then the leader and the others at their fitted strengths.
+    struct ProbePrediction {
+        std::string model;
+        double mean = 0.0, sd = 0.0; ///< over the probe's seeds; sd: the mean's
+    };
+    std::string separating_feature;
+    std::vector<ProbePrediction> separating_predictions;
+    /// The probe's separation: sum over features and pairs of candidates of d^2 over their
+    /// variance and the base's (an expected chi^2 between them on one run of the probe).
+    double separating_chi2 = 0.0;
     /// Unresolved: no gap is found, but only because a numerical check of the base model moves
     /// the simulation by more than half its value: nothing can be said until it is refined.
     enum class Outcome { NoGap, Explained, ExplainedByPair, Unexplained, Unresolved };
@@ -178,5 +189,16 @@ std::vector<std::string> defaultHeldOut(const ExperimentSet &set);
 /// Runs the whole pipeline on measured `set` with the catalogue's diagnosable `effects`.
 Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &effects,
                    Simulator &simulator, const DiagnosisOptions &options);
+
+/// How well a probe's runs (`rows[0]` the base's, then one per candidate, each seeds x
+/// features) tell the candidates apart: per feature, the sum over pairs of candidates of
+/// their means' squared difference over the two means' variances and the base mean's, every
+/// variance from one bed's scatter pooled over all the rows (so two seeds of at least one
+/// model are needed: without them nothing is known to separate, and chi2 is 0).
+struct ProbeSeparation {
+    Eigen::VectorXd chi2;
+    std::vector<Eigen::VectorXd> mean, sd; ///< per row: its mean and that mean's sd
+};
+ProbeSeparation probeSeparation(const std::vector<Eigen::MatrixXd> &rows);
 
 } // namespace grainlink::gap
