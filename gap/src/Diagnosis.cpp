@@ -1024,9 +1024,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                      << (r.at_prior_edge ? ", at its prior's edge" : "") << ')';
         D.claim += also.str();
     }
-    if (!D.separating_experiment.empty()) {
+    if (D.separating_predictions.size() >= 2) {
         std::ostringstream probe;
-        probe << "; the experiment that would separate them best: " << D.separating_experiment
+        probe << "; the experiment that would tell "
+              << D.separating_predictions[1].model.substr(
+                     0, D.separating_predictions[1].model.find(' '))
+              << " from " << joined(D.indistinguishable) << " best: " << D.separating_experiment
               << ", " << D.separating_feature << ':';
         for (std::size_t i = 1; i < D.separating_predictions.size(); ++i)
             probe << (i > 1 ? "," : "") << ' ' << D.separating_predictions[i].model << ' '
