@@ -164,6 +164,23 @@ TEST_CASE("block correlation: one per experiment when its features move together
 
 namespace {
 
+/// The model's and the base's means with seed j left out, for every j (rows: seeds).
+SharedLuck seedJackknife(const Eigen::MatrixXd &model, const Eigen::MatrixXd &base) {
+    SharedLuck jack;
+    const Eigen::Index S = model.rows();
+    for (Eigen::Index j = 0; j < S; ++j) {
+        Eigen::VectorXd m = Eigen::VectorXd::Zero(model.cols()), b = m;
+        for (Eigen::Index s = 0; s < S; ++s)
+            if (s != j) {
+                m += model.row(s).transpose() / double(S - 1);
+                b += base.row(s).transpose() / double(S - 1);
+            }
+        jack.model_mean.push_back(m);
+        jack.null_mean.push_back(b);
+    }
+    return jack;
+}
+
 /// Keys of `experiments` experiments of `each` features.
 std::vector<FeatureKey> blockKeys(int experiments, int each) {
     std::vector<FeatureKey> keys;
@@ -344,17 +361,7 @@ TEST_CASE("one group of beds held out: judged per experiment with the model's ow
                     base(s, k) = null_shift + base_bed + feature_sd * z(rng);
                 }
             }
-            SharedLuck jack;
-            for (int j = 0; j < S; ++j) {
-                Eigen::VectorXd m = Eigen::VectorXd::Zero(n), b = Eigen::VectorXd::Zero(n);
-                for (int s = 0; s < S; ++s)
-                    if (s != j) {
-                        m += model.row(s).transpose() / double(S - 1);
-                        b += base.row(s).transpose() / double(S - 1);
-                    }
-                jack.model_mean.push_back(m);
-                jack.null_mean.push_back(b);
-            }
+            const SharedLuck jack = seedJackknife(model, base);
             const Eigen::VectorXd mm = model.colwise().mean().transpose(),
                                   bm = base.colwise().mean().transpose(),
                                   var = Eigen::VectorXd::Constant(n, v);
@@ -438,25 +445,17 @@ TEST_CASE("the measured beds' shared luck, carried through the gain, holds the l
                     .transpose() /
                 std::sqrt(double(T));
             shared.measured_dof = T - 1;
-            Eigen::VectorXd mm = Eigen::VectorXd::Zero(n), bm = Eigen::VectorXd::Zero(n);
             Eigen::MatrixXd model(S, n), base(S, n);
             for (int s = 0; s < S; ++s)
                 for (int k = 0; k < n; ++k) {
                     model(s, k) = c + 0.05 * z(rng);
                     base(s, k) = -c + 0.05 * z(rng);
                 }
-            for (int j = 0; j < S; ++j) {
-                Eigen::VectorXd m = Eigen::VectorXd::Zero(n), b = Eigen::VectorXd::Zero(n);
-                for (int s = 0; s < S; ++s)
-                    if (s != j) {
-                        m += model.row(s).transpose() / double(S - 1);
-                        b += base.row(s).transpose() / double(S - 1);
-                    }
-                shared.model_mean.push_back(m);
-                shared.null_mean.push_back(b);
-            }
-            mm = model.colwise().mean().transpose();
-            bm = base.colwise().mean().transpose();
+            const SharedLuck jack = seedJackknife(model, base);
+            shared.model_mean = jack.model_mean;
+            shared.null_mean = jack.null_mean;
+            const Eigen::VectorXd mm = model.colwise().mean().transpose(),
+                                  bm = base.colwise().mean().transpose();
             const Eigen::VectorXd var = Eigen::VectorXd::Constant(n, 0.25);
             r.with += compareDensities(y, mm, var, bm, var, all(n), beds, blockKeys(E, K), shared)
                           .p_value < 0.05;
