@@ -281,6 +281,7 @@ PointResult StudyFolder::runPoint(const Point &point, const std::string &grainli
         r.folder = failedPath(point);
         r.log = r.folder + "/log.txt";
         r.error = problem;
+        r.run_wall_s = process_s; // else the machinery counted it (286 s a point, a slope study)
         r.wall_s = secondsSince(start);
         return r;
     }

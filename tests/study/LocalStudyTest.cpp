@@ -118,6 +118,9 @@ TEST_CASE("a failed point is reported with its error and log while the others go
     CHECK(first[1].log == folder / ("study/points/" + first[1].point.id + ".failed/log.txt"));
     CHECK_THAT(readFile(first[1].log), Catch::Contains("overlap"));
     CHECK_FALSE(fs::exists(folder / ("study/points/" + first[1].point.id)));
+    // Its run's time is the run's, not the study machinery's (each point's wall beyond it).
+    CHECK(first[1].run_wall_s > 0.0);
+    CHECK(first[1].run_wall_s <= first[1].wall_s);
 
     const std::vector<PointResult> again = run(s, localPool(1, folder));
     CHECK(again[1].status == PointStatus::Failed);
