@@ -91,11 +91,16 @@ void SingleWheelRig::applyDrive() {
             wheel_speed_.disable(st);
         discrete_.setOneMobilityForce(st, wheel_, SimTK::MobilizerUIndex(0), *s.drive_torque_N_m);
     }
-    if (s.slip) {
-        // Slip s = 1 - v / (ω r): the carriage is held at v = ω r (1 - s) while driving.
-        const double v = omega * wheelRadius_m() * (1.0 - *s.slip);
+    if (s.slip || (locked_ && s.hold_carriage_in_drop)) {
+        // Slip s = 1 - v / (ω r): the carriage is held at v = ω r (1 - s) while driving (at
+        // rest while locked: ω = 0).
+        const double v = omega * wheelRadius_m() * (1.0 - s.slip.value_or(0.0));
+        if (carriage_speed_.isDisabled(st))
+            carriage_speed_.enable(st);
         carriage_speed_.setSpeed(st, v);
         carriage_x_.setOneU(st, SimTK::MobilizerUIndex(0), v);
+    } else if (!carriage_speed_.isDisabled(st)) {
+        carriage_speed_.disable(st); // the drop's hold released: the carriage is free
     }
     discrete_.setOneMobilityForce(st, carriage_x_, SimTK::MobilizerUIndex(0), -s.drawbar_force_N);
     system_.realize(st, SimTK::Stage::Velocity);

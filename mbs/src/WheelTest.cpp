@@ -351,6 +351,7 @@ SingleWheelRigSettings parseSingleWheelRig(const config::ConfigNode &node) {
     }
     s.angular_velocity_rad_s = node.number("angular_velocity_rad_s", s.angular_velocity_rad_s);
     s.drawbar_force_N = node.number("drawbar_force_N", 0.0);
+    s.hold_carriage_in_drop = node.boolean("hold_carriage_in_drop", false);
     if (node.has("drive_torque_N_m")) {
         s.drive_torque_N_m = node["drive_torque_N_m"].number();
         // A torque drive sets no speed, and slip control imposes one.

@@ -129,3 +129,33 @@ TEST_CASE("Rig: save/restore and checkpoints continue bit-identically", "[mbs][r
     CHECK(b.observables().at("motor_torque_N_m") == a.observables().at("motor_torque_N_m"));
     std::filesystem::remove(path);
 }
+
+TEST_CASE("Rig on a slope: the drop holds the carriage where asked, and it slides back once "
+          "the drive starts",
+          "[mbs][rig]") {
+    // Gravity tilted by 20 deg, no soil: a free carriage slides back at g sin 20 deg.
+    auto settings = seedRig();
+    const double a = 20.0 * M_PI / 180.0;
+    settings.gravity_m_s2 = Vec3(-9.81 * std::sin(a), 0, -9.81 * std::cos(a));
+    settings.rotation_locked = true;
+    SECTION("free (the default): x = x0 - g sin a t^2 / 2 in the drop") {
+        SingleWheelRig rig(settings);
+        rig.applyWrenches({Wrench{}});
+        rig.advanceTo(0.2);
+        CHECK(rig.bodyStates()[0].position_m.x() ==
+              Approx(0.1 - 0.5 * 9.81 * std::sin(a) * 0.04).margin(1e-9));
+    }
+    SECTION("held: x stays in the drop, the hold carries m g sin a, and the drive frees it") {
+        settings.hold_carriage_in_drop = true;
+        SingleWheelRig rig(settings);
+        rig.applyWrenches({Wrench{}});
+        rig.advanceTo(0.2);
+        CHECK(rig.bodyStates()[0].position_m.x() == Approx(0.1).margin(1e-9));
+        CHECK(std::abs(rig.observables().at("carriage_drive_force_N")) ==
+              Approx(settings.horizontal_mass_kg * 9.81 * std::sin(a)).epsilon(1e-6));
+        rig.setRotationLocked(false);
+        rig.advanceTo(0.4);
+        CHECK(rig.bodyStates()[0].position_m.x() ==
+              Approx(0.1 - 0.5 * 9.81 * std::sin(a) * 0.04).margin(1e-9));
+    }
+}

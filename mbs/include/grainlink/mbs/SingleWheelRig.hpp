@@ -27,6 +27,9 @@ struct SingleWheelRigSettings {
     double drawbar_force_N = 0.0;            ///< [N] horizontal resistance F_R on the carriage
     std::optional<double> slip;              ///< slip-controlled mode: carriage at ω r (1 - slip)
     bool rotation_locked = false;            ///< start with the wheel rotation locked (drop phase)
+    /// Hold the carriage in x while the rotation is locked (the drop), as a rig's brake does:
+    /// on a slope (gravity tilted) it would slide back before the wheel touches down.
+    bool hold_carriage_in_drop = false;
     Vec3 gravity_m_s2 = Vec3(0, 0, -9.81);
     IntegratorSettings integrator;
 };
