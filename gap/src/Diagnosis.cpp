@@ -979,7 +979,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             const int probe_seeds = std::max(2, opt.signature_seeds);
             std::vector<VariantRequest> req{
                 {"probe base", nullptr, 0.0, nullptr, 0.0, "", probe_seeds}};
-            std::vector<std::string> names{leader}, model_names{"base"};
+            std::vector<std::string> names{leader};
+            std::vector<Diagnosis::ProbePrediction> models{{"base", "", 0.0, 0.0}};
             for (const auto &o : D.indistinguishable)
                 names.push_back(o);
             for (const std::string &name : names)
@@ -991,10 +992,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                                 raw = e;
                         req.push_back({"probe " + name, raw, live[i].result.fit.strength, nullptr,
                                        0.0, "", probe_seeds});
-                        model_names.push_back(
-                            raw ? name + " (" + strengthText(*raw, live[i].result.fit.strength) +
-                                      ")"
-                                : name);
+                        models.push_back(
+                            {name, raw ? strengthText(*raw, live[i].result.fit.strength) : "",
+                             0.0, 0.0});
                     }
             const auto rows = simulator.simulate(probe, pd, req);
             for (const auto &r : req)
@@ -1008,10 +1008,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 Eigen::Index k = 0;
                 ps.chi2.maxCoeff(&k);
                 D.separating_feature = featureText(probe, pd.keys[std::size_t(k)]);
-                D.separating_predictions.clear();
-                for (std::size_t i = 0; i < rows.size(); ++i)
-                    D.separating_predictions.push_back(
-                        {model_names[i], ps.mean[i][k], ps.sd[i][k]});
+                D.separating_predictions = models;
+                for (std::size_t i = 0; i < models.size(); ++i) {
+                    D.separating_predictions[i].mean = ps.mean[i][k];
+                    D.separating_predictions[i].sd = ps.sd[i][k];
+                }
             }
         }
     }
@@ -1026,13 +1027,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     }
     if (D.separating_predictions.size() >= 2) {
         std::ostringstream probe;
-        probe << "; the experiment that would tell "
-              << D.separating_predictions[1].model.substr(
-                     0, D.separating_predictions[1].model.find(' '))
+        probe << "; the experiment that would tell " << D.separating_predictions[1].model
               << " from " << joined(D.indistinguishable) << " best: " << D.separating_experiment
               << ", " << D.separating_feature << ':';
         for (std::size_t i = 1; i < D.separating_predictions.size(); ++i)
-            probe << (i > 1 ? "," : "") << ' ' << D.separating_predictions[i].model << ' '
+            probe << (i > 1 ? "," : "") << ' ' << D.separating_predictions[i].label() << ' '
                   << fmt(D.separating_predictions[i].mean) << " +- "
                   << fmt(D.separating_predictions[i].sd, 2);
         D.claim += probe.str();

@@ -162,7 +162,8 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     j["separating_predictions"] = Json::array();
     for (const auto &p : d.separating_predictions)
         j["separating_predictions"].push_back(
-            {{"model", p.model}, {"mean", number(p.mean)}, {"sd", number(p.sd)}});
+            {{"model", p.model}, {"strength", p.strength}, {"mean", number(p.mean)},
+             {"sd", number(p.sd)}});
     j["unexplained"] = d.unexplained;
     j["simulations"] = d.simulations;
     return j;
@@ -247,7 +248,7 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
             if (!d.separating_predictions.empty()) {
                 r << "  where they differ most, " << d.separating_feature << ":";
                 for (const auto &p : d.separating_predictions)
-                    r << (&p == &d.separating_predictions.front() ? " " : "; ") << p.model << ' '
+                    r << (&p == &d.separating_predictions.front() ? " " : "; ") << p.label() << ' '
                       << p.mean << " +- " << p.sd;
                 r << '\n';
             }

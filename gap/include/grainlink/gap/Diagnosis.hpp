@@ -139,8 +139,10 @@ struct Diagnosis {
     /// Where in that probe they differ most (`FeatureKey::label`), and what each predicts
     /// there: the base first, then the leader and the others at their fitted strengths.
     struct ProbePrediction {
-        std::string model;
+        std::string model;    ///< "base" or the effect's name
+        std::string strength; ///< the fitted strength it ran at, in words ("" for the base)
         double mean = 0.0, sd = 0.0; ///< over the probe's seeds; sd: the mean's
+        std::string label() const { return strength.empty() ? model : model + " (" + strength + ")"; }
     };
     std::string separating_feature;
     std::vector<ProbePrediction> separating_predictions;
