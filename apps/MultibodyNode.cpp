@@ -9,13 +9,21 @@
 #include "grainlink/dem/BedPreparation.hpp"
 #include "grainlink/dem/RigidFloor.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/mbs/Mole.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <memory>
+#include <sstream>
+#include <stdexcept>
 
 namespace grainlink::apps {
 
@@ -104,6 +112,88 @@ Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
     return r;
 }
 
+/// The columns `names` of a series file written by dem::Series (a header, then numbers).
+std::map<std::string, std::vector<double>>
+readSeriesColumns(const std::string &path, const std::vector<std::string> &names) {
+    std::ifstream in(path);
+    std::string line;
+    if (!std::getline(in, line))
+        throw std::runtime_error("cannot read the series " + path);
+    std::vector<std::string> header;
+    std::stringstream header_stream(line);
+    for (std::string cell; std::getline(header_stream, cell, ',');)
+        header.push_back(cell);
+    std::map<std::string, std::vector<double>> columns;
+    std::vector<std::pair<std::size_t, std::vector<double> *>> wanted;
+    for (const std::string &name : names) {
+        const auto at = std::find(header.begin(), header.end(), name);
+        if (at == header.end())
+            throw std::runtime_error(path + " has no column '" + name + "'");
+        wanted.emplace_back(std::size_t(at - header.begin()), &columns[name]);
+    }
+    while (std::getline(in, line)) {
+        std::vector<std::string> cells;
+        std::stringstream row(line);
+        for (std::string cell; std::getline(row, cell, ',');)
+            cells.push_back(cell);
+        if (cells.size() != header.size())
+            throw std::runtime_error(path + ": a row with " + std::to_string(cells.size()) +
+                                     " cells under a header of " + std::to_string(header.size()));
+        for (auto &[index, column] : wanted)
+            column->push_back(std::stod(cells[index]));
+    }
+    return columns;
+}
+
+/// mbs_summary.json of a model run to its end time: its observables at the end and, for the
+/// mole, its strokes (mbs::moleStrokes, from the run's whole series: a resumed run's too) with
+/// the advance per stroke from the second on — the first also holds the sinking into a loose
+/// surface. Written aside and renamed, as the rig's summary: a study sees all of it or none.
+void writeModelSummary(const mbs::MultibodyModel &model, const std::string &series_path,
+                       const std::string &path) {
+    using nlohmann::json;
+    json j{{"time_s", model.time()}, {"observables", model.observables()}};
+    if (const auto *mole = dynamic_cast<const mbs::Mole *>(&model)) {
+        const std::string force = mole->settings().hull_name + ".Fz_N";
+        auto c = readSeriesColumns(series_path, {"time_s", "stroke_count", "penetration_m", force});
+        const auto strokes =
+            mbs::moleStrokes(c["time_s"], c["stroke_count"], c["penetration_m"], c[force]);
+        json list = json::array();
+        std::vector<double> advance;
+        for (const mbs::MoleStroke &s : strokes) {
+            list.push_back({{"stroke", s.stroke},
+                            {"end_time_s", s.end_time_s},
+                            {"penetration_m", s.penetration_m},
+                            {"advance_m", s.advance_m},
+                            {"peak_hull_force_N", s.peak_hull_force_N},
+                            {"mean_hull_force_N", s.mean_hull_force_N},
+                            {"hull_impulse_N_s", s.hull_impulse_N_s}});
+            if (s.stroke >= 2)
+                advance.push_back(s.advance_m);
+        }
+        j["strokes"] = list;
+        j["stroke_count"] = strokes.size();
+        j["penetration_m"] = strokes.empty() ? 0.0 : strokes.back().penetration_m;
+        j["first_stroke_penetration_m"] = strokes.empty() ? 0.0 : strokes.front().penetration_m;
+        // Mean, sample sd and standard error over strokes 2..N (null with fewer than two).
+        const double n = double(advance.size());
+        double mean = 0.0, ss = 0.0;
+        for (double a : advance)
+            mean += a / n;
+        for (double a : advance)
+            ss += (a - mean) * (a - mean);
+        json per_stroke{{"count", advance.size()}, {"from_stroke", 2}};
+        per_stroke["mean"] = advance.empty() ? json(nullptr) : json(mean);
+        per_stroke["sd"] = advance.size() < 2 ? json(nullptr) : json(std::sqrt(ss / (n - 1)));
+        per_stroke["standard_error"] =
+            advance.size() < 2 ? json(nullptr) : json(std::sqrt(ss / (n - 1) / n));
+        j["advance_per_stroke_m"] = per_stroke;
+    }
+    const std::string partial = path + ".partial";
+    std::ofstream(partial) << j.dump(2) << '\n';
+    std::filesystem::rename(partial, path);
+}
+
 /// Any other model: mbs.csv with every observable the model reports (sorted by name) and the
 /// soil's wrench on each coupled body; the run goes to its end time.
 Report observablesReport(const mbs::MultibodyModel &model, const NodeOptions &options) {
@@ -130,11 +220,13 @@ Report observablesReport(const mbs::MultibodyModel &model, const NodeOptions &op
         series << '\n';
         return false;
     };
-    r.finish = [&model, options] {
+    r.finish = [&model, options, series_file = r.series_file] {
         std::printf("%s: t = %.6g s;", options.name.c_str(), model.time());
         for (const auto &[name, value] : model.observables())
             std::printf(" %s %.6g", name.c_str(), value);
         std::printf("\n");
+        writeModelSummary(model, options.output_directory + "/" + series_file,
+                          options.output_directory + "/mbs_summary.json");
         return 0;
     };
     return r;

@@ -107,6 +107,10 @@ int StudyCommand::runStudy() const {
     if (study_path_.empty() || directory_.empty())
         throw std::invalid_argument("usage: grainlink study STUDY.yaml --out DIR "
                                     "(or grainlink study collect DIR)");
+    // Locally there is nothing to return early from: the pool would run every point.
+    if (submit_only_ && executor_.executor != "slurm")
+        throw std::invalid_argument("--submit-only submits a Slurm job array and returns: it "
+                                    "needs --executor slurm");
     const auto start = std::chrono::steady_clock::now();
     study::DesignOptions design;
     if (threads_ > 0)

@@ -1,5 +1,6 @@
 #!/usr/bin/python3
-"""The mole run's report from RUN_DIR/mbs.csv (grainlink mbs-node with a `mole:` model):
+"""The mole run's report from RUN_DIR/mbs.csv and RUN_DIR/mbs_summary.json (grainlink mbs-node
+with a `mole:` model):
 per stroke the penetration at its end, the advance it made, the peak and mean vertical soil
 force on the hull and the soil's impulse on the hull, written to RUN_DIR/strokes.csv, and
 RUN_DIR/mole.png: penetration against stroke number, hull force per stroke, and penetration and
@@ -9,6 +10,7 @@ Usage: tools/plot_mole.py RUN_DIR [HULL_NAME]
 Runs under Debian's /usr/bin/python3 (python3-matplotlib).
 """
 import csv
+import json
 import sys
 
 import matplotlib
@@ -29,23 +31,15 @@ def main():
     t = [float(r["time_s"]) for r in rows]
     depth = [1000 * float(r["penetration_m"]) for r in rows]
     fz = [float(r[f"{hull}.Fz_N"]) for r in rows]
-    stroke = [int(float(r["stroke_count"])) for r in rows]
 
-    # Stroke k spans the windows from its release (stroke_count becomes k) to the next one.
-    strokes = []
-    previous_t, previous_depth = 0.0, 0.0
-    for k in range(1, max(stroke) + 1):
-        index = [i for i, s in enumerate(stroke) if s == k]
-        start_t = t[index[0] - 1] if index[0] > 0 else 0.0
-        impulse = sum(fz[i] * (t[i] - (t[i - 1] if i > 0 else 0.0)) for i in index)
-        span = t[index[-1]] - start_t
-        strokes.append({"stroke": k, "end_time_s": t[index[-1]],
-                        "penetration_mm": depth[index[-1]],
-                        "advance_mm": depth[index[-1]] - previous_depth,
-                        "peak_hull_Fz_N": max(fz[i] for i in index),
-                        "mean_hull_Fz_N": impulse / span if span > 0 else 0.0,
-                        "hull_impulse_z_N_s": impulse})
-        previous_depth = depth[index[-1]]
+    # The strokes as the run's summary gives them (grainlink's mbs::moleStrokes, which a study
+    # reads too): stroke k spans the windows from its release to the next one.
+    with open(f"{run_dir}/mbs_summary.json") as f:
+        summary = json.load(f)
+    strokes = [{"stroke": s["stroke"], "end_time_s": s["end_time_s"],
+                "penetration_mm": 1000 * s["penetration_m"], "advance_mm": 1000 * s["advance_m"],
+                "peak_hull_Fz_N": s["peak_hull_force_N"], "mean_hull_Fz_N": s["mean_hull_force_N"],
+                "hull_impulse_z_N_s": s["hull_impulse_N_s"]} for s in summary["strokes"]]
     with open(f"{run_dir}/strokes.csv", "w", newline="") as f:
         out = csv.DictWriter(f, fieldnames=list(strokes[0]) if strokes else ["stroke"])
         out.writeheader()

@@ -643,3 +643,45 @@ MoleSettings parseMole(const config::ConfigNode &node) {
 }
 
 } // namespace grainlink::mbs
+
+namespace grainlink::mbs {
+
+std::vector<MoleStroke> moleStrokes(const std::vector<double> &time_s,
+                                    const std::vector<double> &stroke_count,
+                                    const std::vector<double> &penetration_m,
+                                    const std::vector<double> &hull_force_z_N) {
+    const std::size_t n = time_s.size();
+    if (stroke_count.size() != n || penetration_m.size() != n || hull_force_z_N.size() != n)
+        throw ModelError("moleStrokes: the series have different lengths");
+    std::vector<MoleStroke> strokes;
+    std::vector<double> start_s;       // each stroke's first window's start
+    double previous_penetration = 0.0; // at the end of the previous stroke, or before the first
+    for (std::size_t i = 0; i < n; ++i) {
+        const int k = int(std::lround(stroke_count[i]));
+        // The window's force acts from the previous window's end to this one's.
+        const double window_start = i > 0 ? time_s[i - 1] : 0.0;
+        if (k == 0) {
+            previous_penetration = penetration_m[i];
+            continue;
+        }
+        if (strokes.empty() || strokes.back().stroke != k) {
+            if (!strokes.empty())
+                previous_penetration = strokes.back().penetration_m;
+            strokes.push_back({k, 0.0, 0.0, 0.0, hull_force_z_N[i], 0.0, 0.0});
+            start_s.push_back(window_start);
+        }
+        MoleStroke &s = strokes.back();
+        s.end_time_s = time_s[i];
+        s.penetration_m = penetration_m[i];
+        s.advance_m = penetration_m[i] - previous_penetration;
+        s.peak_hull_force_N = std::max(s.peak_hull_force_N, hull_force_z_N[i]);
+        s.hull_impulse_N_s += hull_force_z_N[i] * (time_s[i] - window_start);
+    }
+    for (std::size_t j = 0; j < strokes.size(); ++j) {
+        const double span = strokes[j].end_time_s - start_s[j];
+        strokes[j].mean_hull_force_N = span > 0.0 ? strokes[j].hull_impulse_N_s / span : 0.0;
+    }
+    return strokes;
+}
+
+} // namespace grainlink::mbs

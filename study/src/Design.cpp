@@ -169,6 +169,8 @@ Study loadStudy(const std::string &path, const std::string &directory,
         scenario_key.fail("cannot read scenario '" + scenario.string() + "': " + e.what());
     }
     absolutizeFilePaths(scenario_tree, scenario.parent_path().string());
+    if (kind.summary_file_of)
+        kind.summary_file = kind.summary_file_of(scenario_tree);
     if (options.threads)
         setAtPath(scenario_tree, kind.threads_key, YAML::Node(*options.threads));
 

@@ -5,6 +5,8 @@
 
 #include <stdexcept>
 
+#include <yaml-cpp/yaml.h>
+
 namespace grainlink::study {
 
 Kind standardKind(const std::string &kind, const std::string &test) {
@@ -14,6 +16,7 @@ Kind standardKind(const std::string &kind, const std::string &test) {
         return {"dem",
                 {"dem"},
                 "summary.json",
+                {},
                 "simulation.threads",
                 "deposition.seed",
                 "checkpoint.bin",
@@ -22,11 +25,14 @@ Kind standardKind(const std::string &kind, const std::string &test) {
     if (kind == "run") {
         if (!test.empty())
             throw std::invalid_argument("kind 'run' takes no test (got '" + test + "')");
-        // The coupled rig's machine-readable summary comes with its own issue; the name is
-        // fixed here so a study of coupled runs needs no change when it arrives.
+        // The single-wheel rig writes its steady state; every other model (the mole, the
+        // rover, a URDF model) its observables at the end time (docs/study.md).
         return {"run",
                 {"run"},
                 "rig_summary.json",
+                [](const YAML::Node &scenario) {
+                    return scenario["rig"] ? "rig_summary.json" : "mbs_summary.json";
+                },
                 "soil.simulation.threads",
                 "soil.deposition.seed",
                 "checkpoints/latest",
@@ -37,6 +43,7 @@ Kind standardKind(const std::string &kind, const std::string &test) {
         return {"lab " + test,
                 {"lab", test},
                 "summary.json",
+                {},
                 "soil.simulation.threads",
                 "soil.deposition.seed",
                 "", // a lab test has no checkpoint: an interrupted one starts again

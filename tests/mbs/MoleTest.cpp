@@ -320,6 +320,33 @@ TEST_CASE("Mole: strokes repeat with the configured period", "[mbs][mole][slow]"
     CHECK(hint_ok);
 }
 
+TEST_CASE("Mole strokes from a run's windows: span, advance, peak and mean hull force by hand",
+          "[mbs][mole]") {
+    // Two windows resting, then stroke 1 over two windows, stroke 2 over two. Stroke 1 spans
+    // 0.2-0.4 s and advances from the rest penetration 20 mm; its impulse is 10 N x 0.1 s +
+    // 2 N x 0.1 s = 1.2 N s, its mean force 1.2 N s / 0.2 s = 6 N.
+    const std::vector<double> t{0.1, 0.2, 0.3, 0.4, 0.5, 0.6};
+    const std::vector<double> count{0, 0, 1, 1, 2, 2};
+    const std::vector<double> penetration{0.010, 0.020, 0.025, 0.030, 0.031, 0.035};
+    const std::vector<double> force{3, 3, 10, 2, 8, 4};
+    const auto strokes = moleStrokes(t, count, penetration, force);
+    REQUIRE(strokes.size() == 2);
+    CHECK(strokes[0].stroke == 1);
+    CHECK(strokes[0].end_time_s == Approx(0.4));
+    CHECK(strokes[0].penetration_m == Approx(0.030));
+    CHECK(strokes[0].advance_m == Approx(0.010));
+    CHECK(strokes[0].peak_hull_force_N == Approx(10.0));
+    CHECK(strokes[0].hull_impulse_N_s == Approx(1.2));
+    CHECK(strokes[0].mean_hull_force_N == Approx(6.0));
+    CHECK(strokes[1].stroke == 2);
+    CHECK(strokes[1].advance_m == Approx(0.005));
+    CHECK(strokes[1].peak_hull_force_N == Approx(8.0));
+    CHECK(strokes[1].hull_impulse_N_s == Approx(1.2));
+    CHECK(strokes[1].mean_hull_force_N == Approx(6.0));
+    CHECK_THROWS_AS(moleStrokes(t, count, penetration, {1.0}), ModelError);
+    CHECK(moleStrokes({0.1}, {0}, {0.01}, {3}).empty());
+}
+
 TEST_CASE("Mole hull mesh: closed, outward, volume of cylinder plus cone", "[mbs][mole]") {
     const MoleSettings s; // 400 mm × 27 mm, 40 mm tip, 24 facets around
     const MeshShape mesh = moleHullMesh(s);

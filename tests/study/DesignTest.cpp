@@ -249,3 +249,21 @@ TEST_CASE("relative file paths of the base become absolute, other values stay", 
     CHECK(tree["bodies"][0]["other"]["file"].as<std::string>() == "missing.stl");
     CHECK(tree["contact"]["damping"]["model"].as<std::string>() == "viscous");
 }
+
+TEST_CASE("a coupled run's summary is the rig's steady state for the rig and the observables at "
+          "the end for any other model",
+          "[study][design]") {
+    TempFolder folder("run_summary");
+    const auto kindFor = [&](const std::string &name, const std::string &model_section) {
+        writeFile(folder / (name + "_base.yaml"),
+                  model_section + "soil: {deposition: {seed: 1}}\n");
+        writeFile(folder / (name + ".yaml"), "name: " + name + "\nbase: {kind: run, scenario: " +
+                                                 name + "_base.yaml}\nobservables: [a.b]\n");
+        const Study s = loadStudy(folder / (name + ".yaml"), folder / ("out_" + name));
+        REQUIRE(s.points.size() == 1);
+        return s.points[0].kind.summary_file;
+    };
+    CHECK(kindFor("rig", "rig: {normal_load_kg: 2}\n") == "rig_summary.json");
+    CHECK(kindFor("mole", "mole: {stroke_period_s: 0.3}\n") == "mbs_summary.json");
+    CHECK(kindFor("rover", "rover: {}\n") == "mbs_summary.json");
+}

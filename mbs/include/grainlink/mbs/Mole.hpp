@@ -62,6 +62,26 @@ struct MoleImpacts {
     double secondary_speed_m_s; ///< [m/s]
 };
 
+/// One stroke of a mole run: from its release to the next release (or the run's end).
+struct MoleStroke {
+    int stroke = 0;                 ///< 1, 2, ...
+    double end_time_s = 0.0;        ///< [s] the stroke's last window
+    double penetration_m = 0.0;     ///< [m] tip below its start at the stroke's end
+    double advance_m = 0.0;         ///< [m] penetration gained in this stroke
+    double peak_hull_force_N = 0.0; ///< [N] the soil's largest upward force on the hull
+    double hull_impulse_N_s = 0.0;  ///< [N s] the soil's upward impulse on the hull
+    double mean_hull_force_N = 0.0; ///< [N] that impulse over the stroke's span
+};
+
+/// The strokes of a coupled run from its windows (mbs.csv): each window's end time, the stroke
+/// count and penetration at its end, and the soil's vertical force on the hull over it. Stroke k
+/// spans the windows from the one where the count becomes k to the last before it becomes k + 1;
+/// windows before the first release belong to no stroke.
+std::vector<MoleStroke> moleStrokes(const std::vector<double> &time_s,
+                                    const std::vector<double> &stroke_count,
+                                    const std::vector<double> &penetration_m,
+                                    const std::vector<double> &hull_force_z_N);
+
 class Mole final : public SimbodyModel {
 public:
     enum class Phase { Cocking, Released, Resting };

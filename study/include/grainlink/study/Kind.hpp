@@ -8,12 +8,19 @@
 #include <string>
 #include <vector>
 
+namespace YAML {
+class Node;
+}
+
 namespace grainlink::study {
 
 struct Kind {
     std::string name;                 ///< "dem", "run", "lab direct_shear", ...
     std::vector<std::string> command; ///< words after `grainlink`: {"lab", "direct_shear"}
     std::string summary_file;         ///< machine-readable result in the run's output folder
+    /// Where the summary file depends on the scenario (a coupled run: the rig's or any other
+    /// model's), the file for this base scenario; none: `summary_file` always.
+    std::function<std::string(const YAML::Node &scenario)> summary_file_of;
     std::string threads_key;          ///< dotted path of the scenario's thread count
     std::string seed_key;             ///< dotted path replicates vary by default
     /// The run's latest checkpoint in its output folder: an interrupted point that left one
