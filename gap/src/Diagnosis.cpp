@@ -339,11 +339,17 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     for (FeatureKey &key : bed_keys)
         key.experiment = simulator.bedGroup(set.find(key.experiment));
     // What the measured beds of a group may share: a mean's scatter over rebuilt beds, or one
-    // simulated bed's where the measurement has no such repeats (`SharedLuck`).
+    // simulated bed's where the measurement has no such repeats (`SharedLuck`). An experiment
+    // on beds of its own (`beds: own`) shares none: its luck is independent of the others',
+    // and the spread over the held-out experiments already holds it.
     SharedLuck measured_luck;
     measured_luck.measured_sd = V.u_bed;
     measured_luck.measured_dof = std::numeric_limits<double>::infinity();
     for (Eigen::Index k : D.held_out) {
+        if (set.find(meas.keys[std::size_t(k)].experiment).uncertainty.own_beds) {
+            measured_luck.measured_sd[k] = kNaN;
+            continue;
+        }
         const bool repeats = meas.from_repeats[std::size_t(k)];
         if (repeats)
             measured_luck.measured_sd[k] = meas.u_repeats[k];

@@ -632,6 +632,8 @@ ExperimentSet loadExperiments(const std::string &directory) {
             if (u->has("repeats"))
                 e.uncertainty.rebuilt_bed =
                     (*u)["repeats"].choice({"rebuilt_bed", "same_bed"}) == "rebuilt_bed";
+            if (u->has("beds"))
+                e.uncertainty.own_beds = (*u)["beds"].choice({"shared", "own"}) == "own";
             if (e.uncertainty.y_sigma < 0 || e.uncertainty.y_relative < 0 ||
                 e.uncertainty.y_systematic < 0 || e.uncertainty.x_zero_sigma < 0)
                 u->fail("uncertainties must be >= 0");

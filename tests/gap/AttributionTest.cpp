@@ -477,6 +477,17 @@ TEST_CASE("the measured beds' shared luck, carried through the gain, holds the l
     const Rates power = claimRate(0.05, 0.3, 0.3, 1, 500);
     INFO("power " << power.with);
     CHECK(power.with > 0.8);
+
+    // Each plate on beds of its own (a test bed rebuilt for every test: `beds: own`, where
+    // the diagnosis leaves the measured term out): the luck is independent between plates and
+    // the spread over plates already holds it, so the level holds without the term; and the
+    // term, taken where it does not apply, costs power.
+    const Rates own = claimRate(0.3, 0.3, 0.0, 1, 2000);
+    const Rates own_power = claimRate(0.3, 0.3, 0.3, 1, 500);
+    INFO("own beds: claims " << own.without << " without the term; power " << own_power.without
+                             << " without it, " << own_power.with << " with it");
+    CHECK(own.without < 0.06);
+    CHECK(own_power.without > own_power.with);
 }
 
 TEST_CASE("a feature the response lacks at some strengths is taken at the base at all of them",

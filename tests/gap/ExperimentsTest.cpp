@@ -141,6 +141,15 @@ TEST_CASE("experiments.yaml: stated uncertainty and the zero's uncertainty enter
     // One trial: sigma 300 Pa and the slope 2 kPa/mm x 0.5 mm = 1 kPa, in quadrature.
     CHECK_FALSE(m.from_repeats[2]);
     CHECK(m.u_D[2] == Approx(std::sqrt(300.0 * 300.0 + 1000.0 * 1000.0)));
+    // Beds are shared within a box unless the experiment says its own.
+    CHECK_FALSE(set.experiments[0].uncertainty.own_beds);
+    write(dir / "experiments.yaml",
+          "experiments:\n  - id: one\n    type: plate_sinkage\n"
+          "    conditions: {plate_diameter_m: 0.06}\n"
+          "    data:\n      files: [a1.csv]\n      x: {column: sinkage_mm, unit: mm}\n"
+          "      y: {pressure_Pa: {column: pressure_kPa, unit: kPa}}\n"
+          "    uncertainty: {y_sigma: 0.3, unit: kPa, beds: own}\n");
+    CHECK(loadExperiments(dir.string()).experiments[0].uncertainty.own_beds);
 }
 
 TEST_CASE("experiments.yaml: scalars and scatters", "[gap][experiments]") {
@@ -298,6 +307,8 @@ TEST_CASE("experiments.yaml: bad input names the file, the key and the line",
     fails(wrong_type, "unknown experiment type 'plate_test'");
     fails(plateYaml() + "  - id: p60\n    type: angle_of_repose\n    data: {values: [1], unit: deg}\n",
           "used twice");
+    fails(plateYaml("    uncertainty: {beds: separate}\n"), "experiments.yaml:10");
+    fails(plateYaml("    uncertainty: {beds: separate}\n"), "'separate'");
 }
 
 // Another code's output: the plate's force in N with z up (force and sinkage negative). Read

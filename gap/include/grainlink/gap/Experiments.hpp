@@ -50,6 +50,10 @@ struct MeasurementUncertainty {
     double y_systematic = 0.0; ///< [SI] common to every trial (a calibration)
     double x_zero_sigma = 0.0; ///< [SI of x] uncertainty of the x zero; enters as |dy/dx| sigma
     bool rebuilt_bed = true;   ///< repeats on re-prepared beds (their scatter holds the bed's)
+    /// Its trials' beds served no other experiment (`beds: own`). Default (`shared`): trial t of
+    /// every experiment of its type in its box was made on one bed t, as a twin's are, and
+    /// the held-out test counts their luck as one (docs/gap.md, step 7).
+    bool own_beds = false;
 };
 
 /// One trial: a curve per observable over the experiment's x (or one point of a scatter).
