@@ -9,6 +9,7 @@
 #include "grainlink/dem/BedPreparation.hpp"
 #include "grainlink/dem/RigidFloor.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/dem/SteadySignal.hpp"
 #include "grainlink/mbs/Mole.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
 
@@ -112,9 +113,8 @@ Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
     return r;
 }
 
-/// The columns `names` of a series file written by dem::Series (a header, then numbers).
-std::map<std::string, std::vector<double>>
-readSeriesColumns(const std::string &path, const std::vector<std::string> &names) {
+/// Every column of a series file written by dem::Series (a header, then numbers), by name.
+std::map<std::string, std::vector<double>> readSeries(const std::string &path) {
     std::ifstream in(path);
     std::string line;
     if (!std::getline(in, line))
@@ -123,26 +123,21 @@ readSeriesColumns(const std::string &path, const std::vector<std::string> &names
     std::stringstream header_stream(line);
     for (std::string cell; std::getline(header_stream, cell, ',');)
         header.push_back(cell);
-    std::map<std::string, std::vector<double>> columns;
-    std::vector<std::pair<std::size_t, std::vector<double> *>> wanted;
-    for (const std::string &name : names) {
-        const auto at = std::find(header.begin(), header.end(), name);
-        if (at == header.end())
-            throw std::runtime_error(path + " has no column '" + name + "'");
-        wanted.emplace_back(std::size_t(at - header.begin()), &columns[name]);
-    }
+    std::vector<std::vector<double>> columns(header.size());
     while (std::getline(in, line)) {
-        std::vector<std::string> cells;
+        std::size_t c = 0;
         std::stringstream row(line);
-        for (std::string cell; std::getline(row, cell, ',');)
-            cells.push_back(cell);
-        if (cells.size() != header.size())
-            throw std::runtime_error(path + ": a row with " + std::to_string(cells.size()) +
+        for (std::string cell; std::getline(row, cell, ','); ++c)
+            if (c < header.size())
+                columns[c].push_back(std::stod(cell));
+        if (c != header.size())
+            throw std::runtime_error(path + ": a row with " + std::to_string(c) +
                                      " cells under a header of " + std::to_string(header.size()));
-        for (auto &[index, column] : wanted)
-            column->push_back(std::stod(cells[index]));
     }
-    return columns;
+    std::map<std::string, std::vector<double>> named;
+    for (std::size_t c = 0; c < header.size(); ++c)
+        named[header[c]] = std::move(columns[c]);
+    return named;
 }
 
 /// mbs_summary.json of a model run to its end time: its observables at the end and, for the
@@ -153,9 +148,26 @@ void writeModelSummary(const mbs::MultibodyModel &model, const std::string &seri
                        const std::string &path) {
     using nlohmann::json;
     json j{{"time_s", model.time()}, {"observables", model.observables()}};
+    auto c = readSeries(series_path);
+    // Every column's mean, fluctuation and batch-means standard error over the windows of the
+    // run's second half (each window one sample).
+    const std::vector<double> &time = c["time_s"];
+    const double from_s = 0.5 * (time.empty() ? 0.0 : time.back());
+    const std::size_t first =
+        std::size_t(std::lower_bound(time.begin(), time.end(), from_s) - time.begin());
+    json half = json::object();
+    for (const auto &[name, values] : c) {
+        if (name == "time_s" || values.size() <= first)
+            continue;
+        const auto v = dem::summarizeSignal({values.begin() + long(first), values.end()});
+        half[name] = {{"mean", v.mean}, {"sd", v.sd}, {"standard_error", v.standard_error}};
+    }
+    j["second_half"] = half;
+    j["second_half_from_s"] = from_s;
     if (const auto *mole = dynamic_cast<const mbs::Mole *>(&model)) {
         const std::string force = mole->settings().hull_name + ".Fz_N";
-        auto c = readSeriesColumns(series_path, {"time_s", "stroke_count", "penetration_m", force});
+        if (!c.count(force))
+            throw std::runtime_error(series_path + " has no column '" + force + "'");
         const auto strokes =
             mbs::moleStrokes(c["time_s"], c["stroke_count"], c["penetration_m"], c[force]);
         json list = json::array();

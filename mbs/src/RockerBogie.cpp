@@ -260,9 +260,16 @@ std::map<std::string, double> RockerBogie::observables() const {
     o["bogie_right_rad"] = bogies_[1].getOneQ(st, q0());
     // Constraint generalized forces are -Gᵀλ, with G = [1 1] for q_left + q_right.
     o["differential_torque_N_m"] = -differential_.getMultipliersAsVector(st)[0];
+    // Each wheel's slip as the rig's (s = 1 - v / (ω r), 0 while it does not turn): v its
+    // centre's speed along the chassis heading, ω its spin on its carrier (the drive's).
+    const SimTK::UnitVec3 heading = x.R().x();
     for (int i = 0; i < kWheels; ++i) {
         const std::string name = settings_.name_prefix + wheelSuffixes()[i];
-        o[name + "_omega_rad_s"] = wheels_[i].getOneU(st, u0());
+        const double omega = wheels_[i].getOneU(st, u0());
+        const double v_wheel = ~wheels_[i].getBodyOriginVelocity(st) * heading;
+        o[name + "_omega_rad_s"] = omega;
+        o[name + "_slip"] =
+            std::abs(omega) > 1e-9 ? 1.0 - v_wheel / (omega * wheelRadius_m()) : 0.0;
         o[name + "_motor_torque_N_m"] =
             !wheel_speed_[i].isDisabled(st) ? -wheel_speed_[i].getMultiplier(st) : torques_N_m_[i];
     }

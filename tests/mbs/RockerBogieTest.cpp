@@ -317,6 +317,9 @@ TEST_CASE("Rocker-bogie: driven wheels hold their speed and climb a slope", "[mb
     CHECK(torque == Approx(rover.totalMass_kg() * g * std::sin(alpha) * r).epsilon(1e-3));
     // It climbs at ω r less the same slip velocity (0.0061 of 0.1425 m/s); 1e-3 as above.
     CHECK(rover.chassisState().linear_velocity_m_s.x() == Approx(r - creep).epsilon(1e-3));
+    // So every wheel slips by v_s / (ω r) = 0.043; the margin is the velocity's 1e-3 over ω r.
+    for (const auto &suffix : RockerBogie::wheelSuffixes())
+        CHECK(o.at("wheel_" + suffix + "_slip") == Approx(creep / r).margin(1e-3));
 }
 
 TEST_CASE("Rocker-bogie: torque-driven wheels accelerate the rover up the slope", "[mbs][rover][slow]") {

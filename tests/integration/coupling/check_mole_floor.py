@@ -8,7 +8,8 @@
   mole ends near rest (measured 3.1524 N; the impacts throw the mole up to 19 mm high);
 - mbs_summary.json (what a study reads) lists the two strokes, each ending where mbs.csv's
   stroke count last has its number, with the penetration there and the floor's impulse over its
-  windows, recomputed here from mbs.csv.
+  windows, recomputed here from mbs.csv; and every column's mean and sd over the windows of the
+  run's second half, recomputed here for the hull's force and the penetration.
 Usage: check_mole_floor.py RUN_DIR"""
 import csv
 import json
@@ -44,5 +45,15 @@ for k, s in enumerate(listed, start=1):
           and abs(s["penetration_m"] - float(last["penetration_m"])) < 1e-12
           and abs(s["hull_impulse_N_s"] - stroke_impulse) <= 1e-9 * max(1.0, abs(stroke_impulse)))
 ok = ok and abs(summary["penetration_m"] - listed[-1]["penetration_m"]) < 1e-15
+half_from = float(rows[-1]["time_s"]) / 2
+for column in ("mole.Fz_N", "penetration_m"):
+    values = [float(r[column]) for r in rows if float(r["time_s"]) >= half_from]
+    mean = sum(values) / len(values)
+    sd = (sum((v - mean) ** 2 for v in values) / (len(values) - 1)) ** 0.5
+    got = summary["second_half"][column]
+    print(f"second half of {column}: mean {got['mean']:.6g} sd {got['sd']:.6g}; "
+          f"recomputed {mean:.6g} {sd:.6g} over {len(values)} windows")
+    ok = (ok and abs(got["mean"] - mean) <= 1e-9 * max(1.0, abs(mean))
+          and abs(got["sd"] - sd) <= 1e-9 * max(1.0, sd))
 print("ok" if ok else "FAILED")
 sys.exit(0 if ok else 1)
