@@ -10,6 +10,7 @@ import csv
 import json
 import math
 import os
+import re
 import sys
 
 import matplotlib
@@ -25,22 +26,29 @@ def number(text):
         return math.nan
 
 
+def short(text):
+    """A value as a tick label: a mapping's leaves only, one per line
+    ("{tangential: {stick_angle_deg: 5}}" -> "stick_angle_deg: 5")."""
+    leaves = re.sub(r"[\w.]+:\s*\{", "", text).replace("{", "").replace("}", "")
+    return "\n".join(part.strip() for part in leaves.split(","))
+
+
 def main(folder):
     with open(os.path.join(folder, "study.json")) as f:
         study = json.load(f)
-    keys, observables = study["varied_keys"], study["observables"]
+    observables = study["observables"]
     with open(os.path.join(folder, "table.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
+    # A key given one value (a setting shared by the whole study) has nothing to plot against.
+    keys = [k for k in study["varied_keys"] if len({r[k] for r in rows}) > 1]
     columns = keys if keys else ["(base)"]
     fig, axes = plt.subplots(len(observables), len(columns), squeeze=False,
-                             figsize=(4.5 * len(columns), 3.2 * len(observables)))
+                             figsize=(max(7.0, 4.5 * len(columns)), 3.4 * len(observables)))
     for o, name in enumerate(observables):
         for k, key in enumerate(columns):
             ax = axes[o][k]
-            # x: the key's values in table order; text values (lists) are placed by rank.
-            values = sorted({r[key] for r in rows}, key=lambda v: (math.isnan(number(v)),
-                                                                   number(v), v)) \
-                if keys else [""]
+            # x: a number at its value; text values (lists, mappings) in the design's order.
+            values = list(dict.fromkeys(r[key] for r in rows)) if keys else [""]
             numeric = keys and all(not math.isnan(number(v)) for v in values)
             position = {v: (number(v) if numeric else i) for i, v in enumerate(values)}
             others = [c for c in keys if c != key]
@@ -60,13 +68,14 @@ def main(folder):
                 ax.errorbar(x, y, yerr=err, marker="o", capsize=3, label=text)
             if keys and not numeric:
                 ax.set_xticks(range(len(values)))
-                ax.set_xticklabels(values, fontsize=8)
+                ax.set_xticklabels([short(v) for v in values], fontsize=7, rotation=20,
+                                   ha="right")
             ax.set_xlabel(key)
             ax.set_ylabel(name)
             if len(groups) > 1:
                 ax.legend(fontsize=7, loc="best")
     fig.suptitle(f"study '{study['name']}': mean ± standard error over the replicates")
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0, 1, 0.985))  # room for the title
     out = os.path.join(folder, "study.png")
     fig.savefig(out, dpi=110)
     print(f"plot_study: {len(observables)} observables x {len(keys)} varied key"
