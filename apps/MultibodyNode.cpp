@@ -23,6 +23,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <regex>
 #include <sstream>
 #include <stdexcept>
 
@@ -129,7 +130,7 @@ std::map<std::string, std::vector<double>> readSeries(const std::string &path) {
         std::stringstream row(line);
         for (std::string cell; std::getline(row, cell, ','); ++c)
             if (c < header.size())
-                columns[c].push_back(std::stod(cell));
+                columns[c].push_back(std::strtod(cell.c_str(), nullptr)); // nan, 1e-310 too
         if (c != header.size())
             throw std::runtime_error(path + ": a row with " + std::to_string(c) +
                                      " cells under a header of " + std::to_string(header.size()));
@@ -150,7 +151,8 @@ void writeModelSummary(const mbs::MultibodyModel &model, const std::string &seri
     json j{{"time_s", model.time()}, {"observables", model.observables()}};
     auto c = readSeries(series_path);
     // Every column's mean, fluctuation and batch-means standard error over the windows of the
-    // run's second half (each window one sample).
+    // run's second half (each window one sample; the run starts at t = 0). A body's column
+    // `<body>.Fz_N` is nested, second_half.<body>.Fz_N, so a study's dotted path reaches it.
     const std::vector<double> &time = c["time_s"];
     const double from_s = 0.5 * (time.empty() ? 0.0 : time.back());
     const std::size_t first =
@@ -160,7 +162,8 @@ void writeModelSummary(const mbs::MultibodyModel &model, const std::string &seri
         if (name == "time_s" || values.size() <= first)
             continue;
         const auto v = dem::summarizeSignal({values.begin() + long(first), values.end()});
-        half[name] = {{"mean", v.mean}, {"sd", v.sd}, {"standard_error", v.standard_error}};
+        half[json::json_pointer("/" + std::regex_replace(name, std::regex("\\."), "/"))] = {
+            {"mean", v.mean}, {"sd", v.sd}, {"standard_error", v.standard_error}};
     }
     j["second_half"] = half;
     j["second_half_from_s"] = from_s;
@@ -170,23 +173,29 @@ void writeModelSummary(const mbs::MultibodyModel &model, const std::string &seri
             throw std::runtime_error(series_path + " has no column '" + force + "'");
         const auto strokes =
             mbs::moleStrokes(c["time_s"], c["stroke_count"], c["penetration_m"], c[force]);
+        // A run that ends within a stroke's impact window (phase 1, "released") cut that
+        // stroke short: it is listed, marked incomplete, and left out of the statistics.
+        const bool cut = !c["phase"].empty() && std::lround(c["phase"].back()) == 1;
         json list = json::array();
         std::vector<double> advance;
         for (const mbs::MoleStroke &s : strokes) {
+            const bool complete = !(cut && &s == &strokes.back());
             list.push_back({{"stroke", s.stroke},
+                            {"complete", complete},
                             {"end_time_s", s.end_time_s},
                             {"penetration_m", s.penetration_m},
                             {"advance_m", s.advance_m},
                             {"peak_hull_force_N", s.peak_hull_force_N},
                             {"mean_hull_force_N", s.mean_hull_force_N},
                             {"hull_impulse_N_s", s.hull_impulse_N_s}});
-            if (s.stroke >= 2)
+            if (s.stroke >= 2 && complete)
                 advance.push_back(s.advance_m);
         }
         j["strokes"] = list;
         j["stroke_count"] = strokes.size();
-        j["penetration_m"] = strokes.empty() ? 0.0 : strokes.back().penetration_m;
-        j["first_stroke_penetration_m"] = strokes.empty() ? 0.0 : strokes.front().penetration_m;
+        j["penetration_m"] = model.observables().at("penetration_m"); // at the end
+        j["first_stroke_penetration_m"] =
+            strokes.empty() ? json(nullptr) : json(strokes.front().penetration_m);
         // Mean, sample sd and standard error over strokes 2..N (null with fewer than two).
         const double n = double(advance.size());
         double mean = 0.0, ss = 0.0;

@@ -28,7 +28,9 @@ def number(text):
 
 def short(text):
     """A value as a tick label: a mapping's leaves only, one per line
-    ("{tangential: {stick_angle_deg: 5}}" -> "stick_angle_deg: 5")."""
+    ("{tangential: {stick_angle_deg: 5}}" -> "stick_angle_deg: 5"); anything else as it is."""
+    if not text.startswith("{"):
+        return text
     leaves = re.sub(r"[\w.]+:\s*\{", "", text).replace("{", "").replace("}", "")
     return "\n".join(part.strip() for part in leaves.split(","))
 

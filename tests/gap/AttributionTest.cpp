@@ -473,7 +473,8 @@ TEST_CASE("the measured beds' shared luck, carried through the gain, holds the l
     INFO("shared measured luck: claims " << lucky.with << " (without it " << lucky.without << ")");
     CHECK(lucky.without > 0.1);
     CHECK(lucky.with < 0.05);
-    // The model right, the null 0.3 off, each plate on beds of its own: found nearly always.
+    // The model right, the null 0.6 off (it predicts -c), each plate on beds of its own: found
+    // nearly always.
     const Rates power = claimRate(0.05, 0.3, 0.3, 1, 500);
     INFO("power " << power.with);
     CHECK(power.with > 0.8);
