@@ -17,14 +17,17 @@ namespace grainlink::apps {
 
 namespace {
 
-/// The folder of the running executable, so programs built beside `grainlink` are found first.
-std::string ownFolder() {
+/// The running executable's path (empty if it cannot be read).
+std::string ownExecutable() {
     char path[PATH_MAX];
     const ssize_t n = ::readlink("/proc/self/exe", path, sizeof path - 1);
-    if (n <= 0)
-        return {};
-    std::string s(path, static_cast<std::size_t>(n));
-    return s.substr(0, s.rfind('/'));
+    return n > 0 ? std::string(path, static_cast<std::size_t>(n)) : std::string();
+}
+
+/// The folder of the running executable, so programs built beside `grainlink` are found first.
+std::string ownFolder() {
+    const std::string s = ownExecutable();
+    return s.empty() ? s : s.substr(0, s.rfind('/'));
 }
 
 } // namespace
@@ -59,8 +62,14 @@ void ChildProcesses::start(const std::string &name, const std::vector<std::strin
     ::posix_spawnattr_init(&attributes);
     ::posix_spawnattr_setflags(&attributes, POSIX_SPAWN_SETPGROUP);
     ::posix_spawnattr_setpgroup(&attributes, 0);
+    // A participant that is `grainlink` runs this very executable: a copy under another name,
+    // or another grainlink first on PATH, must not run the nodes of a different version.
+    const std::string self = argv[0] == "grainlink" ? ownExecutable() : std::string();
     pid_t pid = 0;
-    const int error = ::posix_spawnp(&pid, args[0], nullptr, &attributes, args.data(), environ);
+    const int error =
+        self.empty()
+            ? ::posix_spawnp(&pid, args[0], nullptr, &attributes, args.data(), environ)
+            : ::posix_spawn(&pid, self.c_str(), nullptr, &attributes, args.data(), environ);
     ::posix_spawnattr_destroy(&attributes);
     if (error != 0)
         throw std::runtime_error("cannot start participant '" + name + "' (" + argv[0] +
