@@ -196,18 +196,14 @@ void writeModelSummary(const mbs::MultibodyModel &model, const std::string &seri
         j["penetration_m"] = model.observables().at("penetration_m"); // at the end
         j["first_stroke_penetration_m"] =
             strokes.empty() ? json(nullptr) : json(strokes.front().penetration_m);
-        // Mean, sample sd and standard error over strokes 2..N (null with fewer than two).
-        const double n = double(advance.size());
-        double mean = 0.0, ss = 0.0;
-        for (double a : advance)
-            mean += a / n;
-        for (double a : advance)
-            ss += (a - mean) * (a - mean);
+        // Mean, sample sd and standard error over strokes 2..N, one batch a stroke (null with
+        // fewer than two).
+        const auto a = dem::summarizeSignal(advance, advance.size());
+        const bool two = advance.size() >= 2;
         json per_stroke{{"count", advance.size()}, {"from_stroke", 2}};
-        per_stroke["mean"] = advance.empty() ? json(nullptr) : json(mean);
-        per_stroke["sd"] = advance.size() < 2 ? json(nullptr) : json(std::sqrt(ss / (n - 1)));
-        per_stroke["standard_error"] =
-            advance.size() < 2 ? json(nullptr) : json(std::sqrt(ss / (n - 1) / n));
+        per_stroke["mean"] = advance.empty() ? json(nullptr) : json(a.mean);
+        per_stroke["sd"] = two ? json(a.sd) : json(nullptr);
+        per_stroke["standard_error"] = two ? json(a.standard_error) : json(nullptr);
         j["advance_per_stroke_m"] = per_stroke;
     }
     const std::string partial = path + ".partial";
