@@ -9,6 +9,7 @@
 #include "grainlink/dem/BedPreparation.hpp"
 #include "grainlink/dem/RigidFloor.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/dem/Series.hpp"
 #include "grainlink/dem/SteadySignal.hpp"
 #include "grainlink/mbs/Mole.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
@@ -21,10 +22,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
-#include <map>
 #include <memory>
-#include <regex>
-#include <sstream>
 #include <stdexcept>
 
 namespace grainlink::apps {
@@ -114,33 +112,6 @@ Report wheelTestReport(const config::ConfigNode &root, mbs::SingleWheelRig &rig,
     return r;
 }
 
-/// Every column of a series file written by dem::Series (a header, then numbers), by name.
-std::map<std::string, std::vector<double>> readSeries(const std::string &path) {
-    std::ifstream in(path);
-    std::string line;
-    if (!std::getline(in, line))
-        throw std::runtime_error("cannot read the series " + path);
-    std::vector<std::string> header;
-    std::stringstream header_stream(line);
-    for (std::string cell; std::getline(header_stream, cell, ',');)
-        header.push_back(cell);
-    std::vector<std::vector<double>> columns(header.size());
-    while (std::getline(in, line)) {
-        std::size_t c = 0;
-        std::stringstream row(line);
-        for (std::string cell; std::getline(row, cell, ','); ++c)
-            if (c < header.size())
-                columns[c].push_back(std::strtod(cell.c_str(), nullptr)); // nan, 1e-310 too
-        if (c != header.size())
-            throw std::runtime_error(path + ": a row with " + std::to_string(c) +
-                                     " cells under a header of " + std::to_string(header.size()));
-    }
-    std::map<std::string, std::vector<double>> named;
-    for (std::size_t c = 0; c < header.size(); ++c)
-        named[header[c]] = std::move(columns[c]);
-    return named;
-}
-
 /// mbs_summary.json of a model run to its end time: its observables at the end and, for the
 /// mole, its strokes (mbs::moleStrokes, from the run's whole series: a resumed run's too) with
 /// the advance per stroke from the second on — the first also holds the sinking into a loose
@@ -149,7 +120,7 @@ void writeModelSummary(const mbs::MultibodyModel &model, const std::string &seri
                        const std::string &path) {
     using nlohmann::json;
     json j{{"time_s", model.time()}, {"observables", model.observables()}};
-    auto c = readSeries(series_path);
+    auto c = dem::readSeries(series_path);
     // Every column's mean, fluctuation and batch-means standard error over the windows of the
     // run's second half (each window one sample; the run starts at t = 0). A body's column
     // `<body>.Fz_N` is nested, second_half.<body>.Fz_N, so a study's dotted path reaches it.
@@ -162,7 +133,9 @@ void writeModelSummary(const mbs::MultibodyModel &model, const std::string &seri
         if (name == "time_s" || values.size() <= first)
             continue;
         const auto v = dem::summarizeSignal({values.begin() + long(first), values.end()});
-        half[json::json_pointer("/" + std::regex_replace(name, std::regex("\\."), "/"))] = {
+        std::string pointer = "/" + name;
+        std::replace(pointer.begin(), pointer.end(), '.', '/');
+        half[json::json_pointer(pointer)] = {
             {"mean", v.mean}, {"sd", v.sd}, {"standard_error", v.standard_error}};
     }
     j["second_half"] = half;
@@ -175,7 +148,8 @@ void writeModelSummary(const mbs::MultibodyModel &model, const std::string &seri
             mbs::moleStrokes(c["time_s"], c["stroke_count"], c["penetration_m"], c[force]);
         // A run that ends within a stroke's impact window (phase 1, "released") cut that
         // stroke short: it is listed, marked incomplete, and left out of the statistics.
-        const bool cut = !c["phase"].empty() && std::lround(c["phase"].back()) == 1;
+        const bool cut = !c["phase"].empty() &&
+                         std::lround(c["phase"].back()) == int(mbs::Mole::Phase::Released);
         json list = json::array();
         std::vector<double> advance;
         for (const mbs::MoleStroke &s : strokes) {
@@ -193,7 +167,7 @@ void writeModelSummary(const mbs::MultibodyModel &model, const std::string &seri
         }
         j["strokes"] = list;
         j["stroke_count"] = strokes.size();
-        j["penetration_m"] = model.observables().at("penetration_m"); // at the end
+        j["penetration_m"] = j["observables"]["penetration_m"]; // at the end
         j["first_stroke_penetration_m"] =
             strokes.empty() ? json(nullptr) : json(strokes.front().penetration_m);
         // Mean, sample sd and standard error over strokes 2..N, one batch a stroke (null with

@@ -109,4 +109,30 @@ void Series::write() {
     rows_.str(std::string());
 }
 
+std::map<std::string, std::vector<double>> readSeries(const std::string &path) {
+    std::ifstream in(path);
+    std::string line;
+    if (!std::getline(in, line))
+        throw std::runtime_error("cannot read the series " + path);
+    std::vector<std::string> header;
+    std::stringstream header_stream(line);
+    for (std::string cell; std::getline(header_stream, cell, ',');)
+        header.push_back(cell);
+    std::vector<std::vector<double>> columns(header.size());
+    while (std::getline(in, line)) {
+        std::size_t c = 0;
+        std::stringstream row(line);
+        for (std::string cell; std::getline(row, cell, ','); ++c)
+            if (c < header.size())
+                columns[c].push_back(std::strtod(cell.c_str(), nullptr));
+        if (c != header.size())
+            throw std::runtime_error(path + ": a row with " + std::to_string(c) +
+                                     " cells under a header of " + std::to_string(header.size()));
+    }
+    std::map<std::string, std::vector<double>> named;
+    for (std::size_t c = 0; c < header.size(); ++c)
+        named[header[c]] = std::move(columns[c]);
+    return named;
+}
+
 } // namespace grainlink::dem

@@ -642,10 +642,6 @@ MoleSettings parseMole(const config::ConfigNode &node) {
     return s;
 }
 
-} // namespace grainlink::mbs
-
-namespace grainlink::mbs {
-
 std::vector<MoleStroke> moleStrokes(const std::vector<double> &time_s,
                                     const std::vector<double> &stroke_count,
                                     const std::vector<double> &penetration_m,

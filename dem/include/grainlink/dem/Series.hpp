@@ -3,9 +3,11 @@
 // mbs.csv): CSV files that a crash at any moment leaves readable and that a resumed run
 // continues cleanly.
 #include <cstddef>
+#include <map>
 #include <optional>
 #include <sstream>
 #include <string>
+#include <vector>
 
 namespace grainlink::dem {
 
@@ -46,5 +48,10 @@ private:
     int fd_ = -1;
     std::ostringstream rows_;
 };
+
+/// Every column of a series written by Series, by its header's name (cells read with strtod:
+/// "nan" and subnormal numbers too). A row with another number of cells than the header is an
+/// error naming the file.
+std::map<std::string, std::vector<double>> readSeries(const std::string &path);
 
 } // namespace grainlink::dem
