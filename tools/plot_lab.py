@@ -186,7 +186,14 @@ def wheel(summary, axes):
     axes[4].set_ylabel("traction [N]")
     axes[4].legend(fontsize=8)
     axes[4].grid(alpha=0.3)
-    axes[5].axis("off")
+    if all("side_force_N" in r for r in runs):
+        axes[5].errorbar(slip, [r["side_force_N"] for r in runs],
+                         yerr=[r["side_force_sd_N"] for r in runs], fmt="o-", capsize=3)
+        axes[5].set_xlabel("slip s [-]")
+        axes[5].set_ylabel(f"side force [N] (slip angle {runs[0]['slip_angle_deg']:g} deg)")
+        axes[5].grid(alpha=0.3)
+    else:  # a summary from before the side force
+        axes[5].axis("off")
     axes[0].set_title("Single-wheel test: steady values (mean +- sd)")
 
 

@@ -1,6 +1,7 @@
 #include "grainlink/gap/Effects.hpp"
 
 #include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/lab/Wheel.hpp"
 
 #include <muParser.h>
 
@@ -186,6 +187,21 @@ void applyDomainSize(YAML::Node scenario, double f_x, double f_y) {
         }
     soil["deposition"]["count"] =
         std::llround(soil["deposition"]["count"].as<double>() * f_x * f_y);
+}
+
+/// The factor a wheel bin's width (y) is scaled by for a domain width factor s: the clearance
+/// between the wheel's footprint and the walls scales by s, the footprint stays (a steered
+/// wheel's reaches further across), so that a narrower bin still holds the wheel.
+double wheelBinFactor(const YAML::Node &scenario, double s) {
+    const YAML::Node region = scenario["soil"]["deposition"]["region"];
+    const double width = region["upper_m"][1].as<double>() - region["lower_m"][1].as<double>();
+    const YAML::Node wheel = scenario["wheel"], shape = wheel["shape"];
+    const double reach = 0.5 * shape["diameter_m"].as<double>() +
+                         (shape["grouser_height_m"] ? shape["grouser_height_m"].as<double>() : 0.0);
+    const double beta = wheel["slip_angle_deg"] ? wheel["slip_angle_deg"].as<double>() : 0.0;
+    const double footprint =
+        2.0 * lab::steeredHalfExtent(reach, shape["width_m"].as<double>(), beta).y();
+    return (footprint + s * (width - footprint)) / width;
 }
 
 } // namespace
@@ -431,9 +447,9 @@ YAML::Node applyEffect(const Effect &effect, double s, const YAML::Node &scenari
     if (effect.builtin == "domain_size") {
         // A direct shear box and a repose tube are the test's own geometry (their sizes are
         // measured conditions), not a container around the bed; a wheel's bin confines it
-        // across its width (y), its length being the travel.
+        // across its width (y) beyond its footprint, its length being the travel.
         if (type == ExperimentType::WheelSteadyState)
-            applyDomainSize(out, 1.0, s);
+            applyDomainSize(out, 1.0, wheelBinFactor(out, s));
         else if (type != ExperimentType::DirectShear && type != ExperimentType::AngleOfRepose)
             applyDomainSize(out, s, s);
         return out;

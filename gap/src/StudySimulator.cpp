@@ -60,8 +60,8 @@ std::string boxOf(const Experiment &e) {
 
 /// The conditions of a wheel experiment that make its test (the wheel and its load): wheel
 /// experiments that share them run as one test, one slip per run.
-constexpr const char *kWheelConditions[] = {"wheel_radius_m", "wheel_width_m", "grouser_count",
-                                            "grouser_height_m", "load_N"};
+constexpr const char *kWheelConditions[] = {"wheel_radius_m",   "wheel_width_m", "grouser_count",
+                                            "grouser_height_m", "load_N",        "slip_angle_deg"};
 
 /// What a test is run for besides its type and box: a wheel's geometry and load.
 std::string rigOf(const Experiment &e) {
@@ -79,10 +79,10 @@ std::string rigOf(const Experiment &e) {
 std::string unsupported(const Experiment &e) {
     if (e.type == ExperimentType::WheelSteadyState) {
         const auto beta = e.numbers.find("slip_angle_deg");
-        if (beta != e.numbers.end() && beta->second != 0.0) {
+        if (beta != e.numbers.end() && !(beta->second >= 0.0 && beta->second <= 90.0)) {
             std::ostringstream why;
             why << "slip angle " << beta->second
-                << " deg: the lab's wheel runs straight (slip angle 0)";
+                << " deg: the lab's wheel is steered between 0 and 90 deg";
             return why.str();
         }
     }
@@ -193,21 +193,23 @@ void wheelSection(YAML::Node section, const ExperimentSet &design, const Feature
     }
     if (const auto load = condition("load_N"))
         section["load_N"] = *load;
+    if (const auto beta = condition("slip_angle_deg"))
+        section["slip_angle_deg"] = *beta;
 }
 
 /// A wheel experiment's observable over slip from the wheel test's runs: each run's steady
-/// value at its slip. The mean side force of a wheel running straight is zero by symmetry.
+/// value at its slip.
 Curve wheelCurve(const lab::LabSummary &summary, const std::string &observable) {
-    static const std::set<std::string> steady{"traction_N", "vertical_load_N", "sinkage_m",
-                                              "torque_N_m"};
+    static const std::set<std::string> steady{"traction_N", "side_force_N", "vertical_load_N",
+                                              "sinkage_m", "torque_N_m"};
     const std::string key = observable == "drawbar_pull_N" ? "traction_N" : observable;
-    if (key != "side_force_N" && !steady.count(key))
+    if (!steady.count(key))
         throw std::invalid_argument("the lab's wheel test gives no '" + observable +
                                     "' (traction_N, drawbar_pull_N, vertical_load_N, sinkage_m, "
                                     "torque_N_m, side_force_N)");
     std::vector<std::pair<double, double>> points;
     for (const auto &run : summary.runs)
-        points.emplace_back(run.value("slip"), key == "side_force_N" ? 0.0 : run.value(key));
+        points.emplace_back(run.value("slip"), run.value(key));
     std::sort(points.begin(), points.end());
     Curve c;
     for (const auto &[x, y] : points) {
@@ -231,11 +233,8 @@ std::vector<std::string> simulatedConditions(ExperimentType type) {
         return {"normal_stress_Pa"};
     case ExperimentType::BevameterShear:
         return {"normal_pressure_Pa"};
-    case ExperimentType::WheelSteadyState: {
-        std::vector<std::string> keys(std::begin(kWheelConditions), std::end(kWheelConditions));
-        keys.push_back("slip_angle_deg");
-        return keys;
-    }
+    case ExperimentType::WheelSteadyState:
+        return {std::begin(kWheelConditions), std::end(kWheelConditions)};
     default:
         return {};
     }

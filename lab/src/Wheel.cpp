@@ -25,6 +25,17 @@ double rimSpeed(double carriage_speed_m_s, double slip) {
     return slip >= 0.0 ? carriage_speed_m_s / (1.0 - slip) : carriage_speed_m_s * (1.0 + slip);
 }
 
+WheelFrame steeredFrame(double slip_angle_deg) {
+    const double b = slip_angle_deg * M_PI / 180.0, c = std::cos(b), s = std::sin(b);
+    return {Vec3(c, s, 0.0), Vec3(-s, c, 0.0), Vec3(s, -c, 0.0)};
+}
+
+Eigen::Vector2d steeredHalfExtent(double outer_radius_m, double width_m, double slip_angle_deg) {
+    const WheelFrame f = steeredFrame(slip_angle_deg);
+    return {outer_radius_m * f.heading.x() + 0.5 * width_m * f.heading.y(),
+            outer_radius_m * f.heading.y() + 0.5 * width_m * f.heading.x()};
+}
+
 WheelScenario parseWheel(const config::ConfigNode &root) {
     WheelScenario s;
     s.name = root["name"].text();
@@ -42,6 +53,8 @@ WheelScenario parseWheel(const config::ConfigNode &root) {
     }
     if (t.slips.empty())
         w["slips"].fail("give at least one slip");
+    if (w.has("slip_angle_deg"))
+        t.slip_angle_deg = w["slip_angle_deg"].number(0.0, 90.0);
     t.carriage_speed_m_s = w["carriage_speed_m_s"].positive();
     t.travel_m = w["travel_m"].positive();
     if (w.has("steady_fraction"))
@@ -76,15 +89,26 @@ WheelScenario parseWheel(const config::ConfigNode &root) {
     }
     if (t.end_margin_m == 0.0)
         t.end_margin_m = 4.0 * r_max;
-    const double reach = 0.5 * t.shape.diameter_m + t.shape.grouser_height_m;
-    const double room = s.soil.deposition.region_upper_m.x() - s.soil.deposition.region_lower_m.x() -
-                        2.0 * (reach + t.end_margin_m);
+    const Eigen::Vector2d half = steeredHalfExtent(
+        0.5 * t.shape.diameter_m + t.shape.grouser_height_m, t.shape.width_m, t.slip_angle_deg);
+    const double half_x = half.x(), half_y = half.y();
+    const Vec3 &lo = s.soil.deposition.region_lower_m, &hi = s.soil.deposition.region_upper_m;
+    const double room = hi.x() - lo.x() - 2.0 * (half_x + t.end_margin_m);
     if (t.travel_m > room) {
         std::ostringstream msg;
-        msg << "the wheel (outer radius " << reach << " m, " << t.end_margin_m
-            << " m from each end) can travel at most " << std::max(room, 0.0)
+        msg << "the wheel (" << half_x << " m from its centre to its front along x, "
+            << t.end_margin_m << " m from each end) can travel at most " << std::max(room, 0.0)
             << " m along x in the deposition region; shorten travel_m or lengthen the region";
         w["travel_m"].fail(msg.str());
+    }
+    // Across the travel it keeps a grain's diameter from the region's sides.
+    if (2.0 * (half_y + 2.0 * r_max) > hi.y() - lo.y() + 1e-12) {
+        std::ostringstream msg;
+        msg << "the wheel reaches " << half_y << " m across the travel at slip angle "
+            << t.slip_angle_deg << " deg; with a grain diameter to spare on each side it needs a "
+            << 2.0 * (half_y + 2.0 * r_max) << " m wide region (y), not " << hi.y() - lo.y()
+            << " m: widen the region or lower the slip angle";
+        (w.has("slip_angle_deg") ? w["slip_angle_deg"] : w["shape"]["width_m"]).fail(msg.str());
     }
     root.finish();
     return s;
@@ -97,9 +121,11 @@ WheelScenario loadWheel(const std::string &path) {
 namespace {
 
 /// Prescribed motion of the wheel (mesh body 0): piecewise-constant carriage speed, vertical
-/// speed and spin about y, changed between sample intervals by retarget().
+/// speed and spin about the steered axle, changed between sample intervals by retarget().
 struct WheelDrive {
     dem::RigidBodyState initial;
+    dem::Quat yaw = dem::Quat::Identity();                         ///< the slip angle about z
+    Vec3 axle = Vec3::UnitY();                                     ///< yaw applied to y
     double t_ref = 0.0, x_ref = 0.0, z_ref = 0.0, theta_ref = 0.0; ///< at the last change
     double v_x = 0.0, v_z = 0.0, omega = 0.0;                      ///< since then
     double x(double t) const { return x_ref + v_x * (t - t_ref); }
@@ -109,9 +135,9 @@ struct WheelDrive {
         dem::RigidBodyState s = initial;
         s.position_m.x() = x(t);
         s.position_m.z() = z(t);
-        s.orientation = dem::Quat(Eigen::AngleAxisd(theta(t), Vec3::UnitY()));
+        s.orientation = yaw * dem::Quat(Eigen::AngleAxisd(theta(t), Vec3::UnitY()));
         s.linear_velocity_m_s = Vec3(v_x, 0.0, v_z);
-        s.angular_velocity_rad_s = Vec3(0.0, omega, 0.0);
+        s.angular_velocity_rad_s = omega * axle;
         return s;
     }
     dem::SegmentedMotion motion() const { return dem::constantVelocity(at(t_ref), t_ref); }
@@ -152,6 +178,7 @@ struct WheelExperiment {
         Result result;
         result.shape = scenario.test.shape;
         result.load_N = scenario.test.load_N;
+        result.slip_angle_deg = scenario.test.slip_angle_deg;
         result.resolution = scenario.test.shape.width_m / (2.0 * bed.summary.largest_radius_m);
         return result;
     }
@@ -175,14 +202,20 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
     dem::DemSystem sys = *bed.system; // every slip drives on its own copy of the settled bed
     WheelRun run;
     run.slip = slip;
+    run.slip_angle_deg = t.slip_angle_deg;
     run.carriage_speed_m_s = t.carriage_speed_m_s;
     run.angular_speed_rad_s = rimSpeed(t.carriage_speed_m_s, slip) / radius;
     run.surface_m = surface;
-    const double x0 = lower.x() + t.end_margin_m + reach;
+    const WheelFrame frame = steeredFrame(t.slip_angle_deg);
+    // The wheel's footprint starts end_margin_m in from the region's end.
+    const double x0 = lower.x() + t.end_margin_m +
+                      steeredHalfExtent(reach, t.shape.width_m, t.slip_angle_deg).x();
     // The lowest point starts above every grain under the wheel's footprint.
     const double highest = highestGrainUnder(
         sys.particles(), Eigen::Vector2d(x0, y), std::hypot(reach, 0.5 * t.shape.width_m), surface);
     WheelDrive drive;
+    drive.yaw = dem::Quat(Eigen::AngleAxisd(t.slip_angle_deg * M_PI / 180.0, Vec3::UnitZ()));
+    drive.axle = frame.axle;
     drive.initial.position_m = Vec3(x0, y, highest + t.start_clearance_m + reach);
     drive.t_ref = sys.time();
     drive.x_ref = x0;
@@ -247,14 +280,15 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
         WheelSample x;
         x.time_s = s.t_mid_s - t_drive;
         x.travel_m = drive.x(s.t_mid_s) - x_drive;
-        x.traction_N = s.load.force_N.x();
+        x.traction_N = s.load.force_N.dot(frame.heading);
+        x.side_force_N = s.load.force_N.dot(frame.side);
         x.vertical_load_N = s.load.force_N.z();
-        x.torque_N_m = -s.load.torque_N_m.y();
+        x.torque_N_m = -s.load.torque_N_m.dot(frame.axle);
         x.sinkage_m = surface - (drive.z(s.t_mid_s) - radius);
         run.samples.push_back(x);
         const double travelled = drive.x(sys.time()) - x_drive;
         progress.update(sys.time() - t0, travelled / t.travel_m, run.steps * sys.particles().size(),
-                        "travel " + std::to_string(travelled * 1e3) + " mm, F_x " +
+                        "travel " + std::to_string(travelled * 1e3) + " mm, traction " +
                             std::to_string(x.traction_N) + " N");
         if (travelled >= t.travel_m - 1e-12)
             break;
@@ -268,6 +302,7 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
                                  std::to_string(slip) +
                                  ": lengthen travel_m or shorten sample_interval_s");
     run.traction_N = steady(run.samples, run.steady_samples, &WheelSample::traction_N);
+    run.side_force_N = steady(run.samples, run.steady_samples, &WheelSample::side_force_N);
     run.vertical_load_N = steady(run.samples, run.steady_samples, &WheelSample::vertical_load_N);
     run.torque_N_m = steady(run.samples, run.steady_samples, &WheelSample::torque_N_m);
     run.sinkage_m = steady(run.samples, run.steady_samples, &WheelSample::sinkage_m);
@@ -275,15 +310,17 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
         run.max_load_error = std::max(
             run.max_load_error, std::abs(run.samples[i].vertical_load_N - t.load_N) / t.load_N);
     run.wall_s = secondsSince(run_start);
-    std::fprintf(stderr,
-                 "[wheel] slip %.3g: carriage %.4g m/s, spin %.4g rad/s, loaded in %.3f s (static sinkage %.2f "
-                 "mm); steady traction %.4g +- %.2g N, load %.4g +- %.2g N, torque %.4g +- %.2g "
-                 "N m, sinkage %.2f +- %.2f mm; %llu steps in %.1f s\n",
-                 slip, run.carriage_speed_m_s, run.angular_speed_rad_s, run.load_time_s, run.sinkage_at_load_m * 1e3,
-                 run.traction_N.mean, run.traction_N.sd, run.vertical_load_N.mean,
-                 run.vertical_load_N.sd, run.torque_N_m.mean, run.torque_N_m.sd,
-                 run.sinkage_m.mean * 1e3, run.sinkage_m.sd * 1e3,
-                 static_cast<unsigned long long>(run.steps), run.wall_s);
+    std::fprintf(
+        stderr,
+        "[wheel] slip %.3g at slip angle %.3g deg: carriage %.4g m/s, spin %.4g rad/s, loaded "
+        "in %.3f s (static sinkage %.2f mm); steady traction %.4g +- %.2g N, side force "
+        "%.4g +- %.2g N, load %.4g +- %.2g N, torque %.4g +- %.2g N m, sinkage %.2f +- "
+        "%.2f mm; %llu steps in %.1f s\n",
+        slip, run.slip_angle_deg, run.carriage_speed_m_s, run.angular_speed_rad_s, run.load_time_s,
+        run.sinkage_at_load_m * 1e3, run.traction_N.mean, run.traction_N.sd, run.side_force_N.mean,
+        run.side_force_N.sd, run.vertical_load_N.mean, run.vertical_load_N.sd, run.torque_N_m.mean,
+        run.torque_N_m.sd, run.sinkage_m.mean * 1e3, run.sinkage_m.sd * 1e3,
+        static_cast<unsigned long long>(run.steps), run.wall_s);
     return run;
 }
 
@@ -299,19 +336,20 @@ std::string WheelResult::report() const {
     out << "Single-wheel test at set slips\n";
     writeBedLine(out, bed);
     out << "  wheel D = " << shape.diameter_m * 1e3 << " mm, b = " << shape.width_m * 1e3 << " mm, "
-        << shape.grouser_count << " grousers of " << shape.grouser_height_m * 1e3
-        << " mm; load " << load_N << " N; Gamma = b / (2 r_max) = " << resolution << "\n";
+        << shape.grouser_count << " grousers of " << shape.grouser_height_m * 1e3 << " mm; load "
+        << load_N << " N; slip angle " << slip_angle_deg
+        << " deg; Gamma = b / (2 r_max) = " << resolution << "\n";
     out << "  steady means +- sd over the last stretch of travel (s = (v_rim - v) / max(v_rim, "
-           "v)):\n";
+           "v); traction along the wheel's heading, side force across it):\n";
     for (const auto &r : runs)
-        out << "  s = " << r.slip << ": traction " << r.traction_N.mean << " +- "
-            << r.traction_N.sd << " N, vertical load " << r.vertical_load_N.mean << " +- "
-            << r.vertical_load_N.sd << " N (within " << 100 * r.max_load_error
-            << " %), torque " << r.torque_N_m.mean << " +- " << r.torque_N_m.sd
-            << " N m, sinkage " << r.sinkage_m.mean * 1e3 << " +- " << r.sinkage_m.sd * 1e3
-            << " mm (static " << r.sinkage_at_load_m * 1e3 << " mm); " << r.steady_samples
-            << " of " << r.samples.size() << " samples; " << r.steps << " steps, " << r.wall_s
-            << " s wall\n";
+        out << "  s = " << r.slip << ": traction " << r.traction_N.mean << " +- " << r.traction_N.sd
+            << " N, side force " << r.side_force_N.mean << " +- " << r.side_force_N.sd
+            << " N, vertical load " << r.vertical_load_N.mean << " +- " << r.vertical_load_N.sd
+            << " N (within " << 100 * r.max_load_error << " %), torque " << r.torque_N_m.mean
+            << " +- " << r.torque_N_m.sd << " N m, sinkage " << r.sinkage_m.mean * 1e3 << " +- "
+            << r.sinkage_m.sd * 1e3 << " mm (static " << r.sinkage_at_load_m * 1e3 << " mm); "
+            << r.steady_samples << " of " << r.samples.size() << " samples; " << r.steps
+            << " steps, " << r.wall_s << " s wall\n";
     out << "  total wall time " << wall_s << " s\n";
     return out.str();
 }
@@ -321,10 +359,13 @@ LabSummary WheelResult::summary() const {
     for (const auto &r : runs) {
         LabRunSummary x;
         x.values = {{"slip", r.slip},
+                    {"slip_angle_deg", r.slip_angle_deg},
                     {"carriage_speed_m_s", r.carriage_speed_m_s},
                     {"angular_speed_rad_s", r.angular_speed_rad_s},
                     {"traction_N", r.traction_N.mean},
                     {"traction_sd_N", r.traction_N.sd},
+                    {"side_force_N", r.side_force_N.mean},
+                    {"side_force_sd_N", r.side_force_N.sd},
                     {"vertical_load_N", r.vertical_load_N.mean},
                     {"vertical_load_sd_N", r.vertical_load_N.sd},
                     {"torque_N_m", r.torque_N_m.mean},
@@ -338,11 +379,12 @@ LabSummary WheelResult::summary() const {
                     {"surface_m", r.surface_m},
                     {"steps", double(r.steps)},
                     {"wall_s", r.wall_s}};
-        std::vector<double> time, travel, traction, load, torque, sinkage;
+        std::vector<double> time, travel, traction, side, load, torque, sinkage;
         for (const auto &p : r.samples) {
             time.push_back(p.time_s);
             travel.push_back(p.travel_m);
             traction.push_back(p.traction_N);
+            side.push_back(p.side_force_N);
             load.push_back(p.vertical_load_N);
             torque.push_back(p.torque_N_m);
             sinkage.push_back(p.sinkage_m);
@@ -351,6 +393,7 @@ LabSummary WheelResult::summary() const {
         x.curves = {{"time_s", time},
                     {"travel_m", travel},
                     {"traction_series_N", traction},
+                    {"side_force_series_N", side},
                     {"vertical_load_series_N", load},
                     {"torque_series_N_m", torque},
                     {"sinkage_series_m", sinkage}};
@@ -362,23 +405,27 @@ LabSummary WheelResult::summary() const {
 void WheelResult::writeCsvs(const std::string &directory) const {
     const fs::path dir(directory);
     {
-        auto csv = openCsv(dir, "wheel_travel.csv",
-                           "slip,time_s,travel_m,traction_N,vertical_load_N,torque_N_m,sinkage_m");
+        auto csv =
+            openCsv(dir, "wheel_travel.csv",
+                    "slip,slip_angle_deg,time_s,travel_m,traction_N,side_force_N,vertical_load_N,"
+                    "torque_N_m,sinkage_m");
         for (const auto &r : runs)
             for (const auto &s : r.samples)
-                csv << r.slip << ',' << s.time_s << ',' << s.travel_m << ',' << s.traction_N << ','
-                    << s.vertical_load_N << ',' << s.torque_N_m << ',' << s.sinkage_m << '\n';
+                csv << r.slip << ',' << r.slip_angle_deg << ',' << s.time_s << ',' << s.travel_m
+                    << ',' << s.traction_N << ',' << s.side_force_N << ',' << s.vertical_load_N
+                    << ',' << s.torque_N_m << ',' << s.sinkage_m << '\n';
     }
     auto csv = openCsv(dir, "wheel_slip.csv",
-                       "slip,carriage_speed_m_s,angular_speed_rad_s,traction_N,traction_sd_N,vertical_load_N,"
+                       "slip,slip_angle_deg,carriage_speed_m_s,angular_speed_rad_s,traction_N,"
+                       "traction_sd_N,side_force_N,side_force_sd_N,vertical_load_N,"
                        "vertical_load_sd_N,torque_N_m,torque_sd_N_m,sinkage_m,sinkage_sd_m,"
                        "steady_samples");
     for (const auto &r : runs)
-        csv << r.slip << ',' << r.carriage_speed_m_s << ',' << r.angular_speed_rad_s << ','
-            << r.traction_N.mean << ','
-            << r.traction_N.sd << ',' << r.vertical_load_N.mean << ',' << r.vertical_load_N.sd
-            << ',' << r.torque_N_m.mean << ',' << r.torque_N_m.sd << ',' << r.sinkage_m.mean << ','
-            << r.sinkage_m.sd << ',' << r.steady_samples << '\n';
+        csv << r.slip << ',' << r.slip_angle_deg << ',' << r.carriage_speed_m_s << ','
+            << r.angular_speed_rad_s << ',' << r.traction_N.mean << ',' << r.traction_N.sd << ','
+            << r.side_force_N.mean << ',' << r.side_force_N.sd << ',' << r.vertical_load_N.mean
+            << ',' << r.vertical_load_N.sd << ',' << r.torque_N_m.mean << ',' << r.torque_N_m.sd
+            << ',' << r.sinkage_m.mean << ',' << r.sinkage_m.sd << ',' << r.steady_samples << '\n';
 }
 
 Quantities wheelQuantities(const WheelResult &result) {
@@ -388,6 +435,8 @@ Quantities wheelQuantities(const WheelResult &result) {
         at << ", s = " << r.slip;
         q.push_back({"traction" + at.str(), "N", r.traction_N.mean});
         q.push_back({"sinkage" + at.str(), "m", r.sinkage_m.mean});
+        if (r.slip_angle_deg != 0.0) // straight, its mean is zero by symmetry
+            q.push_back({"side force" + at.str(), "N", r.side_force_N.mean});
     }
     return q;
 }

@@ -160,6 +160,40 @@ TEST_CASE("polydispersity keeps the mean radius and the solid volume; domain siz
     CHECK(big["soil"]["deposition"]["count"].as<double>() == Approx(4500));
 }
 
+TEST_CASE("a narrower wheel bin keeps the wheel's footprint: the clearance to the walls is what "
+          "shrinks, a steered wheel's footprint being wider",
+          "[gap][effects][wheel]") {
+    const EffectCatalogue c = shippedEffects();
+    // A 160 mm wide bin around a smooth wheel 116 mm across and 50 mm wide.
+    const YAML::Node base = YAML::Load(R"(
+soil:
+  walls: [{name: bin, type: box, lower_m: [0, 0, 0], upper_m: [0.4, 0.16, 0.4]}]
+  deposition: {region: {lower_m: [0, 0, 0], upper_m: [0.4, 0.16, 0.2]}, count: 4000}
+wheel: {shape: {diameter_m: 0.116, width_m: 0.05}}
+)");
+    const auto width = [&](const YAML::Node &scenario, double s) {
+        const YAML::Node out =
+            applyEffect(c.find("domain_size"), s, scenario, ExperimentType::WheelSteadyState);
+        const auto lo = out["soil"]["walls"][0]["lower_m"].as<std::vector<double>>();
+        const auto hi = out["soil"]["walls"][0]["upper_m"].as<std::vector<double>>();
+        CHECK(hi[0] - lo[0] == Approx(0.4)); // the travel's length stays
+        CHECK(0.5 * (lo[1] + hi[1]) == Approx(0.08));
+        return hi[1] - lo[1];
+    };
+    // Straight, the footprint is the 50 mm width: 55 mm each side, times 0.6 is 33 mm.
+    CHECK(width(base, 0.6) == Approx(0.05 + 0.6 * 0.11));
+    CHECK(width(base, 1.5) == Approx(0.05 + 1.5 * 0.11));
+    // Steered across the travel it is the 116 mm diameter: 22 mm each side, times 0.6 is 13.2 mm.
+    YAML::Node steered = YAML::Clone(base);
+    steered["wheel"]["slip_angle_deg"] = 90.0;
+    CHECK(width(steered, 0.6) == Approx(0.116 + 0.6 * 0.044));
+    // At 30 deg with 5 mm grousers: 2 (63 sin 30 + 25 cos 30) mm = 106.3 mm.
+    steered["wheel"]["slip_angle_deg"] = 30.0;
+    steered["wheel"]["shape"]["grouser_height_m"] = 0.005;
+    const double footprint = 2.0 * (0.063 * 0.5 + 0.025 * std::sqrt(3.0) / 2.0);
+    CHECK(width(steered, 0.75) == Approx(footprint + 0.75 * (0.16 - footprint)));
+}
+
 TEST_CASE("measurement effects shift the simulated sinkage: a constant offset, or compliance x force",
           "[gap][effects]") {
     const EffectCatalogue c = shippedEffects();

@@ -103,14 +103,15 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
           "load from their conditions, every effect and check a scenario the lab accepts",
           "[gap][simulator][wheel]") {
     // The CMU base model's wheels, as `gap import cmu` describes them: straight runs of the
-    // smooth and the grousered wheel, and one at a slip angle the lab's wheel does not run.
+    // smooth and the grousered wheel, the smooth one steered by 30 deg, and one at a slip angle
+    // the lab's wheel does not run.
     const BaseModel base =
         loadBaseModel(std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml");
     ExperimentSet set;
     set.name = "wheels";
     for (const auto &[id, grouser, beta] :
          {std::tuple{"smooth_beta0", 0.0, 0.0}, std::tuple{"grouser_beta0", 0.005, 0.0},
-          std::tuple{"smooth_beta30", 0.0, 30.0}}) {
+          std::tuple{"smooth_beta30", 0.0, 30.0}, std::tuple{"smooth_beta120", 0.0, 120.0}}) {
         Experiment e;
         e.id = id;
         e.type = ExperimentType::WheelSteadyState;
@@ -129,9 +130,9 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     }
     std::vector<std::string> left_out;
     const ExperimentSet kept = simulable(set, base, left_out);
-    REQUIRE(kept.experiments.size() == 2);
+    REQUIRE(kept.experiments.size() == 3);
     REQUIRE(left_out.size() == 1);
-    CHECK(left_out[0].find("smooth_beta30 (wheel_steady_state: slip angle 30") == 0);
+    CHECK(left_out[0].find("smooth_beta120 (wheel_steady_state: slip angle 120") == 0);
     CHECK(kept.notes.empty()); // every condition of these wheels sets up their test
     // A condition the simulation does not read is said, with the ones it does: a diameter
     // given for the radius left the base's wheel in its place without a word.
@@ -149,8 +150,8 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     fs::remove_all(scratch);
     fs::create_directories(scratch);
     const StudySimulator sim(base, (scratch / "sims").string(), {});
-    // One test per wheel: the two wheels differ in their grousers.
-    CHECK(sim.groups(kept).size() == 2);
+    // One test per wheel and slip angle: the two wheels differ in their grousers.
+    CHECK(sim.groups(kept).size() == 3);
     const FeatureDesign fd = designFeatures(kept);
     const auto check = [&](const std::string &id, const VariantRequest &r) {
         const fs::path file = scratch / (r.label + "-" + id + ".yaml");
@@ -162,6 +163,8 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     VariantRequest plain;
     plain.label = "base";
     const auto smooth = check("smooth_beta0", plain), grouser = check("grouser_beta0", plain);
+    CHECK(smooth.test.slip_angle_deg == 0.0);
+    CHECK(check("smooth_beta30", plain).test.slip_angle_deg == 30.0);
     CHECK(smooth.test.shape.grouser_count == 0);
     CHECK(grouser.test.shape.grouser_count == 12);
     CHECK(grouser.test.shape.grouser_height_m == 0.005);
@@ -181,7 +184,7 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
         CHECK(smooth.test.slips[i] == Approx(measured[i]).margin(1e-6));
 
     forEveryVariant(sim, [&](const VariantRequest &r) {
-        for (const char *id : {"smooth_beta0", "grouser_beta0"})
+        for (const char *id : {"smooth_beta0", "grouser_beta0", "smooth_beta30"})
             CHECK_NOTHROW(check(id, r));
     });
     fs::remove_all(scratch);
