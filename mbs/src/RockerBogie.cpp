@@ -85,6 +85,11 @@ RockerBogie::RockerBogie(const RockerBogieSettings &settings)
         matter_.Ground(), SimTK::Transform(),
         rigidBody(s.chassis_mass_kg, s.chassis_com_m, s.chassis_inertia_kg_m2, "chassis"),
         SimTK::Transform());
+    // A free mobilizer's speeds are its angular velocity, then its linear velocity, both in
+    // the ground frame: u 3 and 4 are v_x and v_y.
+    for (int k = 0; k < 2; ++k)
+        chassis_hold_[k] =
+            SimTK::Constraint::ConstantSpeed(chassis_, SimTK::MobilizerUIndex(3 + k), 0.0);
     std::array<SimTK::MobilizedBody, 6> carriers;
     std::array<Vec3, 6> wheel_in_carrier;
     for (int side = 0; side < 2; ++side) {
@@ -148,9 +153,21 @@ RockerBogie::RockerBogie(const RockerBogieSettings &settings)
     torque_drive_ = s.drive_torques_N_m.has_value();
     if (torque_drive_)
         torques_N_m_ = *s.drive_torques_N_m;
-    locked_ = s.rotation_locked;
+    locked_ = s.rotation_locked || s.release_time_s.has_value();
+    hold_in_drop_ = s.hold_chassis_in_drop;
     applyDrive();
     saveState();
+}
+
+std::vector<double> RockerBogie::advanceTo(double time_s) {
+    // Decided from the time, so that a restored window decides again. A window that straddles
+    // the release ends the drop at its start.
+    if (settings_.release_time_s) {
+        const bool drop = time() < *settings_.release_time_s - 1e-9;
+        if (drop != locked_)
+            setRotationLocked(drop);
+    }
+    return SimbodyModel::advanceTo(time_s);
 }
 
 void RockerBogie::applyDrive() {
@@ -168,6 +185,16 @@ void RockerBogie::applyDrive() {
             if (!c.isDisabled(st))
                 c.disable(st);
             discrete_.setOneMobilityForce(st, wheels_[i], u0(), torques_N_m_[i]);
+        }
+    }
+    for (int k = 0; k < 2; ++k) {
+        auto &c = chassis_hold_[k];
+        if (locked_ && hold_in_drop_) {
+            if (c.isDisabled(st))
+                c.enable(st);
+            chassis_.setOneU(st, SimTK::MobilizerUIndex(3 + k), 0.0);
+        } else if (!c.isDisabled(st)) {
+            c.disable(st); // released with the wheels: the chassis is free
         }
     }
     system_.realize(st, SimTK::Stage::Velocity);
@@ -376,6 +403,16 @@ RockerBogieSettings parseRockerBogie(const config::ConfigNode &node) {
     if (auto n = node.optional("drive_torque_N_m"))
         s.drive_torques_N_m = perWheel(*n);
     s.rotation_locked = node.boolean("rotation_locked", false);
+    if (node.has("release_time_s")) {
+        if (s.rotation_locked)
+            node["release_time_s"].fail("the wheels are locked for the whole run "
+                                        "(rotation_locked: true): remove one of the two");
+        s.release_time_s = node["release_time_s"].positive();
+    }
+    s.hold_chassis_in_drop = node.boolean("hold_chassis_in_drop", false);
+    if (s.hold_chassis_in_drop && !s.release_time_s)
+        node["hold_chassis_in_drop"].fail("a hold in the drop needs the drop's end: give "
+                                          "release_time_s");
     // One drive, and none for wheels that stay locked (nothing unlocks them in a coupled run).
     for (const char *key : {"wheel_speed_rad_s", "drive_torque_N_m"}) {
         if (!node.has(key))

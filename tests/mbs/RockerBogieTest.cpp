@@ -322,6 +322,41 @@ TEST_CASE("Rocker-bogie: driven wheels hold their speed and climb a slope", "[mb
         CHECK(o.at("wheel_" + suffix + "_slip") == Approx(creep / r).margin(1e-3));
 }
 
+TEST_CASE("Rocker-bogie: held in the drop, it comes down onto a slope without sliding; released, "
+          "it climbs as a free one does",
+          "[mbs][rover][slow]") {
+    // The 10° slope of the test above; the chassis' horizontal velocity held while locked.
+    const double alpha = 10.0 * SimTK::Pi / 180.0, g = 3.71;
+    auto settings = resting();
+    settings.gravity_m_s2 = Vec3(-g * std::sin(alpha), 0.0, -g * std::cos(alpha));
+    settings.wheel_speeds_rad_s.fill(1.0);
+    settings.rotation_locked = false;
+    settings.release_time_s = 0.5;
+    settings.hold_chassis_in_drop = true;
+    settings.start_position_m.z() += 0.02; // dropped from 20 mm
+    RockerBogie rover(settings);
+    CHECK(rover.rotationLocked());
+    PenaltyGround ground;
+    ground.friction_coefficient = 0.6;
+    const Vec3 start = rover.chassisState().position_m;
+    ground.run(rover, 0.5);
+    // Held, it neither creeps down the slope (free, it creeps at v_s, above) nor sideways; it
+    // came down the 20 mm onto its wheels. 1e-9 m: the constraint holds the velocity to the
+    // integrator's accuracy.
+    const RigidState held = rover.chassisState();
+    CHECK(held.linear_velocity_m_s.x() == Approx(0.0).margin(1e-9));
+    CHECK(held.position_m.x() == Approx(start.x()).margin(1e-9));
+    CHECK(held.position_m.y() == Approx(start.y()).margin(1e-9));
+    CHECK(held.position_m.z() < start.z() - 0.015);
+    // Released with the wheels at 0.5 s, it climbs at omega r less the slip velocity, as a
+    // rover never held does (the test above); 1e-3 as there.
+    ground.run(rover, 2.0);
+    CHECK_FALSE(rover.rotationLocked());
+    const double creep = ground.regularization_m_s * std::atanh(std::tan(alpha) / 0.6);
+    CHECK(rover.chassisState().linear_velocity_m_s.x() ==
+          Approx(rover.wheelRadius_m() - creep).epsilon(1e-3));
+}
+
 TEST_CASE("Rocker-bogie: torque-driven wheels accelerate the rover up the slope", "[mbs][rover][slow]") {
     // The slope of the test above, reached at steady speed with the speed drive; then torque
     // drive with each wheel's steady motor torque plus 10 % of the total shared equally.
@@ -430,6 +465,21 @@ TEST_CASE("Rocker-bogie: the rover block is parsed strictly", "[mbs][rover]") {
         "five.yaml");
     CHECK_THROWS_WITH(parseRockerBogie(five["rover"]),
                       Catch::Contains("five.yaml:3") && Catch::Contains("list of 6"));
+    const auto drop = ConfigNode::loadString("rover:\n  start_position_m: [0, 0, 1]\n  "
+                                             "release_time_s: 0.4\n  hold_chassis_in_drop: true\n",
+                                             "drop.yaml");
+    const auto d = parseRockerBogie(drop["rover"]);
+    CHECK(d.release_time_s == 0.4);
+    CHECK(d.hold_chassis_in_drop);
+    const auto no_end = ConfigNode::loadString(
+        "rover:\n  start_position_m: [0, 0, 1]\n  hold_chassis_in_drop: true\n", "h.yaml");
+    CHECK_THROWS_WITH(parseRockerBogie(no_end["rover"]),
+                      Catch::Contains("h.yaml:3") && Catch::Contains("release_time_s"));
+    const auto both = ConfigNode::loadString("rover:\n  start_position_m: [0, 0, 1]\n  "
+                                             "rotation_locked: true\n  release_time_s: 0.4\n",
+                                             "b.yaml");
+    CHECK_THROWS_WITH(parseRockerBogie(both["rover"]),
+                      Catch::Contains("b.yaml:4") && Catch::Contains("rotation_locked"));
     const auto missing = ConfigNode::loadString("rover:\n  chassis_mass_kg: 200\n", "m.yaml");
     CHECK_THROWS_WITH(parseRockerBogie(missing["rover"]), Catch::Contains("start_position_m"));
     RockerBogieSettings bad;

@@ -47,6 +47,11 @@ struct RockerBogieSettings {
     /// [N m] torque drive of each wheel instead of the speed drive, when set.
     std::optional<std::array<double, 6>> drive_torques_N_m;
     bool rotation_locked = false;          ///< start with every wheel held at zero speed
+    /// [s] The drop: every wheel locked until this time, then driven.
+    std::optional<double> release_time_s;
+    /// In the drop, hold the chassis' horizontal velocity at zero: it comes down onto a slope
+    /// without sliding down it (the rig's hold_carriage_in_drop).
+    bool hold_chassis_in_drop = false;
     Vec3 gravity_m_s2 = Vec3(0, 0, -3.71); ///< [m/s^2] Mars
     IntegratorSettings integrator;
 
@@ -73,6 +78,8 @@ public:
     /// differential_torque_N_m (on the left rocker about +y; the right gets the same), and per
     /// wheel <name>_omega_rad_s (relative to its carrier) and <name>_motor_torque_N_m.
     std::map<std::string, double> observables() const override;
+    /// Ends the drop at release_time_s, then integrates (SimbodyModel).
+    std::vector<double> advanceTo(double time_s) override;
 
     /// Speed drive on every wheel at these speeds [rad/s] (coupled-body order).
     void setWheelSpeeds(const std::array<double, 6> &speeds_rad_s);
@@ -104,6 +111,9 @@ private:
     std::array<SimTK::MobilizedBody::Pin, 2> rockers_, bogies_; ///< left, right
     std::array<SimTK::MobilizedBody::Pin, 6> wheels_;
     std::array<SimTK::Constraint::ConstantSpeed, 6> wheel_speed_;
+    /// The drop's hold: the chassis' ground-frame velocity along x and y at zero.
+    std::array<SimTK::Constraint::ConstantSpeed, 2> chassis_hold_;
+    bool hold_in_drop_ = false;
     SimTK::Constraint::CoordinateCoupler differential_;
     // Drive state (in checkpoints): mode, speeds, torques, lock.
     bool torque_drive_ = false;
