@@ -454,8 +454,12 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
     s.settings.newmark_gamma = sim.number("newmark_gamma", 0.5);
     if (const auto g = sim.optional("gravity"))
         s.settings.gravity_m_s2 = gravityOf(*g);
-    if (const auto g = sim.optional("gravity_m_s2"))
+    if (const auto g = sim.optional("gravity_m_s2")) {
+        // Both would leave one silently unused (a study varying the vector over a base's name).
+        if (sim.has("gravity"))
+            g->fail("give gravity or gravity_m_s2, not both (gravity also takes a vector)");
         s.settings.gravity_m_s2 = g->vec3();
+    }
     s.settings.threads = threadsFor(sim);
     s.settings.skin_m = sim.number("skin_m", 0.0);
     s.settings.resort_every_builds = int(sim.integer("resort_every_builds", 0, 1000000, 25));

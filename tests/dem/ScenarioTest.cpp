@@ -109,6 +109,12 @@ TEST_CASE("scenario errors name the file, the key and the line", "[dem][scenario
         CHECK(errorOf(replaced(kValid, "gravity: mars", "gravity: mars\n  threads: 100000")) ==
               "bad.yaml:5: key 'simulation.threads': must be a whole number in [1, 1024], got 100000");
     }
+    SECTION("gravity given twice, by name and as a vector") {
+        CHECK(errorOf(
+                  replaced(kValid, "gravity: mars", "gravity: mars\n  gravity_m_s2: [0, 0, -1]")) ==
+              "bad.yaml:5: key 'simulation.gravity_m_s2': give gravity or gravity_m_s2, not both "
+              "(gravity also takes a vector)");
+    }
     SECTION("a key given twice") {
         CHECK(errorOf(replaced(kValid, "  count: 100\n", "  count: 100\n  count: 200\n")) ==
               "bad.yaml:14: key 'deposition.count' given twice (first at line 13)");
