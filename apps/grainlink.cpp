@@ -125,8 +125,8 @@ int main(int argc, char **argv) {
                     "how far the answers moved")
         ->check(CLI::IsMember({"walls", "resolution", "both"}));
     lab->add_flag("--no-plot", lab_options.no_plot,
-                  "skip the plot (the diagnosis' runs: it reads only summary.json, and a plot "
-                  "costs about a fifth of a small test's time)");
+                  "skip the plot (a study's and the diagnosis' runs: they read only "
+                  "summary.json, and a plot costs about a fifth of a small test's time)");
     lab->add_option("--check-factor", lab_options.check_factor,
                     "box width factor (> 1, default 2) or grain radius factor (< 1, default 0.75)");
 

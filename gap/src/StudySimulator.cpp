@@ -515,9 +515,8 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
         for (int s = 0; s < requests[r].seeds; ++s)
             for (std::size_t g = 0; g < gs.size(); ++g) {
                 const Experiment &e = design.find(gs[g].front());
-                // The diagnosis reads the summary only: no plot per run (a fifth of a plate's time).
+                // The diagnosis reads the summary only (the lab kind makes no plot).
                 study::Kind kind = study::standardKind("lab", labTestOf(e.type));
-                kind.command.push_back("--no-plot");
                 const study::Point p = study::makePoint(
                     kind,
                     scenarioText(design, gs[g], requests[r], requests[r].seed_offset + s),

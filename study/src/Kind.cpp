@@ -40,8 +40,10 @@ Kind standardKind(const std::string &kind, const std::string &test) {
     }
     if (kind == "lab") {
         lab::requireLabTest(test);
+        // The study reads the summary and plots its table: no plot per point, which would
+        // count as the machinery's cost (0.8 s a point; tools/plot_lab.py points/ID draws one).
         return {"lab " + test,
-                {"lab", test},
+                {"lab", test, "--no-plot"},
                 "summary.json",
                 {},
                 "soil.simulation.threads",
