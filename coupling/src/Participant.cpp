@@ -134,6 +134,37 @@ struct Participant::Impl {
         return "";
     }
 
+    /// Throws why a wait for the coordinator must stop (a refused handshake, a stopped run,
+    /// its silence, the timeout); returns when it may go on.
+    void checkWait(Clock::time_point start, double timeout_s, const char *waiting_for) {
+        // Keys the coordinator refuses, or CURVE on one side only: fail at once, saying so.
+        if (handshake_watch)
+            if (auto why = handshake_watch->failure())
+                throw CouplingError(who() + ": " + *why);
+        if (shutdown_heard) {
+            std::lock_guard<std::mutex> lock(shutdown_mutex);
+            run_stopped = true;
+            throw CouplingError(who() + ": the coordinator stopped the run: " + shutdown_reason);
+        }
+        // Silence counts only once the coordinator answered: it may start after us.
+        if (coordinator_heard && coordinatorSilence() > peer_timeout_s) {
+            std::ostringstream os;
+            os.precision(3);
+            os << who() << ": the coordinator has been silent for " << coordinatorSilence()
+               << " s while waiting for " << waiting_for
+               << " (it stopped, or the connection is down)";
+            run_stopped = true;
+            throw CouplingError(os.str());
+        }
+        if (sockets::secondsSince(start) > timeout_s) {
+            std::ostringstream os;
+            os << who() << ": no " << waiting_for << " from the coordinator at " << config.endpoint
+               << " within " << timeout_s << " s";
+            run_stopped = true;
+            throw CouplingError(os.str());
+        }
+    }
+
     /// Receives the next message from the coordinator, checking order and liveness. The envelope
     /// stays valid until the next call.
     const pb::Envelope &receive(double timeout_s, const char *waiting_for) {
@@ -151,33 +182,7 @@ struct Participant::Impl {
                 received_sequence = e.sequence();
                 return e;
             }
-            // Keys the coordinator refuses, or CURVE on one side only: fail at once, saying so.
-            if (handshake_watch)
-                if (auto why = handshake_watch->failure())
-                    throw CouplingError(who() + ": " + *why);
-            if (shutdown_heard) {
-                std::lock_guard<std::mutex> lock(shutdown_mutex);
-                run_stopped = true;
-                throw CouplingError(who() +
-                                    ": the coordinator stopped the run: " + shutdown_reason);
-            }
-            // Silence counts only once the coordinator answered: it may start after us.
-            if (coordinator_heard && coordinatorSilence() > peer_timeout_s) {
-                std::ostringstream os;
-                os.precision(3);
-                os << who() << ": the coordinator has been silent for " << coordinatorSilence()
-                   << " s while waiting for " << waiting_for
-                   << " (it stopped, or the connection is down)";
-                run_stopped = true;
-                throw CouplingError(os.str());
-            }
-            if (sockets::secondsSince(start) > timeout_s) {
-                std::ostringstream os;
-                os << who() << ": no " << waiting_for << " from the coordinator at "
-                   << config.endpoint << " within " << timeout_s << " s";
-                run_stopped = true;
-                throw CouplingError(os.str());
-            }
+            checkWait(start, timeout_s, waiting_for);
         }
     }
 
@@ -279,7 +284,15 @@ const RunInfo &Participant::initialize() {
     h->mutable_capabilities()->set_triangle_loads(s.config.capabilities.triangle_loads);
     if (s.config.role == Role::Multibody)
         codec::toWire(s.config.initial_states, 0, h->mutable_initial_states());
-    sockets::send(s.socket, hello);
+    // Queued once the DEALER has a connection to queue it on. A handshake that failed before
+    // (CURVE on one side only, under load) can leave it none, and a blocking send then waited
+    // for ever: try without waiting, and stop as the wait for the Welcome would.
+    zmq::message_t message = sockets::encode(hello);
+    const auto start = Clock::now();
+    while (!s.socket.send(message, zmq::send_flags::dontwait)) {
+        s.checkWait(start, s.config.handshake_timeout_s, "Welcome");
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
 
     const pb::Envelope &reply = s.receive(s.config.handshake_timeout_s, "Welcome");
     s.handshake_watch.reset(); // the connection is up
