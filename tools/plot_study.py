@@ -41,8 +41,16 @@ def main(folder):
     observables = study["observables"]
     with open(os.path.join(folder, "table.csv"), newline="") as f:
         rows = list(csv.DictReader(f))
-    # A key given one value (a setting shared by the whole study) has nothing to plot against.
-    keys = [k for k in study["varied_keys"] if len({r[k] for r in rows}) > 1]
+    # A key given one value (a setting shared by the whole study) has nothing to plot against,
+    # nor has one that moves in step with an earlier key (zipped, one value per value of it).
+    keys = []
+    for k in study["varied_keys"]:
+        if len({r[k] for r in rows}) < 2:
+            continue
+        if any(len({(r[e], r[k]) for r in rows}) == len({r[e] for r in rows}) ==
+               len({r[k] for r in rows}) for e in keys):
+            continue
+        keys.append(k)
     columns = keys if keys else ["(base)"]
     fig, axes = plt.subplots(len(observables), len(columns), squeeze=False,
                              figsize=(max(7.0, 4.5 * len(columns)), 3.4 * len(observables)))
