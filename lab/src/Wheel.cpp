@@ -125,7 +125,6 @@ namespace {
 struct WheelDrive {
     dem::RigidBodyState initial;
     dem::Quat yaw = dem::Quat::Identity();                         ///< the slip angle about z
-    Vec3 axle = Vec3::UnitY();                                     ///< yaw applied to y
     double t_ref = 0.0, x_ref = 0.0, z_ref = 0.0, theta_ref = 0.0; ///< at the last change
     double v_x = 0.0, v_z = 0.0, omega = 0.0;                      ///< since then
     double x(double t) const { return x_ref + v_x * (t - t_ref); }
@@ -137,7 +136,7 @@ struct WheelDrive {
         s.position_m.z() = z(t);
         s.orientation = yaw * dem::Quat(Eigen::AngleAxisd(theta(t), Vec3::UnitY()));
         s.linear_velocity_m_s = Vec3(v_x, 0.0, v_z);
-        s.angular_velocity_rad_s = omega * axle;
+        s.angular_velocity_rad_s = omega * (yaw * Vec3::UnitY()); // about the steered axle
         return s;
     }
     dem::SegmentedMotion motion() const { return dem::constantVelocity(at(t_ref), t_ref); }
@@ -215,7 +214,6 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
         sys.particles(), Eigen::Vector2d(x0, y), std::hypot(reach, 0.5 * t.shape.width_m), surface);
     WheelDrive drive;
     drive.yaw = dem::Quat(Eigen::AngleAxisd(t.slip_angle_deg * M_PI / 180.0, Vec3::UnitZ()));
-    drive.axle = frame.axle;
     drive.initial.position_m = Vec3(x0, y, highest + t.start_clearance_m + reach);
     drive.t_ref = sys.time();
     drive.x_ref = x0;

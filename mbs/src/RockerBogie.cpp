@@ -154,7 +154,6 @@ RockerBogie::RockerBogie(const RockerBogieSettings &settings)
     if (torque_drive_)
         torques_N_m_ = *s.drive_torques_N_m;
     locked_ = s.rotation_locked || s.release_time_s.has_value();
-    hold_in_drop_ = s.hold_chassis_in_drop;
     applyDrive();
     saveState();
 }
@@ -189,7 +188,7 @@ void RockerBogie::applyDrive() {
     }
     for (int k = 0; k < 2; ++k) {
         auto &c = chassis_hold_[k];
-        if (locked_ && hold_in_drop_) {
+        if (locked_ && settings_.hold_chassis_in_drop) {
             if (c.isDisabled(st))
                 c.enable(st);
             chassis_.setOneU(st, SimTK::MobilizerUIndex(3 + k), 0.0);

@@ -113,7 +113,6 @@ private:
     std::array<SimTK::Constraint::ConstantSpeed, 6> wheel_speed_;
     /// The drop's hold: the chassis' ground-frame velocity along x and y at zero.
     std::array<SimTK::Constraint::ConstantSpeed, 2> chassis_hold_;
-    bool hold_in_drop_ = false;
     SimTK::Constraint::CoordinateCoupler differential_;
     // Drive state (in checkpoints): mode, speeds, torques, lock.
     bool torque_drive_ = false;
