@@ -410,8 +410,18 @@ RunSummary runScenario(const DemScenario &scenario, const RunOptions &options) {
         e["snapshots"] = vtk.count();
         for (int k = 0; k < vtk.count(); ++k)
             e["snapshot" + std::to_string(k) + "_s"] = vtk.times()[std::size_t(k)];
-        if (fs::exists(latest))
-            fs::rename(latest, previous);
+        // The latest becomes the previous by a second name, not a move: a run killed at any
+        // instant leaves a checkpoint.bin (a study resumes only from that name), and
+        // writeCheckpoint replaces it by a rename.
+        if (fs::exists(latest)) {
+            const std::string linking = previous + ".partial";
+            fs::remove(linking);
+            std::error_code no_links;
+            fs::create_hard_link(latest, linking, no_links);
+            if (no_links)
+                fs::copy_file(latest, linking);
+            fs::rename(linking, previous);
+        }
         writeCheckpoint(*sys, latest, e);
     };
 

@@ -30,6 +30,9 @@ straight = open(os.path.join(out, "series.csv")).read()
 latest = os.path.join(out, "checkpoint.bin")
 if not os.path.exists(os.path.join(out, "checkpoint.previous.bin")):
     failures.append("no checkpoint.previous.bin beside checkpoint.bin")
+# The previous checkpoint is the latest's second name only until the next one is written over it.
+if os.path.samefile(latest, os.path.join(out, "checkpoint.previous.bin")):
+    failures.append("checkpoint.previous.bin is the same file as checkpoint.bin")
 size = os.path.getsize(latest)
 with open(latest, "r+b") as f:
     f.seek(size // 2)
