@@ -74,6 +74,8 @@ WheelScenario parseWheel(const config::ConfigNode &root) {
         t.friction_coefficient = w["friction_coefficient"].nonNegative();
     if (w.has("min_resolution"))
         t.min_resolution = w["min_resolution"].positive();
+    if (w.has("end_wall_limit"))
+        t.end_wall_limit = w["end_wall_limit"].number(0.01, 1.0);
     w.finish();
 
     // The wheel drives along x from one end of the region: the travel must fit (seed eq. 11
@@ -229,24 +231,50 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
     std::snprintf(label, sizeof label, "wheel s=%.3g", slip);
     dem::Progress progress(label, progress_interval_s);
     const double t0 = sys.time();
+    // The bin's end walls: ahead of the travel (inward normal along -x) and behind it. How much
+    // harder the soil pushes on the one the wheel pushes towards than before the drive is the
+    // part of the wheel's push the soil hands on to the bin's end rather than carrying itself:
+    // large, and the steady values are the bin's, not the soil's (end_wall_share, refused in
+    // runWheel).
+    std::vector<int> ahead, behind;
+    for (std::size_t p = 0; p < sys.planes().size(); ++p) {
+        const double n_x = sys.planes()[p].normal.normalized().x();
+        if (n_x < -0.5)
+            ahead.push_back(int(p));
+        else if (n_x > 0.5)
+            behind.push_back(int(p));
+    }
+    struct EndWalls {
+        double ahead_N = 0.0, behind_N = 0.0; ///< [N] the soil's push on them, along +x and -x
+    };
     struct Interval {
         MeanLoad load;
         double t_mid_s;
+        EndWalls end_walls; ///< over the interval
     };
+    std::vector<Vec3> plane_forces;
     const auto interval = [&]() {
         const double t_start = sys.time();
-        Interval out{observeInterval(sys, steps_per_sample, {0})[0], 0.0};
+        Interval out{observeInterval(sys, steps_per_sample, {0}, &plane_forces)[0], 0.0};
         out.t_mid_s = 0.5 * (t_start + sys.time());
+        for (int p : ahead)
+            out.end_walls.ahead_N += plane_forces[std::size_t(p)].x();
+        for (int p : behind)
+            out.end_walls.behind_N -= plane_forces[std::size_t(p)].x();
         run.steps += steps_per_sample;
         return out;
     };
 
-    // Approach at constant speed until the load is first reached, then hold it.
+    // Approach at constant speed until the load is first reached, then hold it. The end walls'
+    // push at rest is the mean over the hold (without one, the approach's last interval).
+    EndWalls at_load;
+    std::vector<EndWalls> held;
     for (;;) {
         const Interval s = interval();
         progress.update(sys.time() - t0, 0.0, run.steps * sys.particles().size(),
                         "approach, F_z " + std::to_string(s.load.force_N.z()) + " N");
         if (s.load.force_N.z() >= t.load_N) {
+            at_load = s.end_walls;
             drive.retarget(sys, sys.time(), 0.0, -servo.update(s.load.force_N.z(), interval_s), 0.0);
             break;
         }
@@ -264,6 +292,12 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
     while (sys.time() < hold_end - 0.5 * dt) {
         const Interval s = interval();
         drive.retarget(sys, sys.time(), 0.0, -servo.update(s.load.force_N.z(), interval_s), 0.0);
+        held.push_back(s.end_walls);
+    }
+    EndWalls at_rest = held.empty() ? at_load : EndWalls{};
+    for (const EndWalls &h : held) {
+        at_rest.ahead_N += h.ahead_N / double(held.size());
+        at_rest.behind_N += h.behind_N / double(held.size());
     }
     run.load_time_s = sys.time() - t0;
     run.sinkage_at_load_m = surface - (drive.z(sys.time()) - radius);
@@ -283,6 +317,8 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
         x.vertical_load_N = s.load.force_N.z();
         x.torque_N_m = -s.load.torque_N_m.dot(frame.axle);
         x.sinkage_m = surface - (drive.z(s.t_mid_s) - radius);
+        x.end_wall_ahead_N = s.end_walls.ahead_N - at_rest.ahead_N;
+        x.end_wall_behind_N = s.end_walls.behind_N - at_rest.behind_N;
         run.samples.push_back(x);
         const double travelled = drive.x(sys.time()) - x_drive;
         progress.update(sys.time() - t0, travelled / t.travel_m, run.steps * sys.particles().size(),
@@ -304,6 +340,14 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
     run.vertical_load_N = steady(run.samples, run.steady_samples, &WheelSample::vertical_load_N);
     run.torque_N_m = steady(run.samples, run.steady_samples, &WheelSample::torque_N_m);
     run.sinkage_m = steady(run.samples, run.steady_samples, &WheelSample::sinkage_m);
+    run.end_wall_ahead_N = steady(run.samples, run.steady_samples, &WheelSample::end_wall_ahead_N);
+    run.end_wall_behind_N =
+        steady(run.samples, run.steady_samples, &WheelSample::end_wall_behind_N);
+    // The wheel's push on the soil along x is the soil's force on it, reversed.
+    const double push_N =
+        -(run.traction_N.mean * frame.heading.x() + run.side_force_N.mean * frame.side.x());
+    run.end_wall_share = (push_N >= 0.0 ? run.end_wall_ahead_N : run.end_wall_behind_N).mean /
+                         std::max(std::abs(push_N), 0.1 * t.load_N);
     for (std::size_t i = run.samples.size() - run.steady_samples; i < run.samples.size(); ++i)
         run.max_load_error = std::max(
             run.max_load_error, std::abs(run.samples[i].vertical_load_N - t.load_N) / t.load_N);
@@ -313,19 +357,39 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
         "[wheel] slip %.3g at slip angle %.3g deg: carriage %.4g m/s, spin %.4g rad/s, loaded "
         "in %.3f s (static sinkage %.2f mm); steady traction %.4g +- %.2g N, side force "
         "%.4g +- %.2g N, load %.4g +- %.2g N, torque %.4g +- %.2g N m, sinkage %.2f +- "
-        "%.2f mm; %llu steps in %.1f s\n",
+        "%.2f mm, end walls %+.3g +- %.2g N ahead, %+.3g +- %.2g N behind (share %.2f); %llu "
+        "steps in %.1f s\n",
         slip, run.slip_angle_deg, run.carriage_speed_m_s, run.angular_speed_rad_s, run.load_time_s,
         run.sinkage_at_load_m * 1e3, run.traction_N.mean, run.traction_N.sd, run.side_force_N.mean,
         run.side_force_N.sd, run.vertical_load_N.mean, run.vertical_load_N.sd, run.torque_N_m.mean,
         run.torque_N_m.sd, run.sinkage_m.mean * 1e3, run.sinkage_m.sd * 1e3,
-        static_cast<unsigned long long>(run.steps), run.wall_s);
+        run.end_wall_ahead_N.mean, run.end_wall_ahead_N.sd, run.end_wall_behind_N.mean,
+        run.end_wall_behind_N.sd, run.end_wall_share, static_cast<unsigned long long>(run.steps),
+        run.wall_s);
     return run;
 }
 
 } // namespace
 
 WheelResult runWheel(const WheelScenario &scenario, const LabRunOptions &options) {
-    return runLabExperiment(WheelExperiment{scenario}, options);
+    WheelResult result = runLabExperiment(WheelExperiment{scenario}, options);
+    // Refused after its outputs are written: they stay readable, the steady values flagged.
+    std::ostringstream bound;
+    for (const WheelRun &r : result.runs)
+        if (r.end_wall_share > scenario.test.end_wall_limit)
+            bound << (bound.tellp() > 0 ? "; " : "wheel: ") << "at slip " << r.slip
+                  << " the bin's end walls took " << std::lround(100.0 * r.end_wall_share)
+                  << " % of the wheel's push along its travel over the steady stretch";
+    if (bound.tellp() > 0) {
+        bound << ", more than wheel.end_wall_limit = " << scenario.test.end_wall_limit
+              << ": the soil pushed ahead of the wheel reached the bin's end, and the steady "
+                 "values are the bin's, not the soil's. Lengthen the bin (its walls and the "
+                 "deposition region along x) or shorten wheel.travel_m";
+        if (!options.output_directory.empty())
+            bound << "; the results are written to " << options.output_directory;
+        throw std::runtime_error(bound.str());
+    }
+    return result;
 }
 
 std::string WheelResult::report() const {
@@ -345,9 +409,11 @@ std::string WheelResult::report() const {
             << " N, vertical load " << r.vertical_load_N.mean << " +- " << r.vertical_load_N.sd
             << " N (within " << 100 * r.max_load_error << " %), torque " << r.torque_N_m.mean
             << " +- " << r.torque_N_m.sd << " N m, sinkage " << r.sinkage_m.mean * 1e3 << " +- "
-            << r.sinkage_m.sd * 1e3 << " mm (static " << r.sinkage_at_load_m * 1e3 << " mm); "
-            << r.steady_samples << " of " << r.samples.size() << " samples; " << r.steps
-            << " steps, " << r.wall_s << " s wall\n";
+            << r.sinkage_m.sd * 1e3 << " mm (static " << r.sinkage_at_load_m * 1e3
+            << " mm), end walls " << r.end_wall_ahead_N.mean << " +- " << r.end_wall_ahead_N.sd
+            << " N ahead, " << r.end_wall_behind_N.mean << " +- " << r.end_wall_behind_N.sd
+            << " N behind (share " << r.end_wall_share << "); " << r.steady_samples << " of "
+            << r.samples.size() << " samples; " << r.steps << " steps, " << r.wall_s << " s wall\n";
     out << "  total wall time " << wall_s << " s\n";
     return out.str();
 }
@@ -370,6 +436,11 @@ LabSummary WheelResult::summary() const {
                     {"torque_sd_N_m", r.torque_N_m.sd},
                     {"sinkage_m", r.sinkage_m.mean},
                     {"sinkage_sd_m", r.sinkage_m.sd},
+                    {"end_wall_ahead_N", r.end_wall_ahead_N.mean},
+                    {"end_wall_ahead_sd_N", r.end_wall_ahead_N.sd},
+                    {"end_wall_behind_N", r.end_wall_behind_N.mean},
+                    {"end_wall_behind_sd_N", r.end_wall_behind_N.sd},
+                    {"end_wall_share", r.end_wall_share},
                     {"steady_samples", double(r.steady_samples)},
                     {"sinkage_at_load_m", r.sinkage_at_load_m},
                     {"load_time_s", r.load_time_s},
@@ -377,7 +448,7 @@ LabSummary WheelResult::summary() const {
                     {"surface_m", r.surface_m},
                     {"steps", double(r.steps)},
                     {"wall_s", r.wall_s}};
-        std::vector<double> time, travel, traction, side, load, torque, sinkage;
+        std::vector<double> time, travel, traction, side, load, torque, sinkage, ahead, behind;
         for (const auto &p : r.samples) {
             time.push_back(p.time_s);
             travel.push_back(p.travel_m);
@@ -386,6 +457,8 @@ LabSummary WheelResult::summary() const {
             load.push_back(p.vertical_load_N);
             torque.push_back(p.torque_N_m);
             sinkage.push_back(p.sinkage_m);
+            ahead.push_back(p.end_wall_ahead_N);
+            behind.push_back(p.end_wall_behind_N);
         }
         // The series over travel; the plain names are the steady values above.
         x.curves = {{"time_s", time},
@@ -394,7 +467,9 @@ LabSummary WheelResult::summary() const {
                     {"side_force_series_N", side},
                     {"vertical_load_series_N", load},
                     {"torque_series_N_m", torque},
-                    {"sinkage_series_m", sinkage}};
+                    {"sinkage_series_m", sinkage},
+                    {"end_wall_ahead_series_N", ahead},
+                    {"end_wall_behind_series_N", behind}};
         s.runs.push_back(x);
     }
     return s;
@@ -406,24 +481,27 @@ void WheelResult::writeCsvs(const std::string &directory) const {
         auto csv =
             openCsv(dir, "wheel_travel.csv",
                     "slip,slip_angle_deg,time_s,travel_m,traction_N,side_force_N,vertical_load_N,"
-                    "torque_N_m,sinkage_m");
+                    "torque_N_m,sinkage_m,end_wall_ahead_N,end_wall_behind_N");
         for (const auto &r : runs)
             for (const auto &s : r.samples)
                 csv << r.slip << ',' << r.slip_angle_deg << ',' << s.time_s << ',' << s.travel_m
                     << ',' << s.traction_N << ',' << s.side_force_N << ',' << s.vertical_load_N
-                    << ',' << s.torque_N_m << ',' << s.sinkage_m << '\n';
+                    << ',' << s.torque_N_m << ',' << s.sinkage_m << ',' << s.end_wall_ahead_N << ','
+                    << s.end_wall_behind_N << '\n';
     }
     auto csv = openCsv(dir, "wheel_slip.csv",
                        "slip,slip_angle_deg,carriage_speed_m_s,angular_speed_rad_s,traction_N,"
                        "traction_sd_N,side_force_N,side_force_sd_N,vertical_load_N,"
                        "vertical_load_sd_N,torque_N_m,torque_sd_N_m,sinkage_m,sinkage_sd_m,"
-                       "steady_samples");
+                       "end_wall_ahead_N,end_wall_behind_N,end_wall_share,steady_samples");
     for (const auto &r : runs)
         csv << r.slip << ',' << r.slip_angle_deg << ',' << r.carriage_speed_m_s << ','
             << r.angular_speed_rad_s << ',' << r.traction_N.mean << ',' << r.traction_N.sd << ','
             << r.side_force_N.mean << ',' << r.side_force_N.sd << ',' << r.vertical_load_N.mean
             << ',' << r.vertical_load_N.sd << ',' << r.torque_N_m.mean << ',' << r.torque_N_m.sd
-            << ',' << r.sinkage_m.mean << ',' << r.sinkage_m.sd << ',' << r.steady_samples << '\n';
+            << ',' << r.sinkage_m.mean << ',' << r.sinkage_m.sd << ',' << r.end_wall_ahead_N.mean
+            << ',' << r.end_wall_behind_N.mean << ',' << r.end_wall_share << ',' << r.steady_samples
+            << '\n';
 }
 
 Quantities wheelQuantities(const WheelResult &result) {

@@ -1,15 +1,19 @@
 // Single-wheel test at set slips (docs/lab.md, physics.md §12.17): the slip convention by hand,
 // a driven and a braked wheel on a tiny bed against the laws every such test obeys, and the
 // input checks.
-#include "grainlink/lab/LabTest.hpp"
 #include "grainlink/lab/Wheel.hpp"
+#include "grainlink/lab/LabSummary.hpp"
+#include "grainlink/lab/LabTest.hpp"
 
 #include "TextEdit.hpp"
 #include "TinyBed.hpp"
 
 #include <catch2/catch.hpp>
 
+#include <filesystem>
 #include <string>
+
+#include <unistd.h>
 
 using namespace grainlink;
 using Catch::Matchers::Contains;
@@ -42,6 +46,18 @@ wheel:
 
 lab::WheelScenario parseWheelText(const std::string &text) {
     return lab::parseWheel(config::ConfigNode::loadString(text, "wheel.yaml"));
+}
+
+/// The tiny bed 90 mm wide (the wheel across the travel reaches 30 mm to each side) in a bin
+/// `length` long (grains in proportion), the wheel steered by 90 deg (the carriage drags it
+/// along its axle) at `slips` over 60 mm.
+std::string steeredAcross(const std::string &slips, const std::string &length, int grains) {
+    std::string text = replacedOnce(kTinyWheel, "upper_m: [0.2, 0.05, 0.2]",
+                                    "upper_m: [" + length + ", 0.09, 0.2]");
+    text =
+        replacedOnce(text, "upper_m: [0.2, 0.05, 0.07]", "upper_m: [" + length + ", 0.09, 0.07]");
+    text = replacedOnce(text, "count: 2700", "count: " + std::to_string(grains));
+    return replacedOnce(text, "slips: [-0.4, 0.0, 0.5]", slips + "\n  slip_angle_deg: 90");
 }
 
 } // namespace
@@ -123,15 +139,11 @@ TEST_CASE("wheel: steered across its travel, a locked wheel meets the soil along
           "(mirror symmetry), a spinning one is pushed along its heading, and the soil "
           "dissipates",
           "[lab][wheel][slow]") {
-    // The tiny bed in a 120 x 90 mm bin (the wheel across the travel reaches 30 mm to each
-    // side), the wheel steered by 90 deg: the carriage drags it along its axle.
-    std::string text =
-        replacedOnce(kTinyWheel, "upper_m: [0.2, 0.05, 0.2]", "upper_m: [0.12, 0.09, 0.2]");
-    text = replacedOnce(text, "upper_m: [0.2, 0.05, 0.07]", "upper_m: [0.12, 0.09, 0.07]");
-    text = replacedOnce(text, "count: 2700", "count: 2900");
-    text =
-        replacedOnce(text, "slips: [-0.4, 0.0, 0.5]", "slips: [-1.0, 0.5]\n  slip_angle_deg: 90");
-    const lab::WheelResult r = lab::runWheel(parseWheelText(text), {});
+    // The tiny bed in a 160 x 90 mm bin, the wheel steered by 90 deg: the carriage drags it
+    // along its axle over 60 mm, which leaves 60 mm of soil ahead of it (40 mm less, and the
+    // end wall takes the drag: next test).
+    const lab::WheelResult r =
+        lab::runWheel(parseWheelText(steeredAcross("slips: [-1.0, 0.5]", "0.16", 3870)), {});
     REQUIRE(r.runs.size() == 2);
     const lab::WheelRun &locked = r.runs[0], &spinning = r.runs[1];
     for (const lab::WheelRun &run : r.runs) {
@@ -163,6 +175,28 @@ TEST_CASE("wheel: steered across its travel, a locked wheel meets the soil along
     // Spinning, the rim throws soil back and the wheel is pushed along its heading.
     CHECK(spinning.traction_N.mean > locked.traction_N.mean + locked.traction_N.sd);
     CHECK(spinning.traction_N.mean > 0.0);
+    for (const lab::WheelRun &run : r.runs)
+        CHECK(run.end_wall_share < 0.5);
+}
+
+TEST_CASE("wheel: a drag whose pushed soil reaches the bin's end is refused, its results written",
+          "[lab][wheel][slow]") {
+    // The test before in a bin 120 mm long: the locked wheel's front ends 25 mm from the end
+    // wall, and the soil it pushes ahead reaches it. The bed is in equilibrium: what the wheel
+    // pushes along x the floor, the side walls and the end walls carry, and here the end wall
+    // ahead carries most of it.
+    const auto dir = std::filesystem::temp_directory_path() /
+                     ("grainlink_wall_bound_wheel-" + std::to_string(::getpid()));
+    const std::string out = (dir / "out").string();
+    CHECK_THROWS_WITH(
+        lab::runWheel(parseWheelText(steeredAcross("slips: [-1.0]", "0.12", 2900)), {out, 1e9}),
+        Contains("at slip -1 the bin's end walls took") && Contains("wheel.end_wall_limit = 0.5") &&
+            Contains("results are written to " + out));
+    const lab::LabSummary s = lab::readLabSummary(out + "/summary.json");
+    REQUIRE(s.runs.size() == 1);
+    CHECK(s.runs[0].value("end_wall_share") > 0.5);
+    CHECK(s.runs[0].value("end_wall_ahead_N") > 0.5 * -s.runs[0].value("side_force_N"));
+    std::filesystem::remove_all(dir);
 }
 
 TEST_CASE("wheel: bad input names the file, the key and the line", "[lab][wheel]") {

@@ -38,9 +38,12 @@ struct MeanLoad {
     dem::Vec3 torque_N_m = dem::Vec3::Zero(); ///< [N m] about the body's origin
 };
 
-/// One observation interval: runs `steps` steps and returns each of `bodies`' mean load.
+/// One observation interval: runs `steps` steps and returns each of `bodies`' mean load; with
+/// `plane_forces`, also every plane's mean reaction force over the interval (a plane keeps
+/// only its last step's).
 std::vector<MeanLoad> observeInterval(dem::DemSystem &system, std::uint64_t steps,
-                                      std::initializer_list<int> bodies);
+                                      std::initializer_list<int> bodies,
+                                      std::vector<dem::Vec3> *plane_forces = nullptr);
 
 /// Writes a result's report.txt, its CSVs (Result::writeCsvs) and summary.json into
 /// `directory`, creating it.

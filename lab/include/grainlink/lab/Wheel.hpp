@@ -58,6 +58,9 @@ struct WheelSpec {
     double sample_interval_s = 0.002; ///< [s] servo update and CSV row
     std::optional<double> friction_coefficient; ///< wheel-grain; unset: the grain-tool law's
     double min_resolution = 3.0;      ///< [-] required width / (2 r_max) (seed eq. 11)
+    /// [-] the largest share of the wheel's push along its travel that the bin's end walls may
+    /// take over the steady stretch (WheelRun::end_wall_share); beyond it the run is refused
+    double end_wall_limit = 0.5;
 };
 
 struct WheelScenario {
@@ -80,6 +83,9 @@ struct WheelSample {
     double vertical_load_N = 0.0; ///< [N] soil force on the wheel upward
     double torque_N_m = 0.0;      ///< [N m] soil torque resisting the spin (the motor's torque)
     double sinkage_m = 0.0;       ///< [m] rim bottom (grousers excluded) below the bed surface
+    /// [N] how much harder than before the drive the soil pushes on the bin's end wall ahead
+    /// (along +x) and on the one behind (along -x)
+    double end_wall_ahead_N = 0.0, end_wall_behind_N = 0.0;
 };
 
 /// Mean and sample standard deviation of a quantity over the steady samples.
@@ -98,6 +104,10 @@ struct WheelRun {
     std::vector<WheelSample> samples;
     std::size_t steady_samples = 0; ///< the last this many samples are the steady stretch
     SteadyValue traction_N, side_force_N, vertical_load_N, torque_N_m, sinkage_m;
+    SteadyValue end_wall_ahead_N, end_wall_behind_N; ///< [N] (WheelSample)
+    /// [-] the steady rise on the end wall that the wheel pushes towards, as a share of that
+    /// push (the soil's steady force on the wheel along x, reversed; at least 0.1 load_N)
+    double end_wall_share = 0.0;
     double max_load_error = 0.0;  ///< [-] largest |F_z - load| / load over the steady stretch
     std::uint64_t steps = 0;
     double wall_s = 0.0;
