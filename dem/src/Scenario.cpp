@@ -452,14 +452,7 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
         i->choice({"velocity_verlet", "newmark"});
     s.settings.newmark_beta = sim.number("newmark_beta", 0.25);
     s.settings.newmark_gamma = sim.number("newmark_gamma", 0.5);
-    if (const auto g = sim.optional("gravity"))
-        s.settings.gravity_m_s2 = gravityOf(*g);
-    if (const auto g = sim.optional("gravity_m_s2")) {
-        // Both would leave one silently unused (a study varying the vector over a base's name).
-        if (sim.has("gravity"))
-            g->fail("give gravity or gravity_m_s2, not both (gravity also takes a vector)");
-        s.settings.gravity_m_s2 = g->vec3();
-    }
+    s.settings.gravity_m_s2 = simulationGravity(sim);
     s.settings.threads = threadsFor(sim);
     s.settings.skin_m = sim.number("skin_m", 0.0);
     s.settings.resort_every_builds = int(sim.integer("resort_every_builds", 0, 1000000, 25));
@@ -529,6 +522,18 @@ ContactLaw ContactOverride::appliedTo(ContactLaw law) const {
     if (cohesion)
         law.cohesion = *cohesion;
     return law;
+}
+
+Vec3 simulationGravity(const ConfigNode &sim) {
+    if (const auto g = sim.optional("gravity_m_s2")) {
+        // Both would leave one silently unused (a study varying the vector over a base's name).
+        if (sim.has("gravity"))
+            g->fail("give gravity or gravity_m_s2, not both (gravity also takes a vector)");
+        return g->vec3();
+    }
+    if (const auto g = sim.optional("gravity"))
+        return gravityOf(*g);
+    return DemSettings().gravity_m_s2;
 }
 
 ContactLaws contactLaws(const DemScenario &s) {

@@ -58,25 +58,45 @@ std::string boxOf(const Experiment &e) {
     return it == e.labels.end() ? "" : it->second;
 }
 
-/// The conditions of a wheel experiment that make its test (the wheel and its load): wheel
-/// experiments that share them run as one test, one slip per run.
+/// The conditions of a wheel experiment that make its test (the wheel, its load, the slope):
+/// wheel experiments that share them run as one test, one slip per run.
 constexpr const char *kWheelConditions[] = {"wheel_radius_m",   "wheel_width_m", "grouser_count",
-                                            "grouser_height_m", "load_N",        "slip_angle_deg"};
+                                            "grouser_height_m", "load_N",        "slip_angle_deg",
+                                            "slope_deg"};
+/// The conditions of any experiment that make its soil: its gravity's magnitude.
+constexpr const char *kSoilConditions[] = {"gravity_m_s2"};
 
-/// What a test is run for besides its type and box: a wheel's geometry and load.
-std::string rigOf(const Experiment &e) {
-    if (e.type != ExperimentType::WheelSteadyState)
-        return "";
+/// What a test is run for besides its type and box: its gravity, a wheel's geometry, load and
+/// slope.
+std::string setupOf(const Experiment &e) {
     std::ostringstream key;
     key.precision(12);
-    for (const char *c : kWheelConditions)
+    const auto add = [&](const char *c) {
         if (const auto it = e.numbers.find(c); it != e.numbers.end())
             key << c << '=' << it->second << ';';
+    };
+    for (const char *c : kSoilConditions)
+        add(c);
+    if (e.type == ExperimentType::WheelSteadyState)
+        for (const char *c : kWheelConditions)
+            add(c);
     return key.str();
 }
 
 /// Why the lab cannot run an experiment of a type it simulates; empty: it can.
 std::string unsupported(const Experiment &e) {
+    if (const auto g = e.numbers.find("gravity_m_s2");
+        g != e.numbers.end() && !(g->second > 0.0 && g->second < 1e3)) {
+        std::ostringstream why;
+        why << "gravity_m_s2 " << g->second << ": the magnitude of a gravity, > 0";
+        return why.str();
+    }
+    if (const auto a = e.numbers.find("slope_deg");
+        a != e.numbers.end() && !(std::abs(a->second) < 60.0)) {
+        std::ostringstream why;
+        why << "slope " << a->second << " deg: steeper than any soil stands (|slope| < 60 deg)";
+        return why.str();
+    }
     if (e.type == ExperimentType::WheelSteadyState) {
         const auto beta = e.numbers.find("slip_angle_deg");
         if (beta != e.numbers.end() && !(beta->second >= 0.0 && beta->second <= 90.0)) {
@@ -112,6 +132,29 @@ YAML::Node flowList(const std::vector<double> &v) {
         n.push_back(x);
     n.SetStyle(YAML::EmitterStyle::Flow);
     return n;
+}
+
+/// An experiment's gravity and slope in its soil: the test runs under gravity of the
+/// experiment's magnitude (`gravity_m_s2`; the base's without it) tilted about y by its slope
+/// (`slope_deg`, a wheel's), (-g sin a, 0, -g cos a): a wheel driving along +x climbs. The bed
+/// settles level under that magnitude, unless the base's soil names its own deposition gravity
+/// (a bed prepared on Earth and tested in another gravity).
+void setGravity(YAML::Node soil, const Experiment &e) {
+    const auto g_it = e.numbers.find("gravity_m_s2"), a_it = e.numbers.find("slope_deg");
+    if (g_it == e.numbers.end() && a_it == e.numbers.end())
+        return;
+    YAML::Node sim = soil["simulation"];
+    const double g =
+        g_it != e.numbers.end()
+            ? g_it->second
+            : dem::simulationGravity(config::ConfigNode::loadString(
+                                         YAML::Dump(sim), "the base model's soil.simulation"))
+                  .norm();
+    const double a = a_it != e.numbers.end() ? a_it->second * M_PI / 180.0 : 0.0;
+    sim.remove("gravity_m_s2");
+    sim["gravity"] = flowList({-g * std::sin(a), 0.0, -g * std::cos(a)});
+    if (!soil["deposition"]["gravity"])
+        soil["deposition"]["gravity"] = flowList({0.0, 0.0, -g});
 }
 
 /// Every number under `node` times `f` (a radius distribution's sizes).
@@ -228,13 +271,18 @@ bool close(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::
 std::vector<std::string> simulatedConditions(ExperimentType type) {
     switch (type) {
     case ExperimentType::PlateSinkage:
-        return {"plate_diameter_m"};
+        return {"plate_diameter_m", "gravity_m_s2"};
     case ExperimentType::DirectShear:
-        return {"normal_stress_Pa"};
+        return {"normal_stress_Pa", "gravity_m_s2"};
     case ExperimentType::BevameterShear:
-        return {"normal_pressure_Pa"};
-    case ExperimentType::WheelSteadyState:
-        return {std::begin(kWheelConditions), std::end(kWheelConditions)};
+        return {"normal_pressure_Pa", "gravity_m_s2"};
+    case ExperimentType::AngleOfRepose:
+        return {"gravity_m_s2"};
+    case ExperimentType::WheelSteadyState: {
+        std::vector<std::string> c(std::begin(kWheelConditions), std::end(kWheelConditions));
+        c.insert(c.end(), std::begin(kSoilConditions), std::end(kSoilConditions));
+        return c;
+    }
     default:
         return {};
     }
@@ -270,7 +318,7 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                             (ids.size() == 1 ? " experiment" : " experiments") +
                             "; the tests are set up from plate_diameter_m, normal_stress_Pa, "
                             "normal_pressure_Pa, the wheel's radius, width, grouser count and "
-                            "height, load_N, slip_angle_deg, and box)");
+                            "height, load_N, slip_angle_deg, slope_deg, gravity_m_s2 and box)");
     }
     if (out.experiments.empty())
         throw std::invalid_argument(base.path + ": no test in `tests` simulates any experiment of " +
@@ -394,7 +442,7 @@ std::vector<std::vector<std::string>> StudySimulator::groups(const ExperimentSet
     // of one wheel under one load).
     std::map<std::tuple<ExperimentType, std::string, std::string>, std::vector<std::string>> g;
     for (const Experiment &e : design.experiments)
-        g[{e.type, boxOf(e), rigOf(e)}].push_back(e.id);
+        g[{e.type, boxOf(e), setupOf(e)}].push_back(e.id);
     std::vector<std::vector<std::string>> out;
     for (auto &[key, ids] : g)
         out.push_back(ids);
@@ -422,6 +470,7 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
     mergeInto(root["soil"], t->second["soil"]);
     if (own_box)
         mergeInto(root["soil"], box->second);
+    setGravity(root["soil"], first);
     YAML::Node section = YAML::Clone(t->second[test]);
     const FeatureDesign fd = designFeatures(design);
     double reach = 0.0;

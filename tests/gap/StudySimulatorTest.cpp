@@ -2,8 +2,9 @@
 // catalogue effect at its signature strengths and each numerical check, on every experiment of
 // the CI design (docs/gap.md, "The base model"). A key an effect writes that no reader knows,
 // or a value out of range, fails here rather than hours into a diagnosis.
-#include "grainlink/gap/Effects.hpp"
 #include "grainlink/gap/StudySimulator.hpp"
+#include "grainlink/dem/Scenario.hpp"
+#include "grainlink/gap/Effects.hpp"
 #include "grainlink/gap/Twin.hpp"
 #include "grainlink/lab/LabTest.hpp"
 
@@ -13,7 +14,10 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
+#include <set>
 #include <tuple>
+#include <variant>
 
 using namespace grainlink::gap;
 namespace fs = std::filesystem;
@@ -259,5 +263,103 @@ TEST_CASE("a wheel design makes a twin folder the diagnosis reads", "[gap][twin]
     const Experiment &p = read.find("plate");
     REQUIRE(p.trials.size() == 2);
     CHECK(p.trials[0].curves.at("pressure_Pa").x.back() == Approx(0.004));
+    fs::remove_all(scratch);
+}
+
+TEST_CASE("an experiment's gravity and a wheel's slope make its soil: tilted gravity, a level "
+          "bed, one test per gravity and slope",
+          "[gap][simulator]") {
+    // The CMU base (Earth's gravity by default): a plate at Mars gravity, a plate and a
+    // wheel with neither condition, the wheel on a 20 deg slope (the slope study's hand-written
+    // vector: (-3.3552, 0, -9.2184)), and conditions no soil has.
+    const BaseModel base =
+        loadBaseModel(std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml");
+    const auto plate = [](const std::string &id, std::map<std::string, double> extra) {
+        Experiment e;
+        e.id = id;
+        e.type = ExperimentType::PlateSinkage;
+        e.x_name = "sinkage";
+        e.observables = {"pressure_Pa"};
+        e.numbers = {{"plate_diameter_m", 0.06}};
+        e.numbers.insert(extra.begin(), extra.end());
+        e.labels = {{"box", "large"}};
+        Trial t;
+        t.curves["pressure_Pa"] = Curve{{0.0, 0.005, 0.01}, {0.0, 1e4, 2e4}};
+        e.trials.push_back(t);
+        return e;
+    };
+    const auto wheel = [](const std::string &id, std::map<std::string, double> extra) {
+        Experiment e;
+        e.id = id;
+        e.type = ExperimentType::WheelSteadyState;
+        e.x_name = "slip";
+        e.scatter = true;
+        e.observables = {"traction_N"};
+        e.numbers = {{"wheel_radius_m", 0.058}, {"wheel_width_m", 0.05}, {"load_N", 21.5}};
+        e.numbers.insert(extra.begin(), extra.end());
+        for (double s : {0.0, 0.3}) {
+            Trial t;
+            t.curves["traction_N"] = Curve{{s}, {1.0 + s}};
+            e.trials.push_back(t);
+        }
+        return e;
+    };
+    ExperimentSet set;
+    set.name = "gravity";
+    set.experiments = {plate("earth_plate", {}),
+                       plate("mars_plate", {{"gravity_m_s2", 3.71}}),
+                       plate("mars_plate_again", {{"gravity_m_s2", 3.71}}),
+                       plate("tilted_plate", {{"slope_deg", 10.0}}),
+                       plate("no_gravity", {{"gravity_m_s2", 0.0}}),
+                       wheel("level_wheel", {}),
+                       wheel("slope_wheel", {{"slope_deg", 20.0}}),
+                       wheel("cliff_wheel", {{"slope_deg", 75.0}})};
+    std::vector<std::string> left_out;
+    const ExperimentSet kept = simulable(set, base, left_out);
+    REQUIRE(left_out.size() == 2);
+    CHECK_THAT(left_out[0], Catch::StartsWith("no_gravity (plate_sinkage: gravity_m_s2 0"));
+    CHECK_THAT(left_out[1], Catch::StartsWith("cliff_wheel (wheel_steady_state: slope 75 deg"));
+    // A plate's slope is no condition its test reads, and is said so; gravity is.
+    REQUIRE(kept.notes.size() == 1);
+    CHECK_THAT(kept.notes[0], Catch::Contains("condition 'slope_deg' is not simulated") &&
+                                  Catch::Contains("in tilted_plate (1 experiment"));
+
+    const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-gravity-test";
+    fs::remove_all(scratch);
+    fs::create_directories(scratch);
+    const StudySimulator sim(base, (scratch / "sims").string(), {});
+    // Earth and tilted plates share a test (the slope is not theirs), the two Mars plates
+    // another; each wheel its own.
+    std::set<std::vector<std::string>> groups;
+    for (const auto &g : sim.groups(kept))
+        groups.insert(g);
+    CHECK(groups == std::set<std::vector<std::string>>{{"earth_plate", "tilted_plate"},
+                                                       {"mars_plate", "mars_plate_again"},
+                                                       {"level_wheel"},
+                                                       {"slope_wheel"}});
+    VariantRequest plain;
+    plain.label = "base";
+    const auto soilOf = [&](const std::string &id) {
+        const Experiment &e = kept.find(id);
+        const fs::path file = scratch / (id + ".yaml");
+        std::ofstream(file) << sim.scenarioText(kept, {id}, plain, 1);
+        const auto scenario = grainlink::lab::loadLabScenario(labTestOf(e.type), file.string());
+        return std::visit([](const auto &s) { return s.soil; }, scenario);
+    };
+    const auto earth = soilOf("earth_plate"), mars = soilOf("mars_plate");
+    CHECK(earth.settings.gravity_m_s2.isApprox(grainlink::dem::Vec3(0, 0, -9.81)));
+    CHECK_FALSE(earth.deposition.gravity_m_s2); // without the conditions, the base's soil as it is
+    CHECK(mars.settings.gravity_m_s2.isApprox(grainlink::dem::Vec3(0, 0, -3.71)));
+    REQUIRE(mars.deposition.gravity_m_s2);
+    CHECK(mars.deposition.gravity_m_s2->isApprox(grainlink::dem::Vec3(0, 0, -3.71)));
+    const auto slope = soilOf("slope_wheel");
+    CHECK(slope.settings.gravity_m_s2.x() == Approx(-3.3552).margin(1e-4));
+    CHECK(slope.settings.gravity_m_s2.y() == 0.0);
+    CHECK(slope.settings.gravity_m_s2.z() == Approx(-9.2184).margin(1e-4));
+    REQUIRE(slope.deposition.gravity_m_s2);
+    CHECK(slope.deposition.gravity_m_s2->isApprox(grainlink::dem::Vec3(0, 0, -9.81)));
+    // Every slope shares the level bed's packing; another gravity settles its own.
+    CHECK(grainlink::dem::packingKey(slope) == grainlink::dem::packingKey(soilOf("level_wheel")));
+    CHECK(grainlink::dem::packingKey(mars) != grainlink::dem::packingKey(earth));
     fs::remove_all(scratch);
 }

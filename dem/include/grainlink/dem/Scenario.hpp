@@ -77,6 +77,10 @@ constexpr long long kMaxLayers = 100'000;
 /// without either, OMP_NUM_THREADS; else 1.
 int threadsFor(const ConfigNode &sim);
 
+/// The gravity of a `simulation` block: `gravity` (earth, mars, moon, none or a vector) or
+/// `gravity_m_s2` (a vector), not both; earth without either.
+Vec3 simulationGravity(const ConfigNode &sim);
+
 /// Reads and validates a scenario; errors name the file, key and line.
 DemScenario loadScenario(const std::string &path);
 /// `coupled`: the soil section of a coupled run (no `run:`; bodies come from the coupling).
