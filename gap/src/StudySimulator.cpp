@@ -294,7 +294,7 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     out.experiments.clear();
     // A condition the simulation does not read is said, once with its experiments:
     // `wheel_diameter_m` for `wheel_radius_m` would otherwise leave the base's wheel in silence.
-    std::map<std::string, std::vector<std::string>> unused;
+    std::map<std::string, std::vector<std::string>> unused, undescribed;
     for (const Experiment &e : set.experiments)
         if (!base.tests.count(typeName(e.type)))
             left_out.push_back(e.id + " (" + typeName(e.type) + ": " + base.path + " has no tests." +
@@ -303,22 +303,39 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
             left_out.push_back(e.id + " (" + typeName(e.type) + ": " + why + ")");
         else {
             const std::vector<std::string> used = simulatedConditions(e.type);
-            for (const auto &[key, value] : e.conditionText())
-                if (key != "box" && std::find(used.begin(), used.end(), key) == used.end())
+            for (const auto &[key, value] : e.conditionText()) {
+                const auto described = base.conditions.find(key);
+                if (described != base.conditions.end() || key == "box") {
+                    // A text condition the base gives soils for: this value among them?
+                    if (described == base.conditions.end() || !described->second.count(value))
+                        undescribed[key + " '" + value + "'"].push_back(e.id);
+                } else if (std::find(used.begin(), used.end(), key) == used.end()) {
                     unused[key].push_back(e.id);
+                }
+            }
             out.experiments.push_back(e);
         }
-    for (const auto &[key, ids] : unused) {
+    const auto listed = [](const std::vector<std::string> &ids) {
         std::string list;
         for (std::size_t i = 0; i < ids.size() && i < 4; ++i)
             list += (i ? ", " : "") + ids[i];
+        return list + (ids.size() > 4 ? ", ..." : "") + " (" + std::to_string(ids.size()) +
+               (ids.size() == 1 ? " experiment" : " experiments");
+    };
+    for (const auto &[key, ids] : unused)
         out.notes.push_back("condition '" + key +
-                            "' is not simulated (the base's own value stands) in " + list +
-                            (ids.size() > 4 ? ", ..." : "") + " (" + std::to_string(ids.size()) +
-                            (ids.size() == 1 ? " experiment" : " experiments") +
+                            "' is not simulated (the base's own value "
+                            "stands) in " +
+                            listed(ids) +
                             "; the tests are set up from plate_diameter_m, normal_stress_Pa, "
                             "normal_pressure_Pa, the wheel's radius, width, grouser count and "
-                            "height, load_N, slip_angle_deg, slope_deg, gravity_m_s2 and box)");
+                            "height, load_N, slip_angle_deg, slope_deg, gravity_m_s2, and the "
+                            "text conditions the base's boxes: and conditions: describe)");
+    for (const auto &[key_value, ids] : undescribed) {
+        const std::string key = key_value.substr(0, key_value.find(' '));
+        out.notes.push_back(key + " " + key_value.substr(key.size() + 1) + " has no soil in " +
+                            base.path + " (" + (key == "box" ? "boxes" : "conditions." + key) +
+                            "): the base's own soil stands in " + listed(ids) + ")");
     }
     if (out.experiments.empty())
         throw std::invalid_argument(base.path + ": no test in `tests` simulates any experiment of " +
@@ -384,11 +401,20 @@ BaseModel loadBaseModel(const std::string &path) {
         t.finish();
         b.tests[type] = node;
     }
+    const auto readOverlays = [&](const ConfigNode &values, const std::string &condition) {
+        for (const std::string &value : values.keys()) {
+            const ConfigNode v = values[value];
+            b.conditions[condition][value] = YAML::Clone(v["soil"].yaml());
+            v.finish();
+        }
+    };
     if (const auto boxes = root.optional("boxes"))
-        for (const std::string &label : boxes->keys()) {
-            const ConfigNode box = (*boxes)[label];
-            b.boxes[label] = YAML::Clone(box["soil"].yaml());
-            box.finish();
+        readOverlays(*boxes, "box");
+    if (const auto conditions = root.optional("conditions"))
+        for (const std::string &name : conditions->keys()) {
+            if (name == "box")
+                (*conditions)[name].fail("a box's container is given under `boxes:`");
+            readOverlays((*conditions)[name], name);
         }
     if (const auto n = root.optional("numerics")) {
         b.seeds = int(n->integer("seeds", 2, 64, 3));
@@ -437,12 +463,30 @@ YAML::Node StudySimulator::referenceScenario() const {
     return r;
 }
 
+std::vector<StudySimulator::Overlay> StudySimulator::overlaysOf(const Experiment &e) const {
+    std::vector<Overlay> out;
+    for (const auto &[condition, values] : base_.conditions) {
+        const auto label = e.labels.find(condition);
+        if (label == e.labels.end())
+            continue;
+        const auto soil = values.find(label->second);
+        if (soil != values.end())
+            out.insert(condition == "box" ? out.begin() : out.end(),
+                       Overlay{condition, label->second, soil->second});
+    }
+    return out;
+}
+
 std::vector<std::vector<std::string>> StudySimulator::groups(const ExperimentSet &design) const {
     // Experiments of one type in one box share a bed: one lab test runs them all (wheels: those
     // of one wheel under one load).
     std::map<std::tuple<ExperimentType, std::string, std::string>, std::vector<std::string>> g;
-    for (const Experiment &e : design.experiments)
-        g[{e.type, boxOf(e), setupOf(e)}].push_back(e.id);
+    for (const Experiment &e : design.experiments) {
+        std::string key = setupOf(e);
+        for (const Overlay &o : overlaysOf(e))
+            key += o.condition + '=' + o.value + ';';
+        g[{e.type, boxOf(e), key}].push_back(e.id);
+    }
     std::vector<std::vector<std::string>> out;
     for (auto &[key, ids] : g)
         out.push_back(ids);
@@ -460,16 +504,17 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
         throw std::invalid_argument(base_.path + ": the base model says nothing of how to simulate " +
                                     type + " experiments (add tests." + type + "." + test +
                                     ", docs/gap.md)");
-    // A box the base model does not describe is simulated in the base's own container: the
-    // scenario (and so the cached run) is then the same for every such box.
-    const auto box = base_.boxes.find(boxOf(first));
-    const bool own_box = box != base_.boxes.end();
+    // The soil of the experiment's text conditions that the base describes, its box's first (a
+    // box or preparation the base does not describe leaves the base's soil: the scenario, and
+    // so the cached run, is then the same for every such value; `simulable` says so).
     YAML::Node root;
-    root["name"] = base_.name + "-" + type + (own_box ? "-" + box->first : "");
+    root["name"] = base_.name + "-" + type;
     root["soil"] = YAML::Clone(base_.soil);
     mergeInto(root["soil"], t->second["soil"]);
-    if (own_box)
-        mergeInto(root["soil"], box->second);
+    for (const Overlay &o : overlaysOf(first)) {
+        root["name"] = root["name"].as<std::string>() + "-" + o.value;
+        mergeInto(root["soil"], o.soil);
+    }
     setGravity(root["soil"], first);
     YAML::Node section = YAML::Clone(t->second[test]);
     const FeatureDesign fd = designFeatures(design);

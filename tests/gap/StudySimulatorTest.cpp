@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <iterator>
 #include <map>
 #include <set>
 #include <tuple>
@@ -282,7 +283,7 @@ TEST_CASE("an experiment's gravity and a wheel's slope make its soil: tilted gra
         e.observables = {"pressure_Pa"};
         e.numbers = {{"plate_diameter_m", 0.06}};
         e.numbers.insert(extra.begin(), extra.end());
-        e.labels = {{"box", "large"}};
+        e.labels = {{"box", "small"}};
         Trial t;
         t.curves["pressure_Pa"] = Curve{{0.0, 0.005, 0.01}, {0.0, 1e4, 2e4}};
         e.trials.push_back(t);
@@ -361,5 +362,71 @@ TEST_CASE("an experiment's gravity and a wheel's slope make its soil: tilted gra
     // Every slope shares the level bed's packing; another gravity settles its own.
     CHECK(grainlink::dem::packingKey(slope) == grainlink::dem::packingKey(soilOf("level_wheel")));
     CHECK(grainlink::dem::packingKey(mars) != grainlink::dem::packingKey(earth));
+    fs::remove_all(scratch);
+}
+
+TEST_CASE("a text condition the base describes gives its experiments their soil: a bed's "
+          "preparation; a value it does not describe is said",
+          "[gap][simulator]") {
+    // The CMU base with a dense preparation (more grains in the same box) besides its own bed:
+    // plates prepared dense, loose (which the base leaves to its own soil) and unsaid.
+    const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-preparation-test";
+    fs::remove_all(scratch);
+    fs::create_directories(scratch);
+    const std::string cmu = std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml";
+    std::ifstream in(cmu);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    text += "conditions:\n  preparation:\n    dense: {soil: {deposition: {count: 5000}}}\n";
+    std::ofstream(scratch / "base.yaml") << text;
+    const BaseModel base = loadBaseModel((scratch / "base.yaml").string());
+    ExperimentSet set;
+    set.name = "preparations";
+    for (const auto &[id, preparation] :
+         {std::pair{"dense_plate", "dense"}, std::pair{"loose_plate", "loose"},
+          std::pair{"plain_plate", ""}}) {
+        Experiment e;
+        e.id = id;
+        e.type = ExperimentType::PlateSinkage;
+        e.x_name = "sinkage";
+        e.observables = {"pressure_Pa"};
+        e.numbers = {{"plate_diameter_m", 0.06}};
+        if (*preparation)
+            e.labels = {{"preparation", preparation}};
+        Trial t;
+        t.curves["pressure_Pa"] = Curve{{0.0, 0.005, 0.01}, {0.0, 1e4, 2e4}};
+        e.trials.push_back(t);
+        set.experiments.push_back(e);
+    }
+    std::vector<std::string> left_out;
+    const ExperimentSet kept = simulable(set, base, left_out);
+    CHECK(left_out.empty());
+    REQUIRE(kept.notes.size() == 1);
+    CHECK_THAT(kept.notes[0], Catch::Contains("preparation 'loose' has no soil") &&
+                                  Catch::Contains("(conditions.preparation)") &&
+                                  Catch::Contains("in loose_plate (1 experiment"));
+    const StudySimulator sim(base, (scratch / "sims").string(), {});
+    std::set<std::vector<std::string>> groups;
+    for (const auto &g : sim.groups(kept))
+        groups.insert(g);
+    CHECK(groups ==
+          std::set<std::vector<std::string>>{{"dense_plate"}, {"loose_plate", "plain_plate"}});
+    VariantRequest plain;
+    plain.label = "base";
+    const auto scenarioOf = [&](const std::string &id) {
+        const fs::path file = scratch / (id + ".yaml");
+        std::ofstream(file) << sim.scenarioText(kept, {id}, plain, 1);
+        return std::get<grainlink::lab::BevameterScenario>(
+            grainlink::lab::loadLabScenario("bevameter", file.string()));
+    };
+    const auto dense = scenarioOf("dense_plate"), loose = scenarioOf("loose_plate");
+    CHECK(dense.soil.deposition.count == 5000);
+    CHECK(loose.soil.deposition.count != 5000);
+    CHECK(dense.name == loose.name + "-dense");
+
+    // `box` is `boxes:`' to give.
+    std::ofstream(scratch / "boxed.yaml")
+        << text << "  box:\n    tiny: {soil: {deposition: {count: 100}}}\n";
+    CHECK_THROWS_WITH(loadBaseModel((scratch / "boxed.yaml").string()),
+                      Catch::Contains("conditions.box") && Catch::Contains("boxes:"));
     fs::remove_all(scratch);
 }

@@ -23,7 +23,9 @@ struct BaseModel {
     std::string name;
     YAML::Node soil;                           ///< the DEM soil (docs/scenario.md)
     std::map<std::string, YAML::Node> tests;   ///< experiment type -> {<lab section>: ..., soil: ...}
-    std::map<std::string, YAML::Node> boxes;   ///< box label -> {soil: ...} merged over the soil
+    /// text condition -> its value -> the soil merged over the base's for experiments with it
+    /// (`boxes:` gives the `box` condition's, `conditions:` any other's: a bed preparation)
+    std::map<std::string, std::map<std::string, YAML::Node>> conditions;
     int seeds = 3, signature_seeds = 2, check_seeds = 2, threads = 1;
     std::map<std::string, double> checks;      ///< numerical check -> its factor
 };
@@ -76,6 +78,12 @@ public:
     int runsReused() const { return runs_reused_; }
 
 private:
+    struct Overlay {
+        std::string condition, value;
+        YAML::Node soil;
+    };
+    /// The soils the base gives for the experiment's text conditions, its box's first.
+    std::vector<Overlay> overlaysOf(const Experiment &e) const;
     YAML::Node scenarioNode(const ExperimentSet &design, const std::vector<std::string> &group,
                             const VariantRequest &request, int seed) const;
     BaseModel base_;
