@@ -68,6 +68,23 @@ void forEveryVariant(const StudySimulator &sim,
     }
 }
 
+/// A 60 mm plate's sinkage curve to 10 mm with more `numbers` and the text conditions `labels`.
+Experiment plateExperiment(const std::string &id, const std::map<std::string, double> &numbers,
+                           const std::map<std::string, std::string> &labels) {
+    Experiment e;
+    e.id = id;
+    e.type = ExperimentType::PlateSinkage;
+    e.x_name = "sinkage";
+    e.observables = {"pressure_Pa"};
+    e.numbers = {{"plate_diameter_m", 0.06}};
+    e.numbers.insert(numbers.begin(), numbers.end());
+    e.labels = labels;
+    Trial t;
+    t.curves["pressure_Pa"] = Curve{{0.0, 0.005, 0.01}, {0.0, 1e4, 2e4}};
+    e.trials.push_back(t);
+    return e;
+}
+
 } // namespace
 
 TEST_CASE("every effect and numerical check on the self-tests' designs is a scenario the lab "
@@ -275,19 +292,8 @@ TEST_CASE("an experiment's gravity and a wheel's slope make its soil: tilted gra
     // vector: (-3.3552, 0, -9.2184)), and conditions no soil has.
     const BaseModel base =
         loadBaseModel(std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml");
-    const auto plate = [](const std::string &id, std::map<std::string, double> extra) {
-        Experiment e;
-        e.id = id;
-        e.type = ExperimentType::PlateSinkage;
-        e.x_name = "sinkage";
-        e.observables = {"pressure_Pa"};
-        e.numbers = {{"plate_diameter_m", 0.06}};
-        e.numbers.insert(extra.begin(), extra.end());
-        e.labels = {{"box", "small"}};
-        Trial t;
-        t.curves["pressure_Pa"] = Curve{{0.0, 0.005, 0.01}, {0.0, 1e4, 2e4}};
-        e.trials.push_back(t);
-        return e;
+    const auto plate = [](const std::string &id, const std::map<std::string, double> &extra) {
+        return plateExperiment(id, extra, {{"box", "small"}});
     };
     const auto wheel = [](const std::string &id, std::map<std::string, double> extra) {
         Experiment e;
@@ -381,22 +387,9 @@ TEST_CASE("a text condition the base describes gives its experiments their soil:
     const BaseModel base = loadBaseModel((scratch / "base.yaml").string());
     ExperimentSet set;
     set.name = "preparations";
-    for (const auto &[id, preparation] :
-         {std::pair{"dense_plate", "dense"}, std::pair{"loose_plate", "loose"},
-          std::pair{"plain_plate", ""}}) {
-        Experiment e;
-        e.id = id;
-        e.type = ExperimentType::PlateSinkage;
-        e.x_name = "sinkage";
-        e.observables = {"pressure_Pa"};
-        e.numbers = {{"plate_diameter_m", 0.06}};
-        if (*preparation)
-            e.labels = {{"preparation", preparation}};
-        Trial t;
-        t.curves["pressure_Pa"] = Curve{{0.0, 0.005, 0.01}, {0.0, 1e4, 2e4}};
-        e.trials.push_back(t);
-        set.experiments.push_back(e);
-    }
+    set.experiments = {plateExperiment("dense_plate", {}, {{"preparation", "dense"}}),
+                       plateExperiment("loose_plate", {}, {{"preparation", "loose"}}),
+                       plateExperiment("plain_plate", {}, {})};
     std::vector<std::string> left_out;
     const ExperimentSet kept = simulable(set, base, left_out);
     CHECK(left_out.empty());
