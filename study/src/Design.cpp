@@ -178,7 +178,9 @@ Study loadStudy(const std::string &path, const std::string &directory,
     bool zip = false;
     int replicates = 1;
     long long first_seed = 1;
-    std::string seed_key = kind.seed_key;
+    // Replicate r gives its i-th seed key first + r K + i (K keys): beds of their own per key
+    // (a rover's two soil strips) that never repeat another replicate's.
+    std::vector<std::string> seed_keys{kind.seed_key};
     std::optional<ConfigNode> replicate_node;
     const auto design = root.optional("design");
     std::optional<ConfigNode> vary;
@@ -196,8 +198,20 @@ Study loadStudy(const std::string &path, const std::string &directory,
                 replicates = int(r.integer(1, kMaxReplicates));
             } else {
                 replicates = int(r["count"].integer(1, kMaxReplicates));
+                if (r.has("key") && r.has("keys"))
+                    r["keys"].fail("give key or keys, not both");
                 if (r.has("key"))
-                    seed_key = dottedPath(r["key"]);
+                    seed_keys = {dottedPath(r["key"])};
+                if (r.has("keys")) {
+                    seed_keys.clear();
+                    for (const ConfigNode &k : r["keys"].items()) {
+                        seed_keys.push_back(dottedPath(k));
+                        if (std::count(seed_keys.begin(), seed_keys.end(), seed_keys.back()) > 1)
+                            k.fail("'" + seed_keys.back() + "' is given twice");
+                    }
+                    if (seed_keys.empty())
+                        r["keys"].fail("name at least one key");
+                }
                 first_seed = r.has("first") ? r["first"].integer() : 1;
                 r.finish();
             }
@@ -208,11 +222,11 @@ Study loadStudy(const std::string &path, const std::string &directory,
     }
     for (const Factor &f : factors) {
         study.varied_keys.push_back(f.key);
-        if (f.key == seed_key && replicate_node)
+        if (replicate_node && std::count(seed_keys.begin(), seed_keys.end(), f.key))
             replicate_node->fail("'" + f.key + "' is both varied and the replicates' key");
     }
     if (replicate_node)
-        study.replicate_key = seed_key;
+        study.replicate_key = seed_keys.front();
     for (const ConfigNode &o : root["observables"].items())
         study.observables.push_back(o.text());
     if (study.observables.empty())
@@ -220,7 +234,7 @@ Study loadStudy(const std::string &path, const std::string &directory,
     root.finish();
 
     std::vector<std::string> label_keys = study.varied_keys;
-    label_keys.push_back(seed_key);
+    label_keys.insert(label_keys.end(), seed_keys.begin(), seed_keys.end());
     const std::vector<std::string> names = shortNames(label_keys);
     std::set<std::string> ids;
     for (const auto &combination : combinations(factors, zip, vary ? *vary : root)) {
@@ -242,17 +256,19 @@ Study loadStudy(const std::string &path, const std::string &directory,
                           std::to_string(f.lines[combination[k]]) + ": " + f.key + " = " +
                           inlineText(value);
             }
-            if (replicate_node) {
-                const std::string seed = std::to_string(first_seed + r);
+            for (std::size_t i = 0; replicate_node && i < seed_keys.size(); ++i) {
+                const std::string &key = seed_keys[i];
+                const std::string seed = std::to_string(
+                    first_seed + (long long)(r) * (long long)(seed_keys.size()) + (long long)(i));
                 try {
-                    setAtPath(tree, seed_key, YAML::Node(seed));
+                    setAtPath(tree, key, YAML::Node(seed));
                 } catch (const std::invalid_argument &e) {
                     replicate_node->fail(e.what());
                 }
-                settings.emplace_back(seed_key, seed);
-                label += (label.empty() ? "" : " ") + names.back() + "=" + seed;
+                settings.emplace_back(key, seed);
+                label += (label.empty() ? "" : " ") + names[factors.size() + i] + "=" + seed;
                 origin += (origin.empty() ? "" : ", ") + path + ":" +
-                          std::to_string(replicate_node->line()) + ": " + seed_key + " = " + seed;
+                          std::to_string(replicate_node->line()) + ": " + key + " = " + seed;
             }
             Point p = makePoint(kind, emitYaml(tree), label.empty() ? "base" : label);
             p.origin = origin.empty() ? path + ": the base scenario" : origin;

@@ -75,6 +75,47 @@ TEST_CASE("a factorial design makes every combination of the values, each replic
     CHECK(s.points[0].label == "stick_angle_deg=32 coefficient_N_s_m=0.04 seed=1");
 }
 
+TEST_CASE("replicates over several seed keys give each key a seed of its own, never another "
+          "replicate's",
+          "[study][design]") {
+    // The rover's two soil strips (scenarios/rover.yaml, seeds 21 and 22 of its own): two
+    // replicates from seed 21 give the pairs (21, 22) and (23, 24), one table row.
+    TempFolder folder("seed-keys");
+    const std::string replicates =
+        "  replicates: {count: 2, keys: [soil_left.deposition.seed, soil_right.deposition.seed], "
+        "first: 21}\n";
+    const auto file = [&](const std::string &name, const std::string &design) {
+        const std::string path = folder / (name + ".yaml");
+        writeFile(path, "name: " + name + "\nbase: {kind: run, scenario: " + kSource +
+                            "/scenarios/rover.yaml}\ndesign:\n" + design +
+                            "observables: [second_half.wheel_lm_slip.mean]\n");
+        return path;
+    };
+    const Study s =
+        loadStudy(file("two_strips",
+                       "  vary:\n    - {key: rover.release_time_s, values: [0.4]}\n" + replicates),
+                  folder / "out");
+    REQUIRE(s.points.size() == 2);
+    std::set<std::pair<double, double>> seeds;
+    for (const Point &p : s.points)
+        seeds.emplace(at(p, "soil_left.deposition.seed"), at(p, "soil_right.deposition.seed"));
+    CHECK(seeds == std::set<std::pair<double, double>>{{21, 22}, {23, 24}});
+    CHECK(s.replicate_key == "soil_left.deposition.seed");
+    CHECK(s.varied_keys == std::vector<std::string>{"rover.release_time_s"});
+    CHECK_THAT(s.points[0].label, Catch::Contains("=21") && Catch::Contains("=22"));
+
+    const std::string both =
+        file("both", "  replicates: {count: 2, key: soil_left.deposition.seed, keys: "
+                     "[soil_right.deposition.seed]}\n");
+    CHECK_THAT(errorOf([&] { loadStudy(both, folder / "out"); }),
+               Catch::Contains(both + ":4: key 'design.replicates.keys': give key or keys"));
+    const std::string twice =
+        file("twice", "  replicates: {count: 2, keys: [soil_left.deposition.seed, "
+                      "soil_left.deposition.seed]}\n");
+    CHECK_THAT(errorOf([&] { loadStudy(twice, folder / "out"); }),
+               Catch::Contains(twice + ":4:") && Catch::Contains("is given twice"));
+}
+
 TEST_CASE("a zipped design pairs the i-th values, and lists of unequal length are refused",
           "[study][design]") {
     TempFolder folder("zip");
