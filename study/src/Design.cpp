@@ -163,9 +163,13 @@ Study loadStudy(const std::string &path, const std::string &directory,
         scenario = fs::path(path).parent_path() / scenario;
     base.finish();
     YAML::Node scenario_tree;
+    // A folder opens as a stream and fails only when read, with the stream's own words (an
+    // empty or tagged `scenario:` names the study's folder: the fuzzer's).
+    if (fs::is_directory(scenario))
+        scenario_key.fail("cannot read scenario '" + scenario.string() + "': it is a folder");
     try {
         scenario_tree = YAML::LoadFile(scenario.string());
-    } catch (const YAML::Exception &e) {
+    } catch (const std::exception &e) {
         scenario_key.fail("cannot read scenario '" + scenario.string() + "': " + e.what());
     }
     absolutizeFilePaths(scenario_tree, scenario.parent_path().string());

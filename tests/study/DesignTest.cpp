@@ -116,6 +116,19 @@ TEST_CASE("replicates over several seed keys give each key a seed of its own, ne
                Catch::Contains(twice + ":4:") && Catch::Contains("is given twice"));
 }
 
+TEST_CASE("a base scenario that is a folder is refused naming the study file and the line",
+          "[study][design]") {
+    // An empty (or only tagged) `scenario:` names the study's own folder, which opens as a
+    // stream and failed when read with the stream's words alone (the study fuzzer's finding).
+    TempFolder folder("scenario-folder");
+    const std::string path = folder / "folder.yaml";
+    writeFile(path, "name: folder\nbase: {kind: dem, scenario: \"\"}\n"
+                    "observables: [bodies.plate.force_N.2]\n");
+    CHECK_THAT(errorOf([&] { loadStudy(path, folder / "out"); }),
+               Catch::Contains(path + ":2: key 'base.scenario'") &&
+                   Catch::Contains("it is a folder"));
+}
+
 TEST_CASE("a zipped design pairs the i-th values, and lists of unequal length are refused",
           "[study][design]") {
     TempFolder folder("zip");
