@@ -144,17 +144,26 @@ void setGravity(YAML::Node soil, const Experiment &e) {
     if (g_it == e.numbers.end() && a_it == e.numbers.end())
         return;
     YAML::Node sim = soil["simulation"];
-    const double g =
-        g_it != e.numbers.end()
-            ? g_it->second
-            : dem::simulationGravity(config::ConfigNode::loadString(
-                                         YAML::Dump(sim), "the base model's soil.simulation"))
-                  .norm();
+    const double g_base =
+        dem::simulationGravity(
+            config::ConfigNode::loadString(YAML::Dump(sim), "the base model's soil.simulation"))
+            .norm();
+    const double g = g_it != e.numbers.end() ? g_it->second : g_base;
     const double a = a_it != e.numbers.end() ? a_it->second * M_PI / 180.0 : 0.0;
     sim.remove("gravity_m_s2");
     sim["gravity"] = flowList({-g * std::sin(a), 0.0, -g * std::cos(a)});
-    if (!soil["deposition"]["gravity"])
-        soil["deposition"]["gravity"] = flowList({0.0, 0.0, -g});
+    YAML::Node deposition = soil["deposition"];
+    if (!deposition["gravity"]) {
+        deposition["gravity"] = flowList({0.0, 0.0, -g});
+        // Grains fall sqrt(g_base / g) times as long under a weaker gravity: the settling's
+        // time limit with them (else the bed is cut off unsettled, "NOT (time limit)").
+        if (g < g_base) {
+            const double limit = deposition["max_settle_time_s"]
+                                     ? deposition["max_settle_time_s"].as<double>()
+                                     : dem::DepositionSpec().max_settle_time_s;
+            deposition["max_settle_time_s"] = limit * std::sqrt(g_base / g);
+        }
+    }
 }
 
 /// Every number under `node` times `f` (a radius distribution's sizes).

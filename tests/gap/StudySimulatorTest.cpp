@@ -359,6 +359,9 @@ TEST_CASE("an experiment's gravity and a wheel's slope make its soil: tilted gra
     CHECK(mars.settings.gravity_m_s2.isApprox(grainlink::dem::Vec3(0, 0, -3.71)));
     REQUIRE(mars.deposition.gravity_m_s2);
     CHECK(mars.deposition.gravity_m_s2->isApprox(grainlink::dem::Vec3(0, 0, -3.71)));
+    // A fall under Mars' gravity takes sqrt(9.81 / 3.71) = 1.626 times as long: so may settling.
+    CHECK(mars.deposition.max_settle_time_s ==
+          Approx(earth.deposition.max_settle_time_s * 1.6261).epsilon(1e-4));
     const auto slope = soilOf("slope_wheel");
     CHECK(slope.settings.gravity_m_s2.x() == Approx(-3.3552).margin(1e-4));
     CHECK(slope.settings.gravity_m_s2.y() == 0.0);
