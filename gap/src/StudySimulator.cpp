@@ -303,7 +303,8 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     out.experiments.clear();
     // A condition the simulation does not read is said, once with its experiments:
     // `wheel_diameter_m` for `wheel_radius_m` would otherwise leave the base's wheel in silence.
-    std::map<std::string, std::vector<std::string>> unused, undescribed;
+    std::map<std::string, std::vector<std::string>> unused;
+    std::map<std::pair<std::string, std::string>, std::vector<std::string>> undescribed;
     for (const Experiment &e : set.experiments)
         if (!base.tests.count(typeName(e.type)))
             left_out.push_back(e.id + " (" + typeName(e.type) + ": " + base.path + " has no tests." +
@@ -317,7 +318,7 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                 if (described != base.conditions.end() || key == "box") {
                     // A text condition the base gives soils for: this value among them?
                     if (described == base.conditions.end() || !described->second.count(value))
-                        undescribed[key + " '" + value + "'"].push_back(e.id);
+                        undescribed[{key, value}].push_back(e.id);
                 } else if (std::find(used.begin(), used.end(), key) == used.end()) {
                     unused[key].push_back(e.id);
                 }
@@ -333,17 +334,15 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     };
     for (const auto &[key, ids] : unused)
         out.notes.push_back("condition '" + key +
-                            "' is not simulated (the base's own value "
-                            "stands) in " +
-                            listed(ids) +
+                            "' is not simulated (the base's own value stands) in " + listed(ids) +
                             "; the tests are set up from plate_diameter_m, normal_stress_Pa, "
                             "normal_pressure_Pa, the wheel's radius, width, grouser count and "
                             "height, load_N, slip_angle_deg, slope_deg, gravity_m_s2, and the "
                             "text conditions the base's boxes: and conditions: describe)");
-    for (const auto &[key_value, ids] : undescribed) {
-        const std::string key = key_value.substr(0, key_value.find(' '));
-        out.notes.push_back(key + " " + key_value.substr(key.size() + 1) + " has no soil in " +
-                            base.path + " (" + (key == "box" ? "boxes" : "conditions." + key) +
+    for (const auto &[condition, ids] : undescribed) {
+        const auto &[key, value] = condition;
+        out.notes.push_back(key + " '" + value + "' has no soil in " + base.path + " (" +
+                            (key == "box" ? "boxes" : "conditions." + key) +
                             "): the base's own soil stands in " + listed(ids) + ")");
     }
     if (out.experiments.empty())
