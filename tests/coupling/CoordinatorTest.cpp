@@ -260,7 +260,7 @@ TEST_CASE("A participant that declares its experiment complete ends the run norm
     CHECK_NOTHROW(soil.get());
 }
 
-TEST_CASE("A coordinator runs once; a second run() says what to do instead",
+TEST_CASE("A coordinator runs once, a second run() says what to do instead",
           "[coupling][coordinator]") {
     Coordinator coordinator(twoMassRun(SchemeKind::ExplicitSerial, "inproc://once", 0.01, 0.05));
     CHECK(coordinator.state() == Coordinator::State::Bound);

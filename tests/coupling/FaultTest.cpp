@@ -53,7 +53,7 @@ TEST_CASE("Garbage from a joined participant stops the run naming it", "[couplin
                                                "'soil' failed in window 0"));
 }
 
-TEST_CASE("A wrong protocol major version is refused; the handshake timeout names it",
+TEST_CASE("A wrong protocol major version is refused, the handshake timeout names it",
           "[coupling][fault]") {
     // A wrong-version Hello is no valid Hello: it cannot stop the run (anyone could send one),
     // so the coordinator refuses it, keeps waiting, and names it when the wait runs out.
@@ -114,7 +114,7 @@ TEST_CASE("Out-of-order, duplicate and wrong-tick replies stop the run", "[coupl
     CHECK_THAT(failureOf(mbs), Catch::Contains("the coordinator stopped the run"));
 }
 
-TEST_CASE("Strangers and a mid-run reconnect get an error; the run goes on", "[coupling][fault]") {
+TEST_CASE("Strangers and a mid-run reconnect get an error, the run goes on", "[coupling][fault]") {
     Coordinator coordinator(faultRun(2.0));
     const std::string endpoint = coordinator.boundEndpoint();
     std::promise<void> running;
@@ -163,7 +163,7 @@ TEST_CASE("Strangers and a mid-run reconnect get an error; the run goes on", "[c
     CHECK_THAT(text, !Catch::Contains("\ncoordinator: participant 'soil' failed"));
 }
 
-TEST_CASE("A message of several frames wedges nothing; from a participant it stops the run",
+TEST_CASE("A message of several frames wedges nothing, from a participant it stops the run",
           "[coupling][fault]") {
     SECTION("from a stranger, before anyone joined: the handshake timeout still fires") {
         auto config = faultRun();
@@ -264,7 +264,7 @@ TEST_CASE("A frame above limits.max_message_bytes is dropped at the socket", "[c
     CHECK(small_replies == 1);
 }
 
-TEST_CASE("A stranger that floods is dropped with a logged reason; the run goes on",
+TEST_CASE("A stranger that floods is dropped with a logged reason, the run goes on",
           "[coupling][fault]") {
     Coordinator coordinator(faultRun());
     const std::string endpoint = coordinator.boundEndpoint();

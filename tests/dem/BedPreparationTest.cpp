@@ -163,7 +163,7 @@ TEST_CASE("compaction: the plate holds pressure x area, and the packing fraction
     CHECK(fractions[1] < fractions[3]);
 }
 
-TEST_CASE("compaction: under load the press shortens its step; the bed packs as at a fine step",
+TEST_CASE("compaction: under load the press shortens its step, the bed packs as at a fine step",
           "[dem][preparation]") {
     // 1e-4 s is fine for settling this bed but not under 10 kPa: run there, the loaded bed
     // rattled and packed by noise to 0.57 (physics.md §6.1, table). The press now runs at the
@@ -343,7 +343,7 @@ TEST_CASE("a prepared bed is cached with its crust and read back as it was settl
 }
 
 TEST_CASE("a body placed cutting the highest grain is refused naming the grain and the height to "
-          "add; one above it starts",
+          "add, one above it starts",
           "[bed]") {
     // A 1 mm square plate centred over the grain whose top is highest, its face half that
     // grain's radius above the grain's centre: that grain is cut by 0.5 of its radius.

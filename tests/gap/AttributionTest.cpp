@@ -109,7 +109,7 @@ TEST_CASE("signature overlap: proportional signatures overlap fully, orthogonal 
     CHECK(signatureOverlap(r1, 0.8, r3, p, base, u2, all(4)).fraction == Approx(0.0).margin(1e-6));
 }
 
-TEST_CASE("held-out scores: a perfect model has no gap; a 10 % error is a 10 % relative rmse",
+TEST_CASE("held-out scores: a perfect model has no gap, a 10 % error is a 10 % relative rmse",
           "[gap][attribution]") {
     const Eigen::VectorXd y = Eigen::VectorXd::Constant(4, 100.0);
     const auto perfect = scoreHeldOut(y, y, Eigen::VectorXd::Constant(4, 4.0),
@@ -135,7 +135,7 @@ TEST_CASE("held-out scores: a perfect model has no gap; a 10 % error is a 10 % r
 }
 
 TEST_CASE("block correlation: one per experiment when its features move together, about k when "
-          "independent; its chi^2 is the generalised least squares form",
+          "independent, its chi^2 is the generalised least squares form",
           "[gap][attribution]") {
     std::vector<FeatureKey> keys;
     for (int b = 0; b < 5; ++b)
@@ -276,7 +276,7 @@ TEST_CASE("the held-out density test holds its level when the gains move with th
     CHECK(power > 0.65);
 }
 
-TEST_CASE("the held-out density test: a model as good as the null is not better; a precise "
+TEST_CASE("the held-out density test: a model as good as the null is not better, a precise "
           "right prediction beats a vague one",
           "[gap][attribution]") {
     const Eigen::VectorXd y = Eigen::VectorXd::Constant(6, 10.0);

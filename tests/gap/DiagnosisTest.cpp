@@ -634,7 +634,7 @@ Diagnosis withCappedCohesion(double cap) {
 } // namespace
 
 TEST_CASE("diagnosis: a claim names the rivals that its held-out experiments cannot tell it "
-          "from, at their prior's edge too; a better prediction that cannot be claimed leaves "
+          "from, at their prior's edge too, a better prediction that cannot be claimed leaves "
           "it unexplained",
           "[gap][diagnosis]") {
     // Pinned at its edge the capped entry predicts the held-out plates about as well: never

@@ -79,7 +79,7 @@ TEST_CASE("a smooth discrepancy is interpolated between calibration regimes",
     CHECK(p.mean[1] == Approx(0.3 * std::sin(2.0 * M_PI * 0.625)).margin(0.03));
 }
 
-TEST_CASE("regime coordinates are scaled by the calibration's range; labels one unit apart",
+TEST_CASE("regime coordinates are scaled by the calibration's range, labels one unit apart",
           "[gap][discrepancy]") {
     const auto pts = regimeCoordinates(
         {"a", "a", "a", "b"},

@@ -131,7 +131,7 @@ TEST_CASE("a soft surface layer is a crust of softer grains in the prepared beds
     CHECK_FALSE(poured["soil"]["deposition"]["crust"]);
 }
 
-TEST_CASE("polydispersity keeps the mean radius and the solid volume; domain size the depth",
+TEST_CASE("polydispersity keeps the mean radius and the solid volume, domain size the depth",
           "[gap][effects]") {
     const YAML::Node base = YAML::Load(kScenario);
     const EffectCatalogue c = shippedEffects();

@@ -95,7 +95,7 @@ TEST_CASE("experiments.yaml: repeats in SI, and their mean and scatter per bin",
     CHECK((sim - m.value).cwiseAbs().maxCoeff() < 1e-6);
 }
 
-TEST_CASE("experiments.yaml: a force-threshold zero moves x to the first sample reaching it; an "
+TEST_CASE("experiments.yaml: a force-threshold zero moves x to the first sample reaching it, an "
           "unloading branch is left out",
           "[gap][experiments]") {
     // p = 0 until 3 mm, then rises: with a 0.5 kPa threshold the zero is at 3.5 mm.

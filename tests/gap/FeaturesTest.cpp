@@ -32,7 +32,7 @@ TEST_CASE("a bin mean is the integral of the curve over the bin divided by its w
     CHECK(*binMean(line, 0.1, 0.9) == Approx(1.0 + 2.0 * 0.5).epsilon(1e-12));
 }
 
-TEST_CASE("a bin the curve does not cover has no mean; a scalar is its own value",
+TEST_CASE("a bin the curve does not cover has no mean, a scalar is its own value",
           "[gap][features]") {
     const Curve c{{0.0, 0.01}, {0.0, 1.0}};
     CHECK_FALSE(binMean(c, 0.005, 0.02).has_value());

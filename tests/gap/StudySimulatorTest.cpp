@@ -375,7 +375,7 @@ TEST_CASE("an experiment's gravity and a wheel's slope make its soil: tilted gra
 }
 
 TEST_CASE("a text condition the base describes gives its experiments their soil: a bed's "
-          "preparation; a value it does not describe is said",
+          "preparation, a value it does not describe is said",
           "[gap][simulator]") {
     // The CMU base with a dense preparation (more grains in the same box) besides its own bed:
     // plates prepared dense, loose (which the base leaves to its own soil) and unsaid.

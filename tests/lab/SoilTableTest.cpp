@@ -103,7 +103,7 @@ TEST_CASE("Soil table inversion: targets outside the table name the file and its
                       Contains("angle of repose 60") && Contains("data/synthetic.csv"));
 }
 
-TEST_CASE("Soil table file: written rows read back; a gap in the grid is an error",
+TEST_CASE("Soil table file: written rows read back, a gap in the grid is an error",
           "[lab][soil_table]") {
     const auto dir = std::filesystem::temp_directory_path() /
                      ("grainlink_soil_table_test-" + std::to_string(::getpid()));

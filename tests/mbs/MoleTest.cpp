@@ -139,7 +139,7 @@ TEST_CASE("Mole: the drive spring releases the configured stroke energy", "[mbs]
     CHECK(e_max_error < 1e-6 * e0);
 }
 
-TEST_CASE("Mole in free space: momentum is conserved through a stroke; primary impact before "
+TEST_CASE("Mole in free space: momentum is conserved through a stroke, primary impact before "
           "secondary",
           "[mbs][mole]") {
     MoleSettings s = quickMole();

@@ -322,7 +322,7 @@ TEST_CASE("Rocker-bogie: driven wheels hold their speed and climb a slope", "[mb
         CHECK(o.at("wheel_" + suffix + "_slip") == Approx(creep / r).margin(1e-3));
 }
 
-TEST_CASE("Rocker-bogie: held in the drop, it comes down onto a slope without sliding; released, "
+TEST_CASE("Rocker-bogie: held in the drop, it comes down onto a slope without sliding, released, "
           "it climbs as a free one does",
           "[mbs][rover][slow]") {
     // The 10° slope of the test above; the chassis' horizontal velocity held while locked.

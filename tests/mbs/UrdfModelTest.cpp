@@ -435,7 +435,7 @@ TEST_CASE("URDF floating root with an STL mesh falls under gravity and the soil 
     CHECK(m.observables().at("root_vz_m_s") == Approx(-4.905 * 0.5).margin(1e-9));
 }
 
-TEST_CASE("URDF planar joint moves in its plane only; a massless fixed link is allowed",
+TEST_CASE("URDF planar joint moves in its plane only, a massless fixed link is allowed",
           "[mbs][urdf]") {
     UrdfModel m(parseUrdfModel(kData + "/planar.yaml"));
     Wrench soil;

@@ -207,7 +207,7 @@ void writeLongerPlate(const TempFolder &folder, const std::string &duration_s,
 
 } // namespace
 
-TEST_CASE("a run killed from outside leaves its point unfinished while the study goes on; the "
+TEST_CASE("a run killed from outside leaves its point unfinished while the study goes on, the "
           "next start runs just that point",
           "[study][local]") {
     TempFolder folder("killed-run");
