@@ -32,6 +32,24 @@ double RadiusDistribution::smallest() const {
     return r;
 }
 
+double RadiusDistribution::meanCubedRadius() const {
+    switch (kind) {
+    case Kind::Constant:
+        return min_m * min_m * min_m;
+    case Kind::Uniform: // (b^4 - a^4) / (4 (b - a)), written without the division by b - a
+        return (min_m + max_m) * (min_m * min_m + max_m * max_m) / 4.0;
+    case Kind::Discrete: {
+        double sum = 0.0, weight = 0.0;
+        for (std::size_t k = 0; k < radii_m.size(); ++k) {
+            sum += fractions[k] * radii_m[k] * radii_m[k] * radii_m[k];
+            weight += fractions[k];
+        }
+        return sum / weight;
+    }
+    }
+    return 0.0;
+}
+
 void RadiusDistribution::validate() const {
     if (kind == Kind::Constant && !(min_m > 0.0))
         throw std::invalid_argument("radius: value_m must be > 0");

@@ -324,34 +324,6 @@ void parsePreparation(const ConfigNode &node, DepositionSpec &d) {
     }
 }
 
-DepositionSpec parseDeposition(const ConfigNode &node) {
-    DepositionSpec d;
-    d.method = node.text("method", "random") == "rain" ? DepositionSpec::Method::Rain
-                                                       : DepositionSpec::Method::Random;
-    if (const auto m = node.optional("method"))
-        m->choice({"random", "rain"});
-    const ConfigNode region = node["region"];
-    d.region_lower_m = region["lower_m"].vec3();
-    d.region_upper_m = region["upper_m"].vec3();
-    region.finish();
-    if ((d.region_upper_m - d.region_lower_m).minCoeff() <= 0.0)
-        region.fail("upper_m must exceed lower_m on every axis");
-    d.count = std::size_t(node["count"].integer(1, kMaxGrains));
-    d.radius = parseRadius(node["radius"]);
-    d.seed = std::uint64_t(node.number("seed", 1.0));
-    d.layers = int(node.integer("layers", 1, kMaxLayers, 1));
-    d.layer_interval_s = node.number("layer_interval_s", 0.1);
-    d.settle_kinetic_energy_J = node.number("settle_kinetic_energy_J", 1e-9);
-    d.max_settle_time_s = node.number("max_settle_time_s", 5.0);
-    if (const auto rolling = node.optional("rolling"))
-        d.rolling = parseRolling(*rolling);
-    if (const auto g = node.optional("gravity"))
-        d.gravity_m_s2 = gravityOf(*g);
-    parsePreparation(node, d);
-    node.finish();
-    return d;
-}
-
 TriangleMesh parseMesh(const ConfigNode &node, const std::string &scenario_dir) {
     const std::string type = node["type"].choice({"cylinder", "stl"});
     TriangleMesh mesh;
@@ -406,6 +378,34 @@ BodySpec parseBody(const ConfigNode &node, const std::string &scenario_dir) {
 }
 
 } // namespace
+
+DepositionSpec parseDeposition(const ConfigNode &node) {
+    DepositionSpec d;
+    d.method = node.text("method", "random") == "rain" ? DepositionSpec::Method::Rain
+                                                       : DepositionSpec::Method::Random;
+    if (const auto m = node.optional("method"))
+        m->choice({"random", "rain"});
+    const ConfigNode region = node["region"];
+    d.region_lower_m = region["lower_m"].vec3();
+    d.region_upper_m = region["upper_m"].vec3();
+    region.finish();
+    if ((d.region_upper_m - d.region_lower_m).minCoeff() <= 0.0)
+        region.fail("upper_m must exceed lower_m on every axis");
+    d.count = std::size_t(node["count"].integer(1, kMaxGrains));
+    d.radius = parseRadius(node["radius"]);
+    d.seed = std::uint64_t(node.number("seed", 1.0));
+    d.layers = int(node.integer("layers", 1, kMaxLayers, 1));
+    d.layer_interval_s = node.number("layer_interval_s", 0.1);
+    d.settle_kinetic_energy_J = node.number("settle_kinetic_energy_J", 1e-9);
+    d.max_settle_time_s = node.number("max_settle_time_s", 5.0);
+    if (const auto rolling = node.optional("rolling"))
+        d.rolling = parseRolling(*rolling);
+    if (const auto g = node.optional("gravity"))
+        d.gravity_m_s2 = gravityOf(*g);
+    parsePreparation(node, d);
+    node.finish();
+    return d;
+}
 
 int threadsFor(const ConfigNode &sim) {
     const int given = int(sim.integer("threads", 1, kMaxThreads, 1)); // checked even if overridden

@@ -21,6 +21,8 @@ namespace grainlink::gap {
 
 using config::ConfigNode;
 
+std::vector<std::string> simulatedConditions(ExperimentType type);
+
 namespace {
 
 /// v rounded up to two significant digits (0.01089 -> 0.011); 0 stays 0.
@@ -63,8 +65,9 @@ std::string boxOf(const Experiment &e) {
 constexpr const char *kWheelConditions[] = {"wheel_radius_m",   "wheel_width_m", "grouser_count",
                                             "grouser_height_m", "load_N",        "slip_angle_deg",
                                             "slope_deg"};
-/// The conditions of any experiment that make its soil: its gravity's magnitude.
-constexpr const char *kSoilConditions[] = {"gravity_m_s2"};
+/// The conditions of any experiment that make its soil: its gravity's magnitude and its bed's
+/// depth (read by the tests whose bed is the soil's deposition: plates, shear plates, wheels).
+constexpr const char *kSoilConditions[] = {"gravity_m_s2", "bed_depth_m"};
 
 /// What a test is run for besides its type and box: its gravity, a wheel's geometry, load and
 /// slope.
@@ -89,6 +92,12 @@ std::string unsupported(const Experiment &e) {
         g != e.numbers.end() && !(g->second > 0.0 && g->second < 1e3)) {
         std::ostringstream why;
         why << "gravity_m_s2 " << g->second << ": the magnitude of a gravity, > 0";
+        return why.str();
+    }
+    if (const auto d = e.numbers.find("bed_depth_m");
+        d != e.numbers.end() && !(d->second > 0.0 && d->second < 1e3)) {
+        std::ostringstream why;
+        why << "bed_depth_m " << d->second << ": the bed's depth over its floor, > 0";
         return why.str();
     }
     if (const auto a = e.numbers.find("slope_deg");
@@ -155,6 +164,13 @@ void setGravity(YAML::Node soil, const Experiment &e) {
     YAML::Node deposition = soil["deposition"];
     if (!deposition["gravity"]) {
         deposition["gravity"] = flowList({0.0, 0.0, -g});
+        // A resting grain's energies scale with m g d: the base's "settled" means the same
+        // fraction of them under g (an absolute threshold would pass a Mars bed 2.6 times as
+        // restless, and never a bed under ten Earth gravities).
+        const double settle = deposition["settle_kinetic_energy_J"]
+                                  ? deposition["settle_kinetic_energy_J"].as<double>()
+                                  : dem::DepositionSpec().settle_kinetic_energy_J;
+        deposition["settle_kinetic_energy_J"] = settle * g / g_base;
         // Grains fall sqrt(g_base / g) times as long under a weaker gravity: the settling's
         // time limit with them (else the bed is cut off unsettled, "NOT (time limit)").
         if (g < g_base) {
@@ -164,6 +180,34 @@ void setGravity(YAML::Node soil, const Experiment &e) {
             deposition["max_settle_time_s"] = limit * std::sqrt(g_base / g);
         }
     }
+}
+
+/// An experiment's bed depth (`bed_depth_m`, over the deposition region's floor), made as a test
+/// bed is brought to a depth: the base's grains poured 1.15 times as deep as it even at the
+/// densest packing poured spheres reach, then struck off level at it. The insertion region
+/// grows with the count, so that the grains go in as sparsely as the base's.
+void setBedDepth(YAML::Node soil, const Experiment &e) {
+    const auto it = e.numbers.find("bed_depth_m");
+    const std::vector<std::string> read = simulatedConditions(e.type);
+    if (it == e.numbers.end() || std::find(read.begin(), read.end(), "bed_depth_m") == read.end())
+        return;
+    constexpr double kDensestPour = 0.64; // random close packing of spheres
+    constexpr double kOverfill = 1.15;
+    YAML::Node deposition = soil["deposition"];
+    const dem::DepositionSpec spec = dem::parseDeposition(
+        config::ConfigNode::loadString(YAML::Dump(deposition), "the base model's soil.deposition"));
+    const dem::Vec3 span = spec.region_upper_m - spec.region_lower_m;
+    const double grain = 4.0 / 3.0 * M_PI * spec.radius.meanCubedRadius();
+    const double depth = it->second;
+    const double count = std::ceil(kOverfill * depth * span.x() * span.y() * kDensestPour / grain);
+    const double height = std::max(span.z(), span.z() * count / double(spec.count));
+    deposition["count"] = static_cast<long long>(count);
+    deposition["region"]["upper_m"] = flowList(
+        {spec.region_upper_m.x(), spec.region_upper_m.y(), spec.region_lower_m.z() + height});
+    deposition["strike_off_height_m"] = spec.region_lower_m.z() + depth;
+    // The last grains fall from a higher top: the settling's time limit grows as the fall's.
+    if (height > span.z())
+        deposition["max_settle_time_s"] = spec.max_settle_time_s * std::sqrt(height / span.z());
 }
 
 /// Every number under `node` times `f` (a radius distribution's sizes).
@@ -280,11 +324,11 @@ bool close(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::
 std::vector<std::string> simulatedConditions(ExperimentType type) {
     switch (type) {
     case ExperimentType::PlateSinkage:
-        return {"plate_diameter_m", "gravity_m_s2"};
-    case ExperimentType::DirectShear:
+        return {"plate_diameter_m", "gravity_m_s2", "bed_depth_m"};
+    case ExperimentType::DirectShear: // the shear box is the test's own: its depth too
         return {"normal_stress_Pa", "gravity_m_s2"};
     case ExperimentType::BevameterShear:
-        return {"normal_pressure_Pa", "gravity_m_s2"};
+        return {"normal_pressure_Pa", "gravity_m_s2", "bed_depth_m"};
     case ExperimentType::AngleOfRepose:
         return {"gravity_m_s2"};
     case ExperimentType::WheelSteadyState: {
@@ -337,8 +381,9 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                             "' is not simulated (the base's own value stands) in " + listed(ids) +
                             "; the tests are set up from plate_diameter_m, normal_stress_Pa, "
                             "normal_pressure_Pa, the wheel's radius, width, grouser count and "
-                            "height, load_N, slip_angle_deg, slope_deg, gravity_m_s2, and the "
-                            "text conditions the base's boxes: and conditions: describe)");
+                            "height, load_N, slip_angle_deg, slope_deg, gravity_m_s2, "
+                            "bed_depth_m (plates and wheels), and the text conditions the "
+                            "base's boxes: and conditions: describe)");
     for (const auto &[condition, ids] : undescribed) {
         const auto &[key, value] = condition;
         out.notes.push_back(key + " '" + value + "' has no soil in " + base.path + " (" +
@@ -524,6 +569,7 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
         mergeInto(root["soil"], o.soil);
     }
     setGravity(root["soil"], first);
+    setBedDepth(root["soil"], first);
     YAML::Node section = YAML::Clone(t->second[test]);
     const FeatureDesign fd = designFeatures(design);
     double reach = 0.0;

@@ -255,7 +255,7 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
     std::vector<Vec3> plane_forces;
     const auto interval = [&]() {
         const double t_start = sys.time();
-        Interval out{observeInterval(sys, steps_per_sample, {0}, &plane_forces)[0], 0.0};
+        Interval out{observeInterval(sys, steps_per_sample, {0}, &plane_forces)[0], 0.0, {}};
         out.t_mid_s = 0.5 * (t_start + sys.time());
         for (int p : ahead)
             out.end_walls.ahead_N += plane_forces[std::size_t(p)].x();

@@ -67,6 +67,42 @@ TEST_CASE("random insertion places non-overlapping grains of the requested sizes
     CHECK(b->particles().position == p.position);
 }
 
+TEST_CASE("a distribution's mean cubed radius is the mean of r^3 over the grains it draws",
+          "[dem][deposition]") {
+    // The mean grain volume sizes a bed to a depth (docs/gap.md, bed_depth_m): checked against
+    // the grains the insertion actually draws, 12000 of each distribution in a roomy region
+    // (the sample mean's relative sd: 0.7 % uniform, 1.1 % discrete; 4 %: at least 3.5 sd).
+    RadiusDistribution uniform;
+    uniform.kind = RadiusDistribution::Kind::Uniform;
+    uniform.min_m = 0.001;
+    uniform.max_m = 0.003;
+    RadiusDistribution discrete;
+    discrete.kind = RadiusDistribution::Kind::Discrete;
+    discrete.radii_m = {0.001, 0.002, 0.003};
+    discrete.fractions = {2.0, 1.0, 1.0};
+    RadiusDistribution constant;
+    constant.min_m = constant.max_m = 0.002;
+    // Hand values: uniform (3^4 - 1^4) / (4 * 2) mm^3 = 10 mm^3; discrete (2 + 8 + 27) / 4.
+    CHECK(uniform.meanCubedRadius() == Approx(10e-9));
+    CHECK(discrete.meanCubedRadius() == Approx(9.25e-9));
+    CHECK(constant.meanCubedRadius() == Approx(8e-9));
+    for (const RadiusDistribution &d : {uniform, discrete}) {
+        DepositionSpec spec;
+        spec.region_lower_m = Vec3::Zero();
+        spec.region_upper_m = Vec3(0.2, 0.2, 0.2);
+        spec.count = 12000;
+        spec.radius = d;
+        auto sys = depositionBox(Vec3(0.2, 0.2, 0.4));
+        Random random(5);
+        REQUIRE(insertRandom(*sys, spec, random, spec.count, spec.region_lower_m,
+                             spec.region_upper_m) == 12000);
+        double sum = 0.0;
+        for (double r : sys->particles().radius)
+            sum += r * r * r;
+        CHECK(sum / 12000.0 == Approx(d.meanCubedRadius()).epsilon(0.04));
+    }
+}
+
 TEST_CASE("deposition by rain fills layer by layer and settles below the energy threshold",
           "[dem][deposition]") {
     DepositionSpec spec;

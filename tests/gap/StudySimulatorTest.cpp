@@ -362,6 +362,9 @@ TEST_CASE("an experiment's gravity and a wheel's slope make its soil: tilted gra
     // A fall under Mars' gravity takes sqrt(9.81 / 3.71) = 1.626 times as long: so may settling.
     CHECK(mars.deposition.max_settle_time_s ==
           Approx(earth.deposition.max_settle_time_s * 1.6261).epsilon(1e-4));
+    // Settled means the same fraction of a grain's m g d under either gravity: 3.71 / 9.81.
+    CHECK(mars.deposition.settle_kinetic_energy_J ==
+          Approx(earth.deposition.settle_kinetic_energy_J * 0.37819).epsilon(1e-4));
     const auto slope = soilOf("slope_wheel");
     CHECK(slope.settings.gravity_m_s2.x() == Approx(-3.3552).margin(1e-4));
     CHECK(slope.settings.gravity_m_s2.y() == 0.0);
@@ -424,5 +427,80 @@ TEST_CASE("a text condition the base describes gives its experiments their soil:
         << text << "  box:\n    tiny: {soil: {deposition: {count: 100}}}\n";
     CHECK_THROWS_WITH(loadBaseModel((scratch / "boxed.yaml").string()),
                       Catch::Contains("conditions.box") && Catch::Contains("boxes:"));
+    fs::remove_all(scratch);
+}
+
+TEST_CASE("an experiment's bed depth makes its bed: poured deeper and struck off level at it, "
+          "the shear box's depth is its own",
+          "[gap][simulator]") {
+    // The CI self-test's base (a 50 mm box, grains of 1.8-2 mm poured about 25 mm deep): plates
+    // on beds of 30 and 15 mm and one without the condition, and a shear box given a depth.
+    const BaseModel base = loadBaseModel(kDir + "/base.yaml");
+    Experiment shear;
+    shear.id = "shear";
+    shear.type = ExperimentType::DirectShear;
+    shear.x_name = "shear_displacement";
+    shear.observables = {"shear_stress_Pa"};
+    shear.numbers = {{"normal_stress_Pa", 4000.0}, {"bed_depth_m", 0.03}};
+    shear.trials.push_back(Trial{});
+    shear.trials[0].curves["shear_stress_Pa"] = Curve{{0.0, 0.001, 0.002}, {0.0, 2e3, 3e3}};
+    ExperimentSet set;
+    set.name = "depths";
+    set.experiments = {plateExperiment("deep", {{"bed_depth_m", 0.03}}, {}),
+                       plateExperiment("shallow", {{"bed_depth_m", 0.015}}, {}),
+                       plateExperiment("as_base", {}, {}),
+                       plateExperiment("no_depth", {{"bed_depth_m", -0.01}}, {}), shear};
+    std::vector<std::string> left_out;
+    const ExperimentSet kept = simulable(set, base, left_out);
+    REQUIRE(left_out.size() == 1);
+    CHECK_THAT(left_out[0], Catch::StartsWith("no_depth (plate_sinkage: bed_depth_m -0.01"));
+    REQUIRE(kept.notes.size() == 1);
+    CHECK_THAT(kept.notes[0], Catch::Contains("condition 'bed_depth_m' is not simulated") &&
+                                  Catch::Contains("in shear (1 experiment"));
+
+    const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-depth-test";
+    fs::remove_all(scratch);
+    fs::create_directories(scratch);
+    const StudySimulator sim(base, (scratch / "sims").string(), {});
+    std::set<std::vector<std::string>> groups;
+    for (const auto &g : sim.groups(kept))
+        groups.insert(g);
+    CHECK(groups ==
+          std::set<std::vector<std::string>>{{"deep"}, {"shallow"}, {"as_base"}, {"shear"}});
+    VariantRequest plain;
+    plain.label = "base";
+    const auto soilOf = [&](const std::string &id) {
+        const Experiment &e = kept.find(id);
+        const fs::path file = scratch / (id + ".yaml");
+        std::ofstream(file) << sim.scenarioText(kept, {id}, plain, 1);
+        const auto scenario = grainlink::lab::loadLabScenario(labTestOf(e.type), file.string());
+        return std::visit([](const auto &s) { return s.soil; }, scenario);
+    };
+    const auto deep = soilOf("deep"), shallow = soilOf("shallow"), as_base = soilOf("as_base");
+    CHECK_FALSE(as_base.deposition.strike_off_height_m);
+    CHECK(as_base.deposition.count == 1300);
+    REQUIRE(deep.deposition.strike_off_height_m);
+    CHECK(*deep.deposition.strike_off_height_m == Approx(0.03));
+    REQUIRE(shallow.deposition.strike_off_height_m);
+    CHECK(*shallow.deposition.strike_off_height_m == Approx(0.015));
+    // Enough grains to stand 15 % above the depth at a packing of 0.64: by hand, a grain of
+    // uniform radius in [1.8, 2] mm has E[r^3] = 3.8 * 7.24 / 4 = 6.878 mm^3, a volume of
+    // 28.81 mm^3; 1.15 * 30 mm * 50 mm * 50 mm * 0.64 / 28.81 mm^3 = 1916 grains for 30 mm,
+    // 958 for 15 mm.
+    CHECK(double(deep.deposition.count) == Approx(1916).margin(1));
+    CHECK(double(shallow.deposition.count) == Approx(958).margin(1));
+    // The region grows with the count (1916 / 1300 of 80 mm), never shrinks.
+    CHECK(deep.deposition.region_upper_m.z() == Approx(0.08 * 1916 / 1300).epsilon(1e-3));
+    CHECK(shallow.deposition.region_upper_m.z() == Approx(0.08));
+    CHECK(soilOf("shear").deposition.strike_off_height_m == std::nullopt);
+
+    // The bed as the DEM makes it: poured above 30 mm, struck off within a grain diameter of it
+    // (docs/physics.md §6.1's strike-off bound, |z_s - h| < 2 r_max).
+    auto system = grainlink::dem::makeSystem(deep);
+    const grainlink::dem::DepositionReport report =
+        grainlink::dem::deposit(*system, deep.deposition);
+    CHECK(report.settled);
+    CHECK(report.struck_off > 0);
+    CHECK(grainlink::dem::bedSurface(system->particles()) == Approx(0.03).margin(0.004));
     fs::remove_all(scratch);
 }

@@ -20,6 +20,7 @@ struct RadiusDistribution {
     std::vector<double> fractions;   ///< ... and their number fractions (normalised)
     double largest() const;
     double smallest() const; ///< of the radii drawn with a fraction > 0
+    double meanCubedRadius() const; ///< E[r^3] of a drawn grain [m^3]: its mean volume / (4/3 pi)
     void validate() const;
 };
 

@@ -81,6 +81,9 @@ int threadsFor(const ConfigNode &sim);
 /// `gravity_m_s2` (a vector), not both; earth without either.
 Vec3 simulationGravity(const ConfigNode &sim);
 
+/// A `deposition` block (the region, count, sizes, settling and preparation); errors name the key.
+DepositionSpec parseDeposition(const ConfigNode &node);
+
 /// Reads and validates a scenario; errors name the file, key and line.
 DemScenario loadScenario(const std::string &path);
 /// `coupled`: the soil section of a coupled run (no `run:`; bodies come from the coupling).
