@@ -85,6 +85,32 @@ Experiment plateExperiment(const std::string &id, const std::map<std::string, do
     return e;
 }
 
+/// A fresh scratch folder under the temporary directory.
+fs::path freshScratch(const std::string &name) {
+    const fs::path scratch = fs::temp_directory_path() / name;
+    fs::remove_all(scratch);
+    fs::create_directories(scratch);
+    return scratch;
+}
+
+/// The groups of experiments that share a test, as a set.
+std::set<std::vector<std::string>> groupSet(const StudySimulator &sim, const ExperimentSet &set) {
+    const auto groups = sim.groups(set);
+    return {groups.begin(), groups.end()};
+}
+
+/// The soil of an experiment's base scenario as the lab reads it (written to `scratch`).
+grainlink::dem::DemScenario labSoilOf(const StudySimulator &sim, const ExperimentSet &set,
+                                      const std::string &id, const fs::path &scratch) {
+    VariantRequest plain;
+    plain.label = "base";
+    const fs::path file = scratch / (id + ".yaml");
+    std::ofstream(file) << sim.scenarioText(set, {id}, plain, 1);
+    const auto scenario =
+        grainlink::lab::loadLabScenario(labTestOf(set.find(id).type), file.string());
+    return std::visit([](const auto &s) { return s.soil; }, scenario);
+}
+
 } // namespace
 
 TEST_CASE("every effect and numerical check on the self-tests' designs is a scenario the lab "
@@ -331,28 +357,16 @@ TEST_CASE("an experiment's gravity and a wheel's slope make its soil: tilted gra
     CHECK_THAT(kept.notes[0], Catch::Contains("condition 'slope_deg' is not simulated") &&
                                   Catch::Contains("in tilted_plate (1 experiment"));
 
-    const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-gravity-test";
-    fs::remove_all(scratch);
-    fs::create_directories(scratch);
+    const fs::path scratch = freshScratch("grainlink-gap-gravity-test");
     const StudySimulator sim(base, (scratch / "sims").string(), {});
     // Earth and tilted plates share a test (the slope is not theirs), the two Mars plates
     // another; each wheel its own.
-    std::set<std::vector<std::string>> groups;
-    for (const auto &g : sim.groups(kept))
-        groups.insert(g);
-    CHECK(groups == std::set<std::vector<std::string>>{{"earth_plate", "tilted_plate"},
-                                                       {"mars_plate", "mars_plate_again"},
-                                                       {"level_wheel"},
-                                                       {"slope_wheel"}});
-    VariantRequest plain;
-    plain.label = "base";
-    const auto soilOf = [&](const std::string &id) {
-        const Experiment &e = kept.find(id);
-        const fs::path file = scratch / (id + ".yaml");
-        std::ofstream(file) << sim.scenarioText(kept, {id}, plain, 1);
-        const auto scenario = grainlink::lab::loadLabScenario(labTestOf(e.type), file.string());
-        return std::visit([](const auto &s) { return s.soil; }, scenario);
-    };
+    CHECK(groupSet(sim, kept) ==
+          std::set<std::vector<std::string>>{{"earth_plate", "tilted_plate"},
+                                             {"mars_plate", "mars_plate_again"},
+                                             {"level_wheel"},
+                                             {"slope_wheel"}});
+    const auto soilOf = [&](const std::string &id) { return labSoilOf(sim, kept, id, scratch); };
     const auto earth = soilOf("earth_plate"), mars = soilOf("mars_plate");
     CHECK(earth.settings.gravity_m_s2.isApprox(grainlink::dem::Vec3(0, 0, -9.81)));
     CHECK_FALSE(earth.deposition.gravity_m_s2); // without the conditions, the base's soil as it is
@@ -382,9 +396,7 @@ TEST_CASE("a text condition the base describes gives its experiments their soil:
           "[gap][simulator]") {
     // The CMU base with a dense preparation (more grains in the same box) besides its own bed:
     // plates prepared dense, loose (which the base leaves to its own soil) and unsaid.
-    const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-preparation-test";
-    fs::remove_all(scratch);
-    fs::create_directories(scratch);
+    const fs::path scratch = freshScratch("grainlink-gap-preparation-test");
     const std::string cmu = std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml";
     std::ifstream in(cmu);
     std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
@@ -404,10 +416,7 @@ TEST_CASE("a text condition the base describes gives its experiments their soil:
                                   Catch::Contains("(conditions.preparation)") &&
                                   Catch::Contains("in loose_plate (1 experiment"));
     const StudySimulator sim(base, (scratch / "sims").string(), {});
-    std::set<std::vector<std::string>> groups;
-    for (const auto &g : sim.groups(kept))
-        groups.insert(g);
-    CHECK(groups ==
+    CHECK(groupSet(sim, kept) ==
           std::set<std::vector<std::string>>{{"dense_plate"}, {"loose_plate", "plain_plate"}});
     VariantRequest plain;
     plain.label = "base";
@@ -458,24 +467,11 @@ TEST_CASE("an experiment's bed depth makes its bed: poured deeper and struck off
     CHECK_THAT(kept.notes[0], Catch::Contains("condition 'bed_depth_m' is not simulated") &&
                                   Catch::Contains("in shear (1 experiment"));
 
-    const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-depth-test";
-    fs::remove_all(scratch);
-    fs::create_directories(scratch);
+    const fs::path scratch = freshScratch("grainlink-gap-depth-test");
     const StudySimulator sim(base, (scratch / "sims").string(), {});
-    std::set<std::vector<std::string>> groups;
-    for (const auto &g : sim.groups(kept))
-        groups.insert(g);
-    CHECK(groups ==
+    CHECK(groupSet(sim, kept) ==
           std::set<std::vector<std::string>>{{"deep"}, {"shallow"}, {"as_base"}, {"shear"}});
-    VariantRequest plain;
-    plain.label = "base";
-    const auto soilOf = [&](const std::string &id) {
-        const Experiment &e = kept.find(id);
-        const fs::path file = scratch / (id + ".yaml");
-        std::ofstream(file) << sim.scenarioText(kept, {id}, plain, 1);
-        const auto scenario = grainlink::lab::loadLabScenario(labTestOf(e.type), file.string());
-        return std::visit([](const auto &s) { return s.soil; }, scenario);
-    };
+    const auto soilOf = [&](const std::string &id) { return labSoilOf(sim, kept, id, scratch); };
     const auto deep = soilOf("deep"), shallow = soilOf("shallow"), as_base = soilOf("as_base");
     CHECK_FALSE(as_base.deposition.strike_off_height_m);
     CHECK(as_base.deposition.count == 1300);
