@@ -99,7 +99,7 @@ public:
 
     /// The coupling step this model asks for now: small in the impact window after a release,
     /// larger while cocking or resting, but never past the next release.
-    double suggestedMacroStep_s() const;
+    double suggestedMacroStep_s() const override;
 
     Phase phase() const;
     int strokeCount() const { return controller_.strokes; }

@@ -101,7 +101,6 @@ private:
     std::deque<WheelSample> drive_samples_;
     SteadyState steady_;
     std::string failure_; ///< why the procedure stopped without a steady state
-    double angular_velocity_rad_s_ = 0.0;
 
     /// Judges the drive's samples (the last two spans): statistics and trends into steady_.
     void judge(double t);
