@@ -11,10 +11,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 
 namespace grainlink::apps {
@@ -128,45 +130,6 @@ std::string substitute(std::string text, const std::string &key, const std::stri
     return text;
 }
 
-/// The rig's steady report (rig_summary.json, written by the rig) gets the wheel's sinkage, which
-/// only the soil knows (its settled surface): the soil series' sinkage of the wheel over the span
-/// the rig judged, with the same statistics. Run after the participants ended, so both files
-/// are complete.
-void addSoilSinkage(const config::ConfigNode &root, const std::string &directory) {
-    const auto sections = nodesIn(root).soil_sections;
-    const std::string summary_path = directory + "/rig_summary.json";
-    if (!root.has("rig") || sections.size() != 1 || !std::filesystem::exists(summary_path))
-        return;
-    auto summary = nlohmann::json::parse(std::ifstream(summary_path));
-    if (!summary.contains("span_s"))
-        return; // the drop never ended: no span was judged
-    const double from = summary["span_s"][0], to = summary["span_s"][1];
-    const std::string wheel = mbs::parseSingleWheelRig(root["rig"]).wheel_name;
-    std::ifstream series(directory + "/" + sections[0] + ".csv");
-    std::string line;
-    std::getline(series, line); // time_s,body,sinkage_m,...
-    std::vector<double> sinkage;
-    while (std::getline(series, line)) {
-        std::istringstream cells(line);
-        std::string time, body, value;
-        std::getline(cells, time, ',');
-        std::getline(cells, body, ',');
-        std::getline(cells, value, ',');
-        const double t = std::strtod(time.c_str(), nullptr);
-        if (body == wheel && t >= from - 1e-9 && t <= to + 1e-9)
-            sinkage.push_back(std::strtod(value.c_str(), nullptr));
-    }
-    if (sinkage.empty())
-        return;
-    const auto s = dem::summarizeSignal(sinkage);
-    summary["sinkage_m"] = {{"mean", s.mean}, {"sd", s.sd}, {"standard_error", s.standard_error}};
-    const std::string partial = summary_path + ".partial";
-    std::ofstream(partial) << summary.dump(2) << '\n';
-    std::filesystem::rename(partial, summary_path);
-    std::printf("run: steady sinkage %.2f +- %.2f mm (se %.2f) in %s\n", 1e3 * s.mean,
-                1e3 * s.sd, 1e3 * s.standard_error, summary_path.c_str());
-}
-
 /// A rig that ended unsteady says why as the run's last line (a study shows a failed point's
 /// last line as its error).
 void printRigVerdict(const std::string &directory) {
@@ -179,6 +142,114 @@ void printRigVerdict(const std::string &directory) {
 }
 
 } // namespace
+
+/// The rig's steady report (rig_summary.json, written by the rig) gets what only the soil knows,
+/// over the span the rig judged, with the same statistics: the wheel's sinkage (below the
+/// settled surface) and the rise of the soil's push on the bin's end walls over their push
+/// before the drive. A steady state whose push the end wall it goes towards took more than
+/// wheel_test.end_wall_limit of is refused: the report says why, and the run fails. Run after
+/// the participants ended, so both files are complete. Returns whether the run stands.
+bool addSoilMeasures(const config::ConfigNode &root, const std::string &directory) {
+    const auto sections = nodesIn(root).soil_sections;
+    const std::string summary_path = directory + "/rig_summary.json";
+    if (!root.has("rig") || sections.size() != 1 || !std::filesystem::exists(summary_path))
+        return true;
+    auto summary = nlohmann::json::parse(std::ifstream(summary_path));
+    if (!summary.contains("span_s"))
+        return true; // the drop never ended: no span was judged
+    const double from = summary["span_s"][0], to = summary["span_s"][1];
+    const double drive_start = summary.value("drive_start_s", from);
+    const double hold_from = drive_start - summary.value("span_length_s", 0.0);
+    const std::string wheel = mbs::parseSingleWheelRig(root["rig"]).wheel_name;
+    std::ifstream series(directory + "/" + sections[0] + ".csv");
+    std::string line;
+    std::getline(series, line);
+    std::map<std::string, std::size_t> column;
+    {
+        std::istringstream names(line);
+        std::string name;
+        while (std::getline(names, name, ','))
+            column.emplace(name, column.size());
+    }
+    std::vector<double> sinkage, ahead, behind, hold_ahead, hold_behind;
+    while (std::getline(series, line)) {
+        std::vector<std::string> cells;
+        std::istringstream row(line);
+        for (std::string cell; std::getline(row, cell, ',');)
+            cells.push_back(cell);
+        const auto value = [&](const char *name) {
+            const auto c = column.find(name);
+            return c == column.end() || c->second >= cells.size()
+                       ? std::nan("")
+                       : std::strtod(cells[c->second].c_str(), nullptr);
+        };
+        if (cells.size() < 2 || cells[1] != wheel)
+            continue;
+        const double t = value("time_s");
+        if (t >= from - 1e-9 && t <= to + 1e-9) {
+            sinkage.push_back(value("sinkage_m"));
+            ahead.push_back(value("end_wall_ahead_N"));
+            behind.push_back(value("end_wall_behind_N"));
+        } else if (t > hold_from + 1e-9 && t <= drive_start + 1e-9) {
+            hold_ahead.push_back(value("end_wall_ahead_N"));
+            hold_behind.push_back(value("end_wall_behind_N"));
+        }
+    }
+    if (sinkage.empty())
+        return true;
+    const auto statistics = [](const std::vector<double> &v, double minus) {
+        std::vector<double> rise;
+        for (double x : v)
+            rise.push_back(x - minus);
+        const auto s = dem::summarizeSignal(rise);
+        return nlohmann::json{{"mean", s.mean}, {"sd", s.sd}, {"standard_error", s.standard_error}};
+    };
+    const auto mean = [](const std::vector<double> &v) {
+        double sum = 0.0;
+        for (double x : v)
+            sum += x;
+        return sum / double(v.size());
+    };
+    summary["sinkage_m"] = statistics(sinkage, 0.0);
+    std::printf("run: steady sinkage %.2f +- %.2f mm (se %.2f) in %s\n",
+                1e3 * summary["sinkage_m"]["mean"].get<double>(),
+                1e3 * summary["sinkage_m"]["sd"].get<double>(),
+                1e3 * summary["sinkage_m"]["standard_error"].get<double>(), summary_path.c_str());
+    bool stands = true;
+    if (!hold_ahead.empty() && std::isfinite(mean(ahead)) && std::isfinite(mean(hold_ahead))) {
+        summary["end_wall_ahead_N"] = statistics(ahead, mean(hold_ahead));
+        summary["end_wall_behind_N"] = statistics(behind, mean(hold_behind));
+        // The wheel's push on the soil along x is the soil's force on it, reversed.
+        const double share = dem::endWallShare(
+            summary["end_wall_ahead_N"]["mean"], summary["end_wall_behind_N"]["mean"],
+            -summary["drawbar_pull_N"]["mean"].get<double>(), summary["normal_load_N"]);
+        summary["end_wall_share"] = share;
+        const auto test = root.optional("wheel_test");
+        const double limit =
+            (test ? mbs::parseWheelTest(*test) : mbs::WheelTestSettings{}).end_wall_limit;
+        std::printf("run: end walls %+.3g N ahead, %+.3g N behind (share %.2f of the push)\n",
+                    summary["end_wall_ahead_N"]["mean"].get<double>(),
+                    summary["end_wall_behind_N"]["mean"].get<double>(), share);
+        if (summary.value("steady", false) && share > limit) {
+            std::ostringstream why;
+            why << "the bin's end walls took " << std::lround(100.0 * share)
+                << " % of the wheel's push along its travel over the steady span, more than "
+                   "wheel_test.end_wall_limit = "
+                << limit
+                << ": the soil pushed by the wheel reached the bin's end, and the steady values "
+                   "are the bin's, not the soil's. Lengthen the bin (soil.walls and the "
+                   "deposition region along x); the results are written to "
+                << directory;
+            summary["steady"] = false;
+            summary["message"] = why.str();
+            stands = false;
+        }
+    }
+    const std::string partial = summary_path + ".partial";
+    std::ofstream(partial) << summary.dump(2) << '\n';
+    std::filesystem::rename(partial, summary_path);
+    return stands;
+}
 
 void checkParticipantSections(const config::ConfigNode &root, const std::string &path) {
     const NodesInScenario nodes = nodesIn(root);
@@ -270,14 +341,14 @@ int runCoupled(const CoupledRunOptions &options) {
         const auto summary = coordinator.run();
         const auto failed = children.stopAll(10.0);
         printSummary(summary, config);
-        addSoilSinkage(config::ConfigNode::loadFile(options.config_path),
-                       config.output_directory);
+        const bool stands = addSoilMeasures(config::ConfigNode::loadFile(options.config_path),
+                                            config.output_directory);
         std::fflush(stdout); // the failures below are the log's last lines
         for (const auto &f : failed)
             std::fprintf(stderr, "run: participant %s\n", f.c_str());
-        if (!failed.empty())
+        if (!failed.empty() || !stands)
             printRigVerdict(config.output_directory);
-        return failed.empty() ? 0 : 1;
+        return failed.empty() && stands ? 0 : 1;
     } catch (...) {
         children.stopAll(3.0); // a frozen process will not exit by itself
         throw;

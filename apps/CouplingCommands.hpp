@@ -28,6 +28,12 @@ int runCoupled(const CoupledRunOptions &options);
 /// nodes its participant commands run, before any process starts: each section strictly, and a
 /// section no node reads, or a second multibody model, is an error naming the key and the line.
 void checkParticipantSections(const config::ConfigNode &root, const std::string &path);
+/// After a single-wheel rig's run on the DEM soil (`directory` holds rig_summary.json and the
+/// soil's series): adds the wheel's sinkage and the bin's end walls over the span the rig judged,
+/// and refuses a steady state whose push the end wall it goes towards took more than
+/// wheel_test.end_wall_limit of (steady false, the message says why). Returns whether the run
+/// stands; a scenario without a rig or a judged span stands as it is.
+bool addSoilMeasures(const config::ConfigNode &root, const std::string &directory);
 /// `grainlink keygen`: CURVE key pairs for the coordinator and each named participant.
 int generateKeys(const std::string &directory, const std::vector<std::string> &participants);
 

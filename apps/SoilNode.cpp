@@ -58,11 +58,13 @@ public:
         std::filesystem::create_directories(options_.output_directory);
         series_.emplace(
             options_.output_directory + "/" + options_.section + ".csv",
-            "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts",
+            "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts,end_wall_ahead_N,"
+            "end_wall_behind_N",
             run.restore ? std::optional(dem::SeriesRestart{double(run.restore->tick) * run.tick_s})
                         : std::nullopt);
         first_step_ = sys_->stepCount();
         implicit_ = run.scheme == coupling::SchemeKind::Implicit;
+        end_walls_ = dem::endWallsAlongX(sys_->planes());
     }
 
     // Implicit coupling repeats a window until the wrenches converge: the DEM goes back to the
@@ -108,6 +110,9 @@ public:
                 refuseStartingOverlap(b);
         }
         coupling::WindowLoads loads(options_.bodies);
+        // The soil's push on the bin's end walls along x over the window (a travel's ahead and
+        // behind): `grainlink run` judges the rig's steady state by it (dem::endWallShare).
+        double ahead_N = 0.0, behind_N = 0.0;
         for (std::uint64_t k = 0; k < steps; ++k) {
             sys_->step();
             for (std::size_t b = 0; b < bodyCount(); ++b) {
@@ -115,7 +120,13 @@ public:
                 loads.add(b, body.force_N, body.torque_N_m, body.state().linear_velocity_m_s,
                           body.state().angular_velocity_rad_s, dt);
             }
+            for (int p : end_walls_.ahead)
+                ahead_N += sys_->planeForce(p).x();
+            for (int p : end_walls_.behind)
+                behind_N -= sys_->planeForce(p).x();
         }
+        ahead_N /= double(steps);
+        behind_N /= double(steps);
         watchClearance(in.end_s);
         coupling::WindowOutputs out = loads.outputs(in.duration_s);
         for (std::size_t b = 0; b < bodyCount(); ++b) {
@@ -128,7 +139,8 @@ public:
             series_->rows() << in.end_s << ',' << w.body << ',' << surface_ - lowestPoint(b) << ','
                             << w.force_N.x() << ',' << w.force_N.y() << ',' << w.force_N.z() << ','
                             << w.torque_N_m.x() << ',' << w.torque_N_m.y() << ','
-                            << w.torque_N_m.z() << ',' << sys_->wallContactCount() << '\n';
+                            << w.torque_N_m.z() << ',' << sys_->wallContactCount() << ',' << ahead_N
+                            << ',' << behind_N << '\n';
         }
         if (!implicit_)
             series_->write();
@@ -242,6 +254,7 @@ private:
     NodeProgress progress_;
     std::uint64_t first_step_ = 0;
     bool implicit_ = false; ///< implicit coupling: windows may be repeated
+    dem::EndWalls end_walls_; ///< the planes facing -x and +x (dem::endWallsAlongX)
     struct Saved {
         dem::DemSystem::State dem;
         int snapshots;

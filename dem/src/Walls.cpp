@@ -1,6 +1,26 @@
 #include "grainlink/dem/Walls.hpp"
 
+#include <algorithm>
+#include <cmath>
+
 namespace grainlink::dem {
+
+EndWalls endWallsAlongX(const std::vector<PlaneWall> &planes) {
+    EndWalls walls;
+    for (std::size_t p = 0; p < planes.size(); ++p) {
+        const double n_x = planes[p].normal.normalized().x();
+        if (n_x < -0.5)
+            walls.ahead.push_back(int(p));
+        else if (n_x > 0.5)
+            walls.behind.push_back(int(p));
+    }
+    return walls;
+}
+
+double endWallShare(double ahead_rise_N, double behind_rise_N, double push_N, double load_N) {
+    return (push_N >= 0.0 ? ahead_rise_N : behind_rise_N) /
+           std::max(std::abs(push_N), 0.1 * load_N);
+}
 
 MeshBody::MeshBody(std::string name, TriangleMesh mesh_body_frame, RigidBodyState initial)
     : name_(std::move(name)), mesh_(std::move(mesh_body_frame)) {

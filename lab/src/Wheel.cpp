@@ -236,30 +236,23 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
     // part of the wheel's push the soil hands on to the bin's end rather than carrying itself:
     // large, and the steady values are the bin's, not the soil's (end_wall_share, refused in
     // runWheel).
-    std::vector<int> ahead, behind;
-    for (std::size_t p = 0; p < sys.planes().size(); ++p) {
-        const double n_x = sys.planes()[p].normal.normalized().x();
-        if (n_x < -0.5)
-            ahead.push_back(int(p));
-        else if (n_x > 0.5)
-            behind.push_back(int(p));
-    }
-    struct EndWalls {
+    const dem::EndWalls walls = dem::endWallsAlongX(sys.planes());
+    struct WallPush {
         double ahead_N = 0.0, behind_N = 0.0; ///< [N] the soil's push on them, along +x and -x
     };
     struct Interval {
         MeanLoad load;
         double t_mid_s;
-        EndWalls end_walls; ///< over the interval
+        WallPush end_walls; ///< over the interval
     };
     std::vector<Vec3> plane_forces;
     const auto interval = [&]() {
         const double t_start = sys.time();
         Interval out{observeInterval(sys, steps_per_sample, {0}, &plane_forces)[0], 0.0, {}};
         out.t_mid_s = 0.5 * (t_start + sys.time());
-        for (int p : ahead)
+        for (int p : walls.ahead)
             out.end_walls.ahead_N += plane_forces[std::size_t(p)].x();
-        for (int p : behind)
+        for (int p : walls.behind)
             out.end_walls.behind_N -= plane_forces[std::size_t(p)].x();
         run.steps += steps_per_sample;
         return out;
@@ -267,8 +260,8 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
 
     // Approach at constant speed until the load is first reached, then hold it. The end walls'
     // push at rest is the mean over the hold (without one, the approach's last interval).
-    EndWalls at_load;
-    std::vector<EndWalls> held;
+    WallPush at_load;
+    std::vector<WallPush> held;
     for (;;) {
         const Interval s = interval();
         progress.update(sys.time() - t0, 0.0, run.steps * sys.particles().size(),
@@ -294,8 +287,8 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
         drive.retarget(sys, sys.time(), 0.0, -servo.update(s.load.force_N.z(), interval_s), 0.0);
         held.push_back(s.end_walls);
     }
-    EndWalls at_rest = held.empty() ? at_load : EndWalls{};
-    for (const EndWalls &h : held) {
+    WallPush at_rest = held.empty() ? at_load : WallPush{};
+    for (const WallPush &h : held) {
         at_rest.ahead_N += h.ahead_N / double(held.size());
         at_rest.behind_N += h.behind_N / double(held.size());
     }
@@ -346,8 +339,8 @@ WheelRun WheelExperiment::run(const LabBed &bed, double slip, double progress_in
     // The wheel's push on the soil along x is the soil's force on it, reversed.
     const double push_N =
         -(run.traction_N.mean * frame.heading.x() + run.side_force_N.mean * frame.side.x());
-    run.end_wall_share = (push_N >= 0.0 ? run.end_wall_ahead_N : run.end_wall_behind_N).mean /
-                         std::max(std::abs(push_N), 0.1 * t.load_N);
+    run.end_wall_share =
+        dem::endWallShare(run.end_wall_ahead_N.mean, run.end_wall_behind_N.mean, push_N, t.load_N);
     for (std::size_t i = run.samples.size() - run.steady_samples; i < run.samples.size(); ++i)
         run.max_load_error = std::max(
             run.max_load_error, std::abs(run.samples[i].vertical_load_N - t.load_N) / t.load_N);

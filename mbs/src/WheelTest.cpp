@@ -313,6 +313,8 @@ WheelTestSettings parseWheelTest(const config::ConfigNode &node) {
     s.steady_slip_tolerance = node.number("steady_slip_tolerance", s.steady_slip_tolerance);
     s.steady_height_tolerance_m =
         node.number("steady_height_tolerance_m", s.steady_height_tolerance_m);
+    if (node.has("end_wall_limit"))
+        s.end_wall_limit = node["end_wall_limit"].number(0.01, 1.0);
     if (node.has("run_until")) {
         const std::string until = node["run_until"].text();
         if (until != "steady" && until != "end_time")

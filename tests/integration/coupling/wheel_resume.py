@@ -13,7 +13,8 @@ resumed, ending bit-identically to an uninterrupted one:
 The results written before each crash stay readable; the run ends as an uninterrupted one does:
 coupling.csv (without its wall-time column), rig.csv (phase included) and soil.csv row for row
 and column for column, rig_summary.txt, and the ParaView snapshots. The rig reports the sinkage
-steady once, not again after the resume.
+steady once, not again after the resume. The soil's series holds each window's push on the
+bin's two end walls, positive (the settled grains lean on both).
 Usage: wheel_resume.py GRAINLINK CONFIG WORK"""
 import csv
 import os
@@ -96,6 +97,17 @@ if first.returncode != 0:
     fail("the uninterrupted run failed:\n" + first.stdout + first.stderr)
 if "sinkage steady" not in first.stdout + first.stderr:
     fail("the uninterrupted run does not report the sinkage steady:\n" + first.stderr)
+# The soil's push on the bin's end walls, each window (grainlink run judges a steady state by it).
+soil_table = rows(os.path.join(straight, "soil.csv"))
+walls = [soil_table[0].index(c) for c in ("end_wall_ahead_N", "end_wall_behind_N")
+         if c in soil_table[0]]
+if len(walls) != 2:
+    fail(f"soil.csv has no end wall columns: {soil_table[0]}")
+# The grains lean on both end walls of the settled bed (a few newtons on this 80 x 120 mm bed).
+for i in walls:
+    pushes = [float(r[i]) for r in soil_table[1:]]
+    if not all(0.0 < p < 100.0 for p in pushes):
+        fail(f"{soil_table[0][i]} out of (0, 100) N: {min(pushes)} .. {max(pushes)}")
 phases = {r[0]: r[1] for r in rows(os.path.join(straight, "rig.csv"))[1:]}
 if phases.get("0.2") != "drive":
     fail(f"the wheel does not drive at the crash (phase {phases.get('0.2')} at 0.2 s)")

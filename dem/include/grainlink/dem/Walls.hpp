@@ -32,6 +32,18 @@ struct PlaneWall {
     Material material; ///< wall elasticity; defaults to the particles' material
 };
 
+/// A bin's end walls along x: the planes facing -x (ahead of a travel along +x) and +x (behind).
+struct EndWalls {
+    std::vector<int> ahead, behind;
+};
+EndWalls endWallsAlongX(const std::vector<PlaneWall> &planes);
+
+/// The share of a push along x (a wheel's on the soil, [N]) that the bin's end wall it goes
+/// towards takes: that wall's rise over its value before the drive, over max(|push|, 0.1 load)
+/// (a wheel that hardly pushes is judged against a tenth of its load). Above about a half the
+/// steady values are the bin's, not the soil's (docs/lab.md, "The bin's end").
+double endWallShare(double ahead_rise_N, double behind_rise_N, double push_N, double load_N);
+
 /// A mesh body's wrench of the last step and its accumulated impulse (MeshBody's members).
 struct BodyLoads {
     Vec3 force_N = Vec3::Zero();

@@ -29,6 +29,9 @@ struct WheelTestSettings {
     /// coupling.end_time_s is no failure (a check of the rig, not a measurement); the default
     /// `steady` ends the run when steady and fails it when it ends unsteady.
     bool until_end_time = false;
+    /// With the DEM soil, `grainlink run` refuses a steady state in which the bin's end wall the
+    /// wheel pushes towards took more than this share of its push (dem::endWallShare).
+    double end_wall_limit = 0.5;
 };
 
 /// One row of the rig's time series and the steady-state report.
