@@ -216,7 +216,9 @@ bool addSoilMeasures(const config::ConfigNode &root, const std::string &director
                 1e3 * summary["sinkage_m"]["sd"].get<double>(),
                 1e3 * summary["sinkage_m"]["standard_error"].get<double>(), summary_path.c_str());
     bool stands = true;
-    if (!hold_ahead.empty() && std::isfinite(mean(ahead)) && std::isfinite(mean(hold_ahead))) {
+    // (A series without the end-wall columns, from before they were written, reads NaN.)
+    if (!hold_ahead.empty() && std::isfinite(mean(ahead)) && std::isfinite(mean(hold_ahead)) &&
+        summary.contains("drawbar_pull_N") && summary.contains("normal_load_N")) {
         summary["end_wall_ahead_N"] = statistics(ahead, mean(hold_ahead));
         summary["end_wall_behind_N"] = statistics(behind, mean(hold_behind));
         // The wheel's push on the soil along x is the soil's force on it, reversed.
