@@ -297,4 +297,11 @@ void ConfigNode::finish() const {
     }
 }
 
+std::optional<std::size_t> listIndex(const std::string &step) {
+    if (step.empty() || step.size() > 9 ||
+        step.find_first_not_of("0123456789") != std::string::npos)
+        return std::nullopt;
+    return std::size_t(std::stoul(step));
+}
+
 } // namespace grainlink::config

@@ -41,9 +41,15 @@ CouplingSeries::CouplingSeries(const std::string &directory, const std::vector<s
         if (std::getline(in, line) && line != expected_header)
             throw CouplingError(path_ +
                                 ": the columns differ from this run's bodies; cannot resume");
-        while (std::getline(in, line)) {
-            const auto window = std::stoull(line.substr(0, line.find(',')));
-            if (window < *resume_window)
+        for (int number = 2; std::getline(in, line); ++number) {
+            // A row begins with its window; a damaged one is named, not read as a number.
+            const std::string first = line.substr(0, line.find(','));
+            if (first.empty() || first.size() > 18 ||
+                first.find_first_not_of("0123456789") != std::string::npos)
+                throw CouplingError(path_ + ": line " + std::to_string(number) +
+                                    " does not begin with a window number ('" + line.substr(0, 40) +
+                                    "'); cannot resume");
+            if (std::stoull(first) < *resume_window)
                 kept.push_back(line);
         }
     }

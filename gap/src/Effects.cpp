@@ -25,10 +25,6 @@ std::vector<std::string> splitPath(const std::string &path) {
     return parts;
 }
 
-bool isIndex(const std::string &s) {
-    return !s.empty() && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
-}
-
 void collect(YAML::Node node, const std::vector<std::string> &parts, std::size_t i, bool create,
              std::vector<YAML::Node> &out) {
     if (i == parts.size()) {
@@ -42,10 +38,9 @@ void collect(YAML::Node node, const std::vector<std::string> &parts, std::size_t
                 collect(node[k], parts, i + 1, create, out);
         return;
     }
-    if (isIndex(p)) {
-        const std::size_t k = std::stoul(p);
-        if (node.IsSequence() && k < node.size())
-            collect(node[k], parts, i + 1, create, out);
+    if (const auto k = config::listIndex(p)) {
+        if (node.IsSequence() && *k < node.size())
+            collect(node[*k], parts, i + 1, create, out);
         return;
     }
     if (node.IsMap() && node[p]) {

@@ -1,5 +1,7 @@
 #include "grainlink/study/ResultTable.hpp"
 
+#include "grainlink/config/ConfigNode.hpp"
+
 #include "grainlink/study/StudyFolder.hpp"
 
 #include <cmath>
@@ -56,10 +58,9 @@ std::optional<double> observable(const json &summary, const std::string &path) {
             if (it == node->end())
                 return std::nullopt;
             node = &*it;
-        } else if (node->is_array() && !step.empty() &&
-                   step.find_first_not_of("0123456789") == std::string::npos &&
-                   std::stoul(step) < node->size()) {
-            node = &(*node)[std::stoul(step)];
+        } else if (const auto k = config::listIndex(step);
+                   node->is_array() && k && *k < node->size()) {
+            node = &(*node)[*k];
         } else {
             return std::nullopt;
         }

@@ -1,5 +1,7 @@
 #include "grainlink/study/ScenarioEdit.hpp"
 
+#include "grainlink/config/ConfigNode.hpp"
+
 #include <filesystem>
 #include <sstream>
 #include <stdexcept>
@@ -8,10 +10,6 @@
 namespace grainlink::study {
 
 namespace {
-
-bool isIndex(const std::string &step) {
-    return !step.empty() && step.find_first_not_of("0123456789") == std::string::npos;
-}
 
 std::string keysOf(const YAML::Node &map) {
     std::string list;
@@ -30,8 +28,8 @@ YAML::Node child(const YAML::Node &node, const std::string &step, std::string &w
         return YAML::Node(YAML::NodeType::Undefined);
     }
     if (node.IsSequence()) {
-        if (isIndex(step) && std::stoul(step) < node.size())
-            return node[std::stoul(step)];
+        if (const auto k = config::listIndex(step); k && *k < node.size())
+            return node[*k];
         what = "is a list of " + std::to_string(node.size()) + ": no item '" + step + "'";
         return YAML::Node(YAML::NodeType::Undefined);
     }
@@ -84,10 +82,11 @@ void setAtPath(YAML::Node &root, const std::string &key, const YAML::Node &value
     }
     const std::string &last = steps.back();
     if (node.IsSequence()) {
-        if (!isIndex(last) || std::stoul(last) >= node.size())
+        const auto k = config::listIndex(last);
+        if (!k || *k >= node.size())
             throw std::invalid_argument("key '" + key + "': '" + last + "' is not an index of '" +
                                         done + "', a list of " + std::to_string(node.size()));
-        node[std::stoul(last)] = YAML::Clone(value);
+        node[*k] = YAML::Clone(value);
     } else if (node.IsMap()) {
         node[last] = YAML::Clone(value);
     } else {

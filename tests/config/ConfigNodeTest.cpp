@@ -86,3 +86,19 @@ TEST_CASE("an empty file and a folder are refused with what they are", "[config]
     CHECK_THROWS_WITH(ConfigNode::loadFile(bad), Contains("bad.yaml:") && Contains("YAML syntax error"));
     std::filesystem::remove_all(dir);
 }
+
+TEST_CASE("a key's list index is digits only, at most nine of them: a number too long for any "
+          "list is no index, not an overflow",
+          "[config]") {
+    // The study fuzzer's finding (fuzz/regressions/study/index-too-long.txt): a varied key
+    // `bodies.7777...70.motion` ended in std::stoul's out_of_range, which named no file.
+    CHECK(grainlink::config::listIndex("0") == std::size_t(0));
+    CHECK(grainlink::config::listIndex("12") == std::size_t(12));
+    CHECK(grainlink::config::listIndex("999999999") == std::size_t(999999999));
+    CHECK_FALSE(grainlink::config::listIndex("1000000000"));
+    CHECK_FALSE(grainlink::config::listIndex(std::string(70, '7')));
+    CHECK_FALSE(grainlink::config::listIndex(""));
+    CHECK_FALSE(grainlink::config::listIndex("-1"));
+    CHECK_FALSE(grainlink::config::listIndex("1e3"));
+    CHECK_FALSE(grainlink::config::listIndex("plate"));
+}

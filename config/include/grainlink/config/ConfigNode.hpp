@@ -81,4 +81,8 @@ private:
     std::shared_ptr<std::set<std::string>> used_;
 };
 
+/// A dotted key's step as a list index ("3" in `walls.3.upper_m`): digits only, and short enough
+/// for any list (at most 9 digits); anything else, an overflowing number included, is none.
+std::optional<std::size_t> listIndex(const std::string &step);
+
 } // namespace grainlink::config
