@@ -143,6 +143,12 @@ YAML::Node flowList(const std::vector<double> &v) {
     return n;
 }
 
+/// The deposition block of a soil as the DEM reads it (its defaults included).
+dem::DepositionSpec depositionOf(YAML::Node soil) {
+    return dem::parseDeposition(config::ConfigNode::loadString(YAML::Dump(soil["deposition"]),
+                                                               "the base model's soil.deposition"));
+}
+
 /// An experiment's gravity and slope in its soil: the test runs under gravity of the
 /// experiment's magnitude (`gravity_m_s2`; the base's without it) tilted about y by its slope
 /// (`slope_deg`, a wheel's), (-g sin a, 0, -g cos a): a wheel driving along +x climbs. The bed
@@ -163,22 +169,16 @@ void setGravity(YAML::Node soil, const Experiment &e) {
     sim["gravity"] = flowList({-g * std::sin(a), 0.0, -g * std::cos(a)});
     YAML::Node deposition = soil["deposition"];
     if (!deposition["gravity"]) {
+        const dem::DepositionSpec spec = depositionOf(soil);
         deposition["gravity"] = flowList({0.0, 0.0, -g});
         // A resting grain's energies scale with m g d: the base's "settled" means the same
         // fraction of them under g (an absolute threshold would pass a Mars bed 2.6 times as
         // restless, and never a bed under ten Earth gravities).
-        const double settle = deposition["settle_kinetic_energy_J"]
-                                  ? deposition["settle_kinetic_energy_J"].as<double>()
-                                  : dem::DepositionSpec().settle_kinetic_energy_J;
-        deposition["settle_kinetic_energy_J"] = settle * g / g_base;
+        deposition["settle_kinetic_energy_J"] = spec.settle_kinetic_energy_J * g / g_base;
         // Grains fall sqrt(g_base / g) times as long under a weaker gravity: the settling's
         // time limit with them (else the bed is cut off unsettled, "NOT (time limit)").
-        if (g < g_base) {
-            const double limit = deposition["max_settle_time_s"]
-                                     ? deposition["max_settle_time_s"].as<double>()
-                                     : dem::DepositionSpec().max_settle_time_s;
-            deposition["max_settle_time_s"] = limit * std::sqrt(g_base / g);
-        }
+        if (g < g_base)
+            deposition["max_settle_time_s"] = spec.max_settle_time_s * std::sqrt(g_base / g);
     }
 }
 
@@ -194,8 +194,7 @@ void setBedDepth(YAML::Node soil, const Experiment &e) {
     constexpr double kDensestPour = 0.64; // random close packing of spheres
     constexpr double kOverfill = 1.15;
     YAML::Node deposition = soil["deposition"];
-    const dem::DepositionSpec spec = dem::parseDeposition(
-        config::ConfigNode::loadString(YAML::Dump(deposition), "the base model's soil.deposition"));
+    const dem::DepositionSpec spec = depositionOf(soil);
     const dem::Vec3 span = spec.region_upper_m - spec.region_lower_m;
     const double grain = 4.0 / 3.0 * M_PI * spec.radius.meanCubedRadius();
     const double depth = it->second;
