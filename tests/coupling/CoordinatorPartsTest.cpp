@@ -2,6 +2,7 @@
 // (Hellos, floods, CURVE keys) and its limits' configuration.
 #include "Admission.hpp"
 #include "Authenticator.hpp"
+#include "CouplingSeries.hpp"
 #include "Peer.hpp"
 #include "RunBodies.hpp"
 #include "RunState.hpp"
@@ -11,6 +12,8 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 
 using namespace grainlink::coupling;
 namespace pb = grainlink::v1;
@@ -435,4 +438,32 @@ TEST_CASE("Limits: read from coupling.limits, checked with the file and line",
                           Catch::Contains("max_stranger_messages_per_s / 3"));
     CHECK_THROWS_WITH(load("  limits:\n    max_stranger_messages_per_s: 10\n"),
                       Catch::Contains("at least three heartbeats per heartbeat_interval_s"));
+}
+
+TEST_CASE("Coupling series: a resume keeps the rows before its window, and a damaged row is "
+          "named with its file and line",
+          "[coupling][coordinator]") {
+    const auto dir = std::filesystem::temp_directory_path() / "grainlink-coupling-series-test";
+    std::filesystem::remove_all(dir);
+    { CouplingSeries series(dir.string(), {}, std::nullopt); } // its header only
+    const auto path = dir / "coupling.csv";
+    std::ifstream in(path);
+    std::string header;
+    std::getline(in, header);
+    in.close();
+    std::ofstream(path) << header << "\n0,0,1\n1,1,2\n2,2,3\n";
+    { CouplingSeries resumed(dir.string(), {}, std::uint64_t(2)); }
+    std::ifstream kept(path);
+    std::string line;
+    int rows = -1;
+    while (std::getline(kept, line))
+        ++rows;
+    CHECK(rows == 2); // windows 0 and 1
+    kept.close();
+    // A row cut into something that is no window number (a torn write, an edited file).
+    std::ofstream(path) << header << "\n0,0,1\n#1,1,2\n";
+    CHECK_THROWS_WITH(CouplingSeries(dir.string(), {}, std::uint64_t(2)),
+                      Catch::Contains(path.string()) && Catch::Contains("line 3") &&
+                          Catch::Contains("cannot resume"));
+    std::filesystem::remove_all(dir);
 }
