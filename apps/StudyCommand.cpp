@@ -2,7 +2,6 @@
 // into tables (docs/study.md). The machinery is the study library; this is its command line.
 #include "StudyCommand.hpp"
 
-#include "CouplingCommands.hpp"
 #include "grainlink/study/Design.hpp"
 #include "grainlink/study/ResultTable.hpp"
 #include "grainlink/study/StudyFolder.hpp"
@@ -36,13 +35,6 @@ void printProgress(const study::StudyProgress &p) {
     std::fprintf(stderr, "[study] %zu/%zu done, %zu running, %zu failed; %s elapsed, ETA %s\n",
                  p.done, p.total, p.running, p.failed, duration(p.elapsed_s).c_str(),
                  duration(p.eta_s).c_str());
-}
-
-study::Kind kindOf(const std::string &kind, const std::string &test) {
-    study::Kind k = study::standardKind(kind, test);
-    if (k.name == "run")
-        k.validate = [](const config::ConfigNode &root) { checkedCoupledConfig(root); };
-    return k;
 }
 
 /// The closing report: counts, every failed or unfinished point, the tables; exit code.
@@ -115,7 +107,6 @@ int StudyCommand::runStudy() const {
     study::DesignOptions design;
     if (threads_ > 0)
         design.threads = threads_;
-    design.kind_of = kindOf;
     const study::Study s = study::loadStudy(study_path_, directory_, design);
 
     study::ExecutorOptions options = executor_.options();

@@ -6,6 +6,7 @@
 #include "StudyCommand.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
 #include "grainlink/lab/LabTest.hpp"
+#include "grainlink/study/Kind.hpp"
 
 #include <CLI/CLI.hpp>
 
@@ -30,6 +31,10 @@ __attribute__((constructor(101), target("arch=x86-64"))) static void requireX86_
 #endif
 
 int main(int argc, char **argv) {
+    // A study's or a diagnosis' coupled runs are checked by `grainlink run`'s own reader.
+    grainlink::study::setRunScenarioCheck([](const grainlink::config::ConfigNode &root) {
+        grainlink::apps::checkedCoupledConfig(root);
+    });
     CLI::App app{"grainlink: co-simulation of planetary locomotion on granular soil"};
     app.require_subcommand(1);
     app.set_version_flag("--version", std::string("grainlink ") + GRAINLINK_VERSION + " (" +

@@ -153,7 +153,7 @@ Study loadStudy(const std::string &path, const std::string &directory,
     const ConfigNode base = root["base"];
     Kind kind;
     try {
-        kind = options.kind_of(base["kind"].text(), base.text("test", ""));
+        kind = standardKind(base["kind"].text(), base.text("test", ""));
     } catch (const std::invalid_argument &e) {
         base["kind"].fail(e.what());
     }

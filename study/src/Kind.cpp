@@ -9,6 +9,19 @@
 
 namespace grainlink::study {
 
+namespace {
+
+std::function<void(const config::ConfigNode &)> &runScenarioCheck() {
+    static std::function<void(const config::ConfigNode &)> check;
+    return check;
+}
+
+} // namespace
+
+void setRunScenarioCheck(std::function<void(const config::ConfigNode &root)> check) {
+    runScenarioCheck() = std::move(check);
+}
+
 Kind standardKind(const std::string &kind, const std::string &test) {
     if (kind == "dem") {
         if (!test.empty())
@@ -36,7 +49,7 @@ Kind standardKind(const std::string &kind, const std::string &test) {
                 "soil.simulation.threads",
                 "soil.deposition.seed",
                 "checkpoints/latest",
-                {}};
+                runScenarioCheck()};
     }
     if (kind == "lab") {
         lab::requireLabTest(test);

@@ -12,7 +12,6 @@ namespace grainlink::study {
 struct DesignOptions {
     std::optional<int> threads; ///< `--threads`: every point's thread count (kind.threads_key)
     /// The kinds a study file may name; the `grainlink` command adds the coupled run's reader.
-    std::function<Kind(const std::string &kind, const std::string &test)> kind_of = standardKind;
 };
 
 /// Reads the study file and makes its points (not validated yet: `run` does that first).

@@ -31,7 +31,12 @@ struct Kind {
 };
 
 /// `dem`, `run` or `lab` with its `test` (bevameter, repose, direct_shear, bevameter_shear).
-/// `run` has no validator here: its reader lives in the `grainlink` command, which sets it.
+/// `run` is checked by the reader `setRunScenarioCheck` registered (none: unchecked).
 Kind standardKind(const std::string &kind, const std::string &test = "");
+
+/// The coupled run's scenario reader (the coupling and every model's section) lives in the
+/// `grainlink` command, above this library: the command registers it once at start, and every
+/// `run` kind made after carries it (a study's points, a diagnosis' mole runs).
+void setRunScenarioCheck(std::function<void(const config::ConfigNode &root)> check);
 
 } // namespace grainlink::study
