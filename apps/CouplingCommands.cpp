@@ -7,6 +7,7 @@
 #include "grainlink/dem/RigidFloor.hpp"
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/dem/SteadySignal.hpp"
+#include "grainlink/mbs/Mole.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
 
 #include <nlohmann/json.hpp>
@@ -141,27 +142,15 @@ void printRigVerdict(const std::string &directory) {
         std::fprintf(stderr, "run: %s\n", summary.value("message", std::string()).c_str());
 }
 
-} // namespace
+/// One window's row of a soil node's series (soil.csv) for one body.
+struct SoilRow {
+    double time_s, sinkage_m, end_wall_ahead_N, end_wall_behind_N;
+};
 
-/// The rig's steady report (rig_summary.json, written by the rig) gets what only the soil knows,
-/// over the span the rig judged, with the same statistics: the wheel's sinkage (below the
-/// settled surface) and the rise of the soil's push on the bin's end walls over their push
-/// before the drive. A steady state whose push the end wall it goes towards took more than
-/// wheel_test.end_wall_limit of is refused: the report says why, and the run fails. Run after
-/// the participants ended, so both files are complete. Returns whether the run stands.
-bool addSoilMeasures(const config::ConfigNode &root, const std::string &directory) {
-    const auto sections = nodesIn(root).soil_sections;
-    const std::string summary_path = directory + "/rig_summary.json";
-    if (!root.has("rig") || sections.size() != 1 || !std::filesystem::exists(summary_path))
-        return true;
-    auto summary = nlohmann::json::parse(std::ifstream(summary_path));
-    if (!summary.contains("span_s"))
-        return true; // the drop never ended: no span was judged
-    const double from = summary["span_s"][0], to = summary["span_s"][1];
-    const double drive_start = summary.value("drive_start_s", from);
-    const double hold_from = drive_start - summary.value("span_length_s", 0.0);
-    const std::string wheel = mbs::parseSingleWheelRig(root["rig"]).wheel_name;
-    std::ifstream series(directory + "/" + sections[0] + ".csv");
+/// The rows of `body` in the soil series `path`, in time order; a column the file lacks (a
+/// series from before the end-wall columns were written) reads NaN.
+std::vector<SoilRow> soilSeries(const std::string &path, const std::string &body) {
+    std::ifstream series(path);
     std::string line;
     std::getline(series, line);
     std::map<std::string, std::size_t> column;
@@ -171,7 +160,7 @@ bool addSoilMeasures(const config::ConfigNode &root, const std::string &director
         while (std::getline(names, name, ','))
             column.emplace(name, column.size());
     }
-    std::vector<double> sinkage, ahead, behind, hold_ahead, hold_behind;
+    std::vector<SoilRow> rows;
     while (std::getline(series, line)) {
         std::vector<std::string> cells;
         std::istringstream row(line);
@@ -183,16 +172,85 @@ bool addSoilMeasures(const config::ConfigNode &root, const std::string &director
                        ? std::nan("")
                        : std::strtod(cells[c->second].c_str(), nullptr);
         };
-        if (cells.size() < 2 || cells[1] != wheel)
+        if (cells.size() < 2 || cells[1] != body)
             continue;
-        const double t = value("time_s");
-        if (t >= from - 1e-9 && t <= to + 1e-9) {
-            sinkage.push_back(value("sinkage_m"));
-            ahead.push_back(value("end_wall_ahead_N"));
-            behind.push_back(value("end_wall_behind_N"));
-        } else if (t > hold_from + 1e-9 && t <= drive_start + 1e-9) {
-            hold_ahead.push_back(value("end_wall_ahead_N"));
-            hold_behind.push_back(value("end_wall_behind_N"));
+        rows.push_back({value("time_s"), value("sinkage_m"), value("end_wall_ahead_N"),
+                        value("end_wall_behind_N")});
+    }
+    return rows;
+}
+
+void writeJsonAtomically(const std::string &path, const nlohmann::json &j) {
+    const std::string partial = path + ".partial";
+    std::ofstream(partial) << j.dump(2) << '\n';
+    std::filesystem::rename(partial, path);
+}
+
+/// A mole's strokes (mbs_summary.json) get the depth of the hull's tip below the settled bed
+/// surface at each stroke's end, from the soil's series: what a mole's depth is measured as
+/// (the run's own `penetration_m` counts from the tip's start above the grains).
+void addMoleDepths(const config::ConfigNode &root, const std::string &directory,
+                   const std::string &soil_section) {
+    const std::string summary_path = directory + "/mbs_summary.json";
+    if (!std::filesystem::exists(summary_path))
+        return;
+    auto summary = nlohmann::json::parse(std::ifstream(summary_path));
+    if (!summary.contains("strokes") || !summary["strokes"].is_array())
+        return;
+    const mbs::MoleSettings mole = mbs::parseMole(root["mole"]);
+    const auto rows = soilSeries(directory + "/" + soil_section + ".csv", mole.hull_name);
+    if (rows.empty())
+        return;
+    // The last window that ended by `t`: the depth then.
+    const auto depthAt = [&rows](double t) {
+        const SoilRow *at = nullptr;
+        for (const SoilRow &r : rows)
+            if (r.time_s <= t + 1e-9)
+                at = &r;
+        return at ? nlohmann::json(at->sinkage_m) : nlohmann::json(nullptr);
+    };
+    // Resting on the grains under its weight, before the first stroke's release.
+    summary["depth_before_strokes_m"] = depthAt(mole.first_cocking_s + mole.cocking_duration_s);
+    for (auto &stroke : summary["strokes"])
+        stroke["depth_m"] = depthAt(stroke.value("end_time_s", 0.0));
+    summary["depth_m"] = rows.back().sinkage_m;
+    writeJsonAtomically(summary_path, summary);
+    std::printf("run: the mole's tip %.1f mm below the bed surface after %zu strokes (%s)\n",
+                1e3 * rows.back().sinkage_m, summary["strokes"].size(), summary_path.c_str());
+}
+
+} // namespace
+
+/// A mole's strokes get their depths below the bed surface (above). The rig's steady report
+/// (rig_summary.json, written by the rig) gets what only the soil knows,
+/// over the span the rig judged, with the same statistics: the wheel's sinkage (below the
+/// settled surface) and the rise of the soil's push on the bin's end walls over their push
+/// before the drive. A steady state whose push the end wall it goes towards took more than
+/// wheel_test.end_wall_limit of is refused: the report says why, and the run fails. Run after
+/// the participants ended, so both files are complete. Returns whether the run stands.
+bool addSoilMeasures(const config::ConfigNode &root, const std::string &directory) {
+    const auto sections = nodesIn(root).soil_sections;
+    if (root.has("mole") && sections.size() == 1)
+        addMoleDepths(root, directory, sections[0]);
+    const std::string summary_path = directory + "/rig_summary.json";
+    if (!root.has("rig") || sections.size() != 1 || !std::filesystem::exists(summary_path))
+        return true;
+    auto summary = nlohmann::json::parse(std::ifstream(summary_path));
+    if (!summary.contains("span_s"))
+        return true; // the drop never ended: no span was judged
+    const double from = summary["span_s"][0], to = summary["span_s"][1];
+    const double drive_start = summary.value("drive_start_s", from);
+    const double hold_from = drive_start - summary.value("span_length_s", 0.0);
+    const std::string wheel = mbs::parseSingleWheelRig(root["rig"]).wheel_name;
+    std::vector<double> sinkage, ahead, behind, hold_ahead, hold_behind;
+    for (const SoilRow &row : soilSeries(directory + "/" + sections[0] + ".csv", wheel)) {
+        if (row.time_s >= from - 1e-9 && row.time_s <= to + 1e-9) {
+            sinkage.push_back(row.sinkage_m);
+            ahead.push_back(row.end_wall_ahead_N);
+            behind.push_back(row.end_wall_behind_N);
+        } else if (row.time_s > hold_from + 1e-9 && row.time_s <= drive_start + 1e-9) {
+            hold_ahead.push_back(row.end_wall_ahead_N);
+            hold_behind.push_back(row.end_wall_behind_N);
         }
     }
     if (sinkage.empty())
@@ -247,9 +305,7 @@ bool addSoilMeasures(const config::ConfigNode &root, const std::string &director
             stands = false;
         }
     }
-    const std::string partial = summary_path + ".partial";
-    std::ofstream(partial) << summary.dump(2) << '\n';
-    std::filesystem::rename(partial, summary_path);
+    writeJsonAtomically(summary_path, summary);
     return stands;
 }
 

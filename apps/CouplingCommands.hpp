@@ -28,6 +28,8 @@ int runCoupled(const CoupledRunOptions &options);
 /// nodes its participant commands run, before any process starts: each section strictly, and a
 /// section no node reads, or a second multibody model, is an error naming the key and the line.
 void checkParticipantSections(const config::ConfigNode &root, const std::string &path);
+/// After a mole's run on the DEM soil: each stroke in mbs_summary.json gets `depth_m`, the tip's
+/// depth below the settled bed surface at the stroke's end (and the summary the last one).
 /// After a single-wheel rig's run on the DEM soil (`directory` holds rig_summary.json and the
 /// soil's series): adds the wheel's sinkage and the bin's end walls over the span the rig judged,
 /// and refuses a steady state whose push the end wall it goes towards took more than

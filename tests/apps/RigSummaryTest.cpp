@@ -95,3 +95,46 @@ TEST_CASE("a rig's steady report gets the soil's sinkage and end walls, and a wa
     for (const auto &dir : {braked, lenient, driven})
         fs::remove_all(dir);
 }
+
+TEST_CASE("a mole's strokes get the tip's depth below the bed surface at each stroke's end",
+          "[apps][mole]") {
+    // Three strokes ending at 0.5, 0.8 and 1.1 s; the soil's series every 10 ms has the tip 20 mm
+    // above the surface until 0.2 s, then 100 mm deep plus 2 mm for every stroke begun. Each
+    // stroke's depth is the last window that ended within it; penetration (from the start
+    // height) stays as the model wrote it.
+    const fs::path dir = fs::temp_directory_path() / "grainlink-mole-depths";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    std::ofstream(dir / "scenario.yaml")
+        << "participants:\n"
+           "  - {name: mole, role: multibody, command: [grainlink, mbs-node]}\n"
+           "  - {name: soil, role: soil, command: [grainlink, dem-node]}\n"
+           "mole: {start_tip_position_m: [0.04, 0.04, 0.17], hull_name: hull, stroke_period_s: "
+           "0.3,\n"
+           "       cocking_duration_s: 0.1, first_cocking_s: 0.1}\n";
+    nlohmann::json strokes = nlohmann::json::array();
+    for (int k = 1; k <= 3; ++k)
+        strokes.push_back({{"stroke", k}, {"end_time_s", 0.2 + 0.3 * k}, {"penetration_m", 0.1}});
+    std::ofstream(dir / "mbs_summary.json") << nlohmann::json{{"strokes", strokes}}.dump(2);
+    std::ofstream series(dir / "soil.csv");
+    series << "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts\n";
+    for (int k = 1; k <= 110; ++k) {
+        const double t = 0.01 * k;
+        // a stroke is released at 0.2, 0.5 and 0.8 s; the window ending at a release is before it
+        const int begun = t <= 0.2 + 1e-9 ? 0 : t <= 0.5 + 1e-9 ? 1 : t <= 0.8 + 1e-9 ? 2 : 3;
+        series << t << ",hull," << (begun ? 0.1 + 0.002 * begun : -0.02) << ",0,0,1,0,0,0,5\n";
+        series << t << ",other,0.5,0,0,1,0,0,0,5\n"; // another body's rows are not the hull's
+    }
+    series.close();
+    CHECK(grainlink::apps::addSoilMeasures(
+        grainlink::config::ConfigNode::loadFile((dir / "scenario.yaml").string()), dir.string()));
+    const auto s = nlohmann::json::parse(std::ifstream(dir / "mbs_summary.json"));
+    REQUIRE(s["strokes"].size() == 3);
+    CHECK(s["strokes"][0]["depth_m"].get<double>() == Approx(0.102));
+    CHECK(s["strokes"][1]["depth_m"].get<double>() == Approx(0.104));
+    CHECK(s["strokes"][2]["depth_m"].get<double>() == Approx(0.106));
+    CHECK(s["strokes"][2]["penetration_m"].get<double>() == Approx(0.1));
+    CHECK(s["depth_m"].get<double>() == Approx(0.106));
+    CHECK(s["depth_before_strokes_m"].get<double>() == Approx(-0.02)); // the first release: 0.2 s
+    fs::remove_all(dir);
+}
