@@ -12,10 +12,10 @@
 #include <cstdio>
 #include <limits>
 #include <optional>
-#include <tuple>
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 namespace grainlink::gap {
 
@@ -209,6 +209,52 @@ void setBedDepth(YAML::Node soil, const Experiment &e) {
         deposition["max_settle_time_s"] = spec.max_settle_time_s * std::sqrt(height / span.z());
 }
 
+/// A mole experiment's coupled run (docs/gap.md, "The mole"): the Simbody mole of the base's
+/// `mole:` section and the DEM column of the soil, `strokes` strokes long, to the start of the
+/// next cocking (the hull at rest after the last stroke). The windows are whole DEM steps of
+/// the soil as the variant left it (a stiffer grain's shorter step), the step rounded down to
+/// the coupling's nanosecond tick. The tip starts `clearance` above the struck-off surface, so
+/// that a deeper or shallower column meets it alike; the mole's gravity is the experiment's.
+void moleRun(YAML::Node root, const YAML::Node &coupling_over, int strokes, const Experiment &e,
+             std::optional<double> clearance) {
+    YAML::Node mole = root["mole"];
+    const auto number = [](const YAML::Node &n, double fallback) {
+        return n ? n.as<double>() : fallback;
+    };
+    YAML::Node soil = root["soil"];
+    const double dt = 1e-9 * std::floor(soil["simulation"]["time_step_s"].as<double>() / 1e-9);
+    soil["simulation"]["time_step_s"] = dt;
+    YAML::Node c;
+    c["scheme"] = "explicit-serial";
+    c["handshake_timeout_s"] = 1800; // the first run of a packing settles it first
+    c["checkpoint_every_windows"] = 20000;
+    mergeInto(c, coupling_over);
+    const double largest =
+        number(c["adaptive"]["max_macro_step_s"], number(c["macro_step_s"], 1e-3));
+    const double step = dt * std::max(1.0, std::floor(largest / dt + 1e-9));
+    const double end =
+        number(mole["first_cocking_s"], 0.0) + strokes * number(mole["stroke_period_s"], 3.6);
+    c["end_time_s"] = dt * std::ceil(end / dt - 1e-9);
+    c["macro_step_s"] = step;
+    c["adaptive"]["min_macro_step_s"] = dt;
+    c["adaptive"]["max_macro_step_s"] = step;
+    root["coupling"] = c;
+    root.remove("name"); // a coupled scenario is named by its folder
+    const std::string hull = mole["hull_name"] ? mole["hull_name"].as<std::string>() : "mole";
+    root["participants"] = YAML::Load(
+        "- {name: mole, role: multibody, command: [grainlink, mbs-node, '{scenario}', --name, "
+        "'{name}', --endpoint, '{endpoint}', --out, '{out}']}\n"
+        "- {name: soil, role: soil, command: [grainlink, dem-node, '{scenario}', --name, '{name}', "
+        "--endpoint, '{endpoint}', --out, '{out}', --bodies, '" +
+        hull + "', --progress-interval, '60']}");
+    if (const auto g = e.numbers.find("gravity_m_s2"); g != e.numbers.end())
+        mole["gravity_m_s2"] = flowList({0.0, 0.0, -g->second});
+    const YAML::Node strike = soil["deposition"]["strike_off_height_m"];
+    if (strike && clearance && mole["start_tip_position_m"] &&
+        mole["start_tip_position_m"].size() == 3)
+        mole["start_tip_position_m"][2] = strike.as<double>() + *clearance;
+}
+
 /// Every number under `node` times `f` (a radius distribution's sizes).
 void scaleAll(YAML::Node node, double f) {
     if (node.IsScalar()) {
@@ -314,7 +360,26 @@ Curve wheelCurve(const lab::LabSummary &summary, const std::string &observable) 
     return c;
 }
 
-bool close(double a, double b) { return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b)); }
+/// A mole's depth below the bed surface over its strokes, from its run's mbs_summary.json
+/// (`grainlink run` adds each stroke's depth from the soil's series): stroke 0 is the hull
+/// resting on the grains before the first release.
+Curve moleCurve(const nlohmann::json &summary) {
+    Curve c;
+    const auto before = summary.find("depth_before_strokes_m");
+    if (before != summary.end() && before->is_number())
+        c.x.push_back(0.0), c.y.push_back(before->get<double>());
+    const auto strokes = summary.find("strokes");
+    if (strokes == summary.end() || !strokes->is_array())
+        return c;
+    for (const auto &s : *strokes)
+        if (s.value("complete", false) && s.contains("depth_m") && s["depth_m"].is_number())
+            c.x.push_back(s["stroke"].get<double>()), c.y.push_back(s["depth_m"].get<double>());
+    return c;
+}
+
+bool close(double a, double b) {
+    return std::abs(a - b) <= 1e-6 * std::max(std::abs(a), std::abs(b));
+}
 
 } // namespace
 
@@ -330,6 +395,8 @@ std::vector<std::string> simulatedConditions(ExperimentType type) {
         return {"normal_pressure_Pa", "gravity_m_s2", "bed_depth_m"};
     case ExperimentType::AngleOfRepose:
         return {"gravity_m_s2"};
+    case ExperimentType::Mole:
+        return {"gravity_m_s2", "bed_depth_m"};
     case ExperimentType::WheelSteadyState: {
         std::vector<std::string> c(std::begin(kWheelConditions), std::end(kWheelConditions));
         c.insert(c.end(), std::begin(kSoilConditions), std::end(kSoilConditions));
@@ -395,7 +462,7 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     return out;
 }
 
-std::string labTestOf(ExperimentType type) {
+std::string testSectionOf(ExperimentType type) {
     switch (type) {
     case ExperimentType::PlateSinkage:
         return "bevameter";
@@ -408,12 +475,10 @@ std::string labTestOf(ExperimentType type) {
     case ExperimentType::WheelSteadyState:
         return "wheel";
     case ExperimentType::Mole:
-        break;
+        return "mole";
     }
     throw std::invalid_argument(std::string("grainlink gap cannot simulate ") + typeName(type) +
-                                " experiments from a base model yet (plate_sinkage, "
-                                "bevameter_shear, direct_shear, angle_of_repose and "
-                                "wheel_steady_state it can)");
+                                " experiments from a base model");
 }
 
 BaseModel loadBaseModel(const std::string &path) {
@@ -435,7 +500,7 @@ BaseModel loadBaseModel(const std::string &path) {
         }
         std::string section;
         try {
-            section = labTestOf(et);
+            section = testSectionOf(et);
         } catch (const std::invalid_argument &e) {
             t.fail(e.what());
         }
@@ -443,6 +508,8 @@ BaseModel loadBaseModel(const std::string &path) {
         node[section] = YAML::Clone(t[section].yaml());
         if (t.has("soil"))
             node["soil"] = YAML::Clone(t["soil"].yaml());
+        if (et == ExperimentType::Mole && t.has("coupling"))
+            node["coupling"] = YAML::Clone(t["coupling"].yaml());
         if (t.has("probe")) {
             const ConfigNode probe = t["probe"];
             (void)probe["conditions"].items();
@@ -550,7 +617,7 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
                                         const VariantRequest &request, int seed) const {
     const Experiment &first = design.find(group.front());
     const std::string type = typeName(first.type);
-    const std::string test = labTestOf(first.type);
+    const std::string test = testSectionOf(first.type);
     const auto t = base_.tests.find(type);
     if (t == base_.tests.end() || !t->second[test])
         throw std::invalid_argument(base_.path + ": the base model says nothing of how to simulate " +
@@ -567,9 +634,20 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
         root["name"] = root["name"].as<std::string>() + "-" + o.value;
         mergeInto(root["soil"], o.soil);
     }
+    YAML::Node section = YAML::Clone(t->second[test]);
+    // The mole's tip keeps its height above the struck surface of the base's column (10 mm over
+    // a column the base does not strike off, when the experiment gives its depth).
+    std::optional<double> clearance;
+    if (test == "mole") {
+        const YAML::Node strike = root["soil"]["deposition"]["strike_off_height_m"];
+        const YAML::Node tip = section["start_tip_position_m"];
+        if (strike && tip && tip.IsSequence() && tip.size() == 3)
+            clearance = tip[2].as<double>() - strike.as<double>();
+        else if (first.numbers.count("bed_depth_m"))
+            clearance = 0.01;
+    }
     setGravity(root["soil"], first);
     setBedDepth(root["soil"], first);
-    YAML::Node section = YAML::Clone(t->second[test]);
     const FeatureDesign fd = designFeatures(design);
     double reach = 0.0;
     for (const auto &id : group)
@@ -594,6 +672,8 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
     } else if (test == "wheel") {
         wheelSection(section, design, fd, group, base_.path);
     }
+    // A mole run hammers as many strokes as the measured depth curve reaches (its x).
+    const int strokes = std::max(1, int(std::ceil(reach - 1e-6)));
     root[test] = section;
     YAML::Node soil = root["soil"];
     const long long seed0 = soil["deposition"]["seed"] ? soil["deposition"]["seed"].as<long long>() : 1;
@@ -631,8 +711,15 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
                     sec[k] = sec[k].as<double>() * f;
             if (sec["sample_interval_s"])
                 sec["sample_interval_s"] = sec["sample_interval_s"].as<double>() / f;
+            // The mole's loading rate is its strokes' rate (each stroke's impact is the
+            // mechanism's own): the period is compressed from the flight model's 3.6 s.
+            if (test == "mole")
+                sec["stroke_period_s"] =
+                    (sec["stroke_period_s"] ? sec["stroke_period_s"].as<double>() : 3.6) / f;
         }
     }
+    if (test == "mole")
+        moleRun(root, t->second["coupling"], strokes, first, clearance);
     return root;
 }
 
@@ -662,11 +749,17 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
         for (int s = 0; s < requests[r].seeds; ++s)
             for (std::size_t g = 0; g < gs.size(); ++g) {
                 const Experiment &e = design.find(gs[g].front());
-                // The diagnosis reads the summary only (the lab kind makes no plot).
-                study::Kind kind = study::standardKind("lab", labTestOf(e.type));
+                // The diagnosis reads the summary only (the lab kind makes no plot); a mole
+                // hammers in a coupled run.
+                study::Kind kind = e.type == ExperimentType::Mole
+                                       ? study::standardKind("run", "")
+                                       : study::standardKind("lab", testSectionOf(e.type));
+                const YAML::Node scenario =
+                    scenarioNode(design, gs[g], requests[r], requests[r].seed_offset + s);
+                if (kind.summary_file_of)
+                    kind.summary_file = kind.summary_file_of(scenario);
                 const study::Point p = study::makePoint(
-                    kind,
-                    scenarioText(design, gs[g], requests[r], requests[r].seed_offset + s),
+                    kind, study::emitYaml(scenario),
                     requests[r].label + " seed " + std::to_string(s) + " " + gs[g].front());
                 auto [it, fresh] = index.try_emplace(p.id, st.points.size());
                 if (fresh)
@@ -687,7 +780,8 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
                          results[i].error.c_str(), results[i].log.c_str());
             continue;
         }
-        summaries[i] = lab::labSummaryFromJson(results[i].summary.dump(), results[i].folder);
+        if (results[i].point.kind.name != "run")
+            summaries[i] = lab::labSummaryFromJson(results[i].summary.dump(), results[i].folder);
     }
     std::vector<SimulatedCurves> out;
     seeds_of.clear();
@@ -695,8 +789,14 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
         for (int s = 0; s < requests[r].seeds; ++s) {
             SimulatedCurves c;
             for (const Slot &slot : slots) {
-                if (slot.request != r || slot.seed != s || !summaries[slot.point])
+                if (slot.request != r || slot.seed != s ||
+                    results[slot.point].status != study::PointStatus::Done)
                     continue;
+                if (!summaries[slot.point]) { // a mole's coupled run
+                    for (const std::string &id : gs[slot.group])
+                        c[id]["depth_m"] = moleCurve(results[slot.point].summary);
+                    continue;
+                }
                 const lab::LabSummary &sum = *summaries[slot.point];
                 for (const std::string &id : gs[slot.group]) {
                     const Experiment &e = design.find(id);

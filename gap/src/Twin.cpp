@@ -54,8 +54,6 @@ Design loadDesign(const std::string &path) {
         } catch (const std::invalid_argument &ex) {
             n["type"].fail(ex.what());
         }
-        if (e.type == ExperimentType::Mole)
-            n["type"].fail("a design cannot hold mole experiments yet");
         // A wheel reports several observables; every other test one.
         e.observables = e.type == ExperimentType::WheelSteadyState
                             ? wheelObservables(n)
@@ -241,7 +239,8 @@ void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves,
                 data["scatter"] = true;
             YAML::Node x, y;
             x["column"] = e.x_name;
-            x["unit"] = e.x_name == "slip" ? "-" : "m";
+            const std::string x_unit = unitOf(e.x_name); // a slip's and a stroke's: none
+            x["unit"] = x_unit.empty() ? "-" : x_unit;
             data["x"] = x;
             for (const std::string &o : e.observables) {
                 YAML::Node yc;

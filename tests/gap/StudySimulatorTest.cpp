@@ -34,7 +34,7 @@ void acceptedByTheLab(const StudySimulator &sim, const Design &design, const Var
         const fs::path file = scratch / (r.label + "-" + e.id + ".yaml");
         std::ofstream(file) << text;
         INFO(r.label << " on " << e.id << ":\n" << text);
-        CHECK_NOTHROW(grainlink::lab::loadLabScenario(labTestOf(e.type), file.string()));
+        CHECK_NOTHROW(grainlink::lab::loadLabScenario(testSectionOf(e.type), file.string()));
     }
 }
 
@@ -107,7 +107,7 @@ grainlink::dem::DemScenario labSoilOf(const StudySimulator &sim, const Experimen
     const fs::path file = scratch / (id + ".yaml");
     std::ofstream(file) << sim.scenarioText(set, {id}, plain, 1);
     const auto scenario =
-        grainlink::lab::loadLabScenario(labTestOf(set.find(id).type), file.string());
+        grainlink::lab::loadLabScenario(testSectionOf(set.find(id).type), file.string());
     return std::visit([](const auto &s) { return s.soil; }, scenario);
 }
 
@@ -499,4 +499,61 @@ TEST_CASE("an experiment's bed depth makes its bed: poured deeper and struck off
     CHECK(report.struck_off > 0);
     CHECK(grainlink::dem::bedSurface(system->particles()) == Approx(0.03).margin(0.004));
     fs::remove_all(scratch);
+}
+
+TEST_CASE("a mole experiment becomes a coupled run of the base's mole in its column: as many "
+          "strokes as measured, windows of whole DEM steps, its gravity and its column's depth",
+          "[gap][simulator][mole]") {
+    const std::string dir = std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/mole";
+    const BaseModel base = loadBaseModel(dir + "/base.yaml");
+    const Design design = loadDesign(dir + "/design.yaml");
+    const StudySimulator sim(base, (freshScratch("grainlink-gap-mole-test") / "sims").string(), {});
+    const auto runOf = [&](const ExperimentSet &set, const VariantRequest &r) {
+        return YAML::Load(sim.scenarioText(set, {set.experiments.front().id}, r, 1));
+    };
+    VariantRequest plain;
+    plain.label = "base";
+    const YAML::Node run = runOf(design.set, plain);
+    // Two strokes measured: 0.1 s of settling plus two periods of 0.3 s (docs/gap.md, "The mole").
+    CHECK(run["coupling"]["end_time_s"].as<double>() == Approx(0.7));
+    CHECK(run["coupling"]["adaptive"]["min_macro_step_s"].as<double>() == Approx(5e-5));
+    CHECK(run["coupling"]["adaptive"]["max_macro_step_s"].as<double>() == Approx(1e-3));
+    CHECK(run["participants"].size() == 2);
+    CHECK(run["participants"][1]["command"][1].as<std::string>() == "dem-node");
+    CHECK_FALSE(run["name"]); // a coupled scenario has none
+    const auto gravity = run["mole"]["gravity_m_s2"].as<std::vector<double>>();
+    CHECK(gravity == std::vector<double>{0.0, 0.0, -3.71});
+    CHECK(run["mole"]["start_tip_position_m"][2].as<double>() == Approx(0.22)); // 20 mm above 0.2
+
+    // Every variant: windows of whole DEM steps and an end on one (the soil node refuses a
+    // window of a fractional step); the soil, the mole and the coupling each read by their own
+    // readers is the run's validation in `grainlink gap` (test `gap:mole-twin-is-diagnosed`).
+    forEveryVariant(sim, [&](const VariantRequest &r) {
+        const YAML::Node v = runOf(design.set, r);
+        INFO(r.label << ":\n" << YAML::Dump(v));
+        const double dt = v["soil"]["simulation"]["time_step_s"].as<double>();
+        for (const double t :
+             {v["coupling"]["adaptive"]["min_macro_step_s"].as<double>(),
+              v["coupling"]["adaptive"]["max_macro_step_s"].as<double>(),
+              v["coupling"]["macro_step_s"].as<double>(), v["coupling"]["end_time_s"].as<double>()})
+            CHECK(std::abs(t / dt - std::round(t / dt)) < 1e-6);
+        CHECK(std::abs(dt / 1e-9 - std::round(dt / 1e-9)) < 1e-6); // whole coupling ticks
+    });
+
+    // The rate check (f = 0.5) runs the strokes at half the rate: periods of 0.6 s.
+    VariantRequest rate;
+    rate.label = "check-rate";
+    rate.check = "rate";
+    const YAML::Node slow = runOf(design.set, rate);
+    CHECK(slow["mole"]["stroke_period_s"].as<double>() == Approx(0.6));
+    CHECK(slow["coupling"]["end_time_s"].as<double>() == Approx(1.3));
+
+    // A deeper column (bed_depth_m 0.25) starts the tip 20 mm above its struck surface.
+    ExperimentSet deeper = design.set;
+    deeper.experiments.front().numbers["bed_depth_m"] = 0.25;
+    deeper.experiments.front().numbers["gravity_m_s2"] = 1.62;
+    const YAML::Node deep = runOf(deeper, plain);
+    CHECK(deep["soil"]["deposition"]["strike_off_height_m"].as<double>() == Approx(0.25));
+    CHECK(deep["mole"]["start_tip_position_m"][2].as<double>() == Approx(0.27));
+    CHECK(deep["mole"]["gravity_m_s2"][2].as<double>() == Approx(-1.62));
 }

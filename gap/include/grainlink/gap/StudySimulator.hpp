@@ -1,7 +1,8 @@
 #pragma once
 // The diagnosis' simulations as grainlink runs (docs/gap.md, "The base model"): every
 // experiment becomes a lab test of the base model (a plate test, a direct shear box, an angle
-// of repose, a bevameter shear annulus) with its conditions filled in; experiments that share a
+// of repose, a bevameter shear annulus, a wheel) or a coupled run (the HP3 mole) with its
+// conditions filled in; experiments that share a
 // bed run in one test (plates of several sizes on copies of one settled bed). Each variant x
 // seed x test is one point of a `grainlink study`, cached by its resolved scenario, so a killed
 // diagnosis resumes without redoing finished runs and the same run is never made twice.
@@ -40,9 +41,9 @@ BaseModel loadBaseModel(const std::string &path);
 ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                         std::vector<std::string> &left_out);
 
-/// The lab test that simulates an experiment type ("bevameter", "direct_shear", ...); throws
-/// naming the type when grainlink cannot simulate it from a base model yet.
-std::string labTestOf(ExperimentType type);
+/// The section of the base's `tests.<type>` that sets up an experiment type's simulation: its
+/// lab test's ("bevameter", "direct_shear", ...), or "mole" (the HP3 mole of a coupled run).
+std::string testSectionOf(ExperimentType type);
 
 class StudySimulator final : public Simulator {
 public:
