@@ -156,8 +156,18 @@ Eigen::MatrixXd firstRows(const Eigen::MatrixXd &rows, int n) {
 
 } // namespace
 
-ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidates) {
+ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidates,
+                                    bool held_out_exists) {
     ClosestCandidates c;
+    if (!held_out_exists) {
+        // Nothing to predict: the best fit of the calibration experiments, confirmed or not (a
+        // held-out gap of 0 everywhere would name whichever came first).
+        for (const CandidateResult &R : candidates)
+            if (R.applicability.empty() && R.fit.features > 0 && std::isfinite(R.fit.chi2) &&
+                (!c.by_gap || R.fit.chi2 < c.by_gap->fit.chi2))
+                c.by_gap = &R;
+        return c;
+    }
     for (const CandidateResult &R : candidates) {
         if (!R.confirmed)
             continue;
@@ -905,14 +915,26 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             else
                 claim << "unexplained: no catalogued effect, alone or in a pair, predicts the "
                          "held-out experiments better than the null model and leaves no gap";
-            const ClosestCandidates closest = closestCandidates(D.candidates);
+            const ClosestCandidates closest = closestCandidates(D.candidates, !D.held_out.empty());
             const CandidateResult *best = closest.by_gap;
             if (best) {
                 D.best_model = best->name;
                 D.best_model_mean = best->confirmed_mean;
                 D.best_model_z = best->confirmed_z;
             }
-            if (best)
+            if (best && D.held_out.empty())
+                claim << "; closest on the calibration experiments: " << best->name << " at "
+                      << strengthText(best->effect, best->fit.strength) << " [" << fmt(best->fit.lo)
+                      << ", " << fmt(best->fit.hi) << "] (chi^2 " << fmt(best->fit.chi2, 3)
+                      << " against " << fmt(best->fit.chi2_off, 3) << " with it off"
+                      << (best->confirmed && std::isfinite(best->held_out.gap)
+                              ? std::string()
+                              : std::string(", its confirming runs failed"))
+                      << (best->fit.beyond_prior    ? ", pinned at its prior's edge"
+                          : best->fit.at_prior_edge ? ", at its prior's edge"
+                                                    : "")
+                      << ")";
+            else if (best)
                 claim << "; closest: " << best->name << " at "
                       << strengthText(best->effect, best->fit.strength) << " (held-out gap "
                       << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "

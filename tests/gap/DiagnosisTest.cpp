@@ -762,6 +762,24 @@ TEST_CASE("when nothing is claimed the closest by held-out gap and the nearest t
     tied[0].held_out.log_density = -270.7;
     tied[1].held_out.log_density = -263.9;
     CHECK(closestCandidates(tied).by_gap->name == "domain_size");
+    // No held-out experiment (one mole experiment; every held-out gap 0): the best calibration
+    // fit, even where its confirming runs failed (the hull's friction that let the mole through
+    // the column's floor), not the first with a gap of 0 (grain density, at its prior's edge).
+    std::vector<CandidateResult> calibration_only{
+        candidate("grain_density", true, 0.0, 1.0),
+        candidate("tool_friction", true, std::numeric_limits<double>::infinity(), 1.0),
+        candidate("cohesion", false, 0.0, 1.0)};
+    for (auto &[R, chi2] :
+         {std::pair{&calibration_only[0], 14.6}, std::pair{&calibration_only[1], 1.22},
+          std::pair{&calibration_only[2], 260.1}}) {
+        R->fit.chi2 = chi2;
+        R->fit.features = 8;
+    }
+    const ClosestCandidates by_fit = closestCandidates(calibration_only, false);
+    REQUIRE(by_fit.by_gap != nullptr);
+    CHECK(by_fit.by_gap->name == "tool_friction");
+    CHECK(by_fit.by_p_value == nullptr);
+    CHECK(closestCandidates(calibration_only).by_gap->name == "grain_density");
 }
 
 TEST_CASE("the default held-out experiments: the last box, else the last half of a type, "

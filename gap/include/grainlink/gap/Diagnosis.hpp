@@ -175,12 +175,15 @@ const char *outcomeName(Diagnosis::Outcome outcome);
 /// When nothing is claimed, two confirmed candidates come closest: the one whose added effect
 /// leaves the smallest held-out gap (of equal gaps, the best held-out density), and the one
 /// nearest to a claim (the smallest p against the
-/// null). Either is null when nothing was confirmed; they may be the same.
+/// null). Either is null when nothing was confirmed; they may be the same. Without held-out
+/// experiments (one experiment) there is nothing to predict: `by_gap` is then the candidate
+/// that fits the calibration experiments best (the smallest chi^2), confirmed or not.
 struct ClosestCandidates {
     const CandidateResult *by_gap = nullptr;
     const CandidateResult *by_p_value = nullptr;
 };
-ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidates);
+ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidates,
+                                    bool held_out_exists = true);
 
 /// The calibration / held-out split by experiment id (docs/gap.md): `held_out` when given;
 /// otherwise, for every experiment type with two or more experiments, the experiments of its
