@@ -561,7 +561,35 @@ BaseModel loadBaseModel(const std::string &path) {
 
 StudySimulator::StudySimulator(BaseModel base, std::string directory,
                                study::ExecutorOptions executor)
-    : base_(std::move(base)), directory_(std::move(directory)), executor_(std::move(executor)) {}
+    : base_(std::move(base)), directory_(std::move(directory)), executor_(std::move(executor)) {
+    // A mole's run is read by `grainlink run`'s reader when a point runs, in a file the
+    // diagnosis writes: a typo in the base's mole is said now, naming the base.
+    const study::Kind run = study::standardKind("run", "");
+    if (!base_.tests.count("mole") || !run.validate)
+        return;
+    ExperimentSet stand_in;
+    Experiment e;
+    e.id = "mole";
+    e.type = ExperimentType::Mole;
+    e.x_name = xNameOf(e.type);
+    e.observables = {"depth_m"};
+    Trial t;
+    t.curves["depth_m"] = Curve{{0.0, 1.0}, {0.0, 0.0}};
+    e.trials.push_back(t);
+    stand_in.experiments.push_back(e);
+    VariantRequest plain;
+    plain.label = "base";
+    try {
+        run.validate(config::ConfigNode::loadString(
+            study::emitYaml(scenarioNode(stand_in, {"mole"}, plain, 0)),
+            base_.path + " (the run tests.mole makes)"));
+    } catch (const std::exception &ex) {
+        throw std::invalid_argument(base_.path +
+                                    ": tests.mole (its mole: under tests.mole.mole, "
+                                    "its column under soil and tests.mole.soil): " +
+                                    ex.what());
+    }
+}
 
 std::vector<std::string> StudySimulator::checks() const {
     std::vector<std::string> c;
