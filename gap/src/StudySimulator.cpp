@@ -214,8 +214,8 @@ void setBedDepth(YAML::Node soil, const Experiment &e) {
 /// next cocking (the hull at rest after the last stroke). The windows are whole DEM steps of
 /// the soil as the variant left it (a stiffer grain's shorter step), the step rounded down to
 /// the coupling's nanosecond tick. The tip starts `clearance` above the struck-off surface, so
-/// that a deeper or shallower column meets it alike; the mole's gravity is the experiment's.
-void moleRun(YAML::Node root, const YAML::Node &coupling_over, int strokes, const Experiment &e,
+/// that a deeper or shallower column meets it alike; the mole's gravity is the soil's.
+void moleRun(YAML::Node root, const YAML::Node &coupling_over, int strokes,
              std::optional<double> clearance) {
     YAML::Node mole = root["mole"];
     const auto number = [](const YAML::Node &n, double fallback) {
@@ -247,8 +247,10 @@ void moleRun(YAML::Node root, const YAML::Node &coupling_over, int strokes, cons
         "- {name: soil, role: soil, command: [grainlink, dem-node, '{scenario}', --name, '{name}', "
         "--endpoint, '{endpoint}', --out, '{out}', --bodies, '" +
         hull + "', --progress-interval, '60']}");
-    if (const auto g = e.numbers.find("gravity_m_s2"); g != e.numbers.end())
-        mole["gravity_m_s2"] = flowList({0.0, 0.0, -g->second});
+    // One world: the mole falls under the soil's gravity (the experiment's, set above).
+    const dem::Vec3 g = dem::simulationGravity(
+        config::ConfigNode::loadString(YAML::Dump(soil["simulation"]), "the mole run's soil"));
+    mole["gravity_m_s2"] = flowList({g.x(), g.y(), g.z()});
     const YAML::Node strike = soil["deposition"]["strike_off_height_m"];
     if (strike && clearance && mole["start_tip_position_m"] &&
         mole["start_tip_position_m"].size() == 3)
@@ -747,7 +749,7 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
         }
     }
     if (test == "mole")
-        moleRun(root, t->second["coupling"], strokes, first, clearance);
+        moleRun(root, t->second["coupling"], strokes, clearance);
     return root;
 }
 

@@ -556,4 +556,9 @@ TEST_CASE("a mole experiment becomes a coupled run of the base's mole in its col
     CHECK(deep["soil"]["deposition"]["strike_off_height_m"].as<double>() == Approx(0.25));
     CHECK(deep["mole"]["start_tip_position_m"][2].as<double>() == Approx(0.27));
     CHECK(deep["mole"]["gravity_m_s2"][2].as<double>() == Approx(-1.62));
+    // Without the experiment's gravity the mole falls under the soil's (the base's `mars`), its
+    // own default never standing apart from the soil's.
+    ExperimentSet unstated = design.set;
+    unstated.experiments.front().numbers.erase("gravity_m_s2");
+    CHECK(runOf(unstated, plain)["mole"]["gravity_m_s2"][2].as<double>() == Approx(-3.71));
 }
