@@ -149,9 +149,11 @@ int GapCommand::run() const {
 
 int GapCommand::diagnose() const {
     const auto t0 = std::chrono::steady_clock::now();
-    const gap::BaseModel base = gap::loadBaseModel(model_);
+    gap::BaseModel base = gap::loadBaseModel(model_);
     std::vector<std::string> left_out;
-    const gap::ExperimentSet set = gap::simulable(gap::loadExperiments(measurements_), base, left_out);
+    gap::ExperimentSet set = gap::simulable(gap::loadExperiments(measurements_), base, left_out);
+    if (const std::string note = gap::addRateCheckWhereSpeedDiffers(base, set); !note.empty())
+        set.notes.push_back(note);
     for (const std::string &why : left_out)
         std::fprintf(stderr, "[gap] left out: %s\n", why.c_str());
     for (const std::string &note : set.notes)

@@ -25,6 +25,12 @@ std::vector<std::string> simulatedConditions(ExperimentType type);
 
 namespace {
 
+/// A test section's loading speeds: a plate's, a shear box's, a carriage's (in m/s, what an
+/// experiment's `speed_m_s` is compared with), and with them every rate the rate check scales.
+constexpr const char *kSpeedKeys[] = {"speed_m_s", "shear_speed_m_s", "carriage_speed_m_s"};
+constexpr const char *kRateKeys[] = {"speed_m_s", "shear_speed_m_s", "angular_speed_rad_s",
+                                     "lift_speed_m_s", "carriage_speed_m_s"};
+
 /// v rounded up to two significant digits (0.01089 -> 0.011); 0 stays 0.
 double roundUp2(double v) {
     if (!(v > 0.0))
@@ -464,6 +470,38 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     return out;
 }
 
+std::string addRateCheckWhereSpeedDiffers(BaseModel &base, const ExperimentSet &set) {
+    if (base.checks.count("rate"))
+        return "";
+    std::vector<std::string> differ;
+    double measured = 0.0, simulated = 0.0;
+    for (const Experiment &e : set.experiments) {
+        const auto speed = e.numbers.find("speed_m_s");
+        const auto test = base.tests.find(typeName(e.type));
+        if (speed == e.numbers.end() || test == base.tests.end())
+            continue;
+        const YAML::Node section = test->second[testSectionOf(e.type)];
+        for (const char *key : kSpeedKeys)
+            if (section && section[key]) {
+                const double v = section[key].as<double>();
+                if (std::abs(v - speed->second) > 0.1 * std::abs(speed->second)) {
+                    differ.push_back(e.id);
+                    measured = speed->second, simulated = v;
+                }
+            }
+    }
+    if (differ.empty())
+        return "";
+    base.checks["rate"] = 0.5;
+    std::ostringstream note;
+    note << differ.size() << (differ.size() == 1 ? " experiment is" : " experiments are")
+         << " loaded at another speed than simulated (" << differ.front() << ": " << measured
+         << " m/s measured, " << simulated
+         << " m/s simulated): the loading rate check (x 0.5) is added to the base's numerical "
+            "checks";
+    return note.str();
+}
+
 std::string testSectionOf(ExperimentType type) {
     switch (type) {
     case ExperimentType::PlateSinkage:
@@ -735,8 +773,7 @@ YAML::Node StudySimulator::scenarioNode(const ExperimentSet &design,
             root = applyEffect(domain, f, root, first.type);
         } else if (request.check == "rate") {
             YAML::Node sec = root[test];
-            for (const char *k : {"speed_m_s", "shear_speed_m_s", "angular_speed_rad_s",
-                                  "lift_speed_m_s", "carriage_speed_m_s"})
+            for (const char *k : kRateKeys)
                 if (sec[k])
                     sec[k] = sec[k].as<double>() * f;
             if (sec["sample_interval_s"])

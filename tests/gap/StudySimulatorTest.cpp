@@ -562,3 +562,30 @@ TEST_CASE("a mole experiment becomes a coupled run of the base's mole in its col
     unstated.experiments.front().numbers.erase("gravity_m_s2");
     CHECK(runOf(unstated, plain)["mole"]["gravity_m_s2"][2].as<double>() == Approx(-3.71));
 }
+
+TEST_CASE("an experiment loaded at another speed than its test is simulated at adds the loading "
+          "rate check",
+          "[gap][simulator]") {
+    // The CI base presses its plates at 0.05 m/s and has no rate check: a plate measured at the
+    // same speed (within 10 %) adds nothing; one pressed at 3 mm/s, as the CMU test bed does,
+    // adds the check at its default factor and says so.
+    const auto setWith = [](double speed) {
+        ExperimentSet set;
+        set.experiments = {
+            plateExperiment("p", {{"plate_diameter_m", 0.02}, {"speed_m_s", speed}}, {})};
+        return set;
+    };
+    BaseModel base = loadBaseModel(kDir + "/base.yaml");
+    REQUIRE_FALSE(base.checks.count("rate"));
+    CHECK(addRateCheckWhereSpeedDiffers(base, setWith(0.047)).empty());
+    CHECK_FALSE(base.checks.count("rate"));
+    const std::string note = addRateCheckWhereSpeedDiffers(base, setWith(0.003));
+    CHECK_THAT(note, Catch::Contains("p: 0.003 m/s measured, 0.05 m/s simulated") &&
+                         Catch::Contains("rate check (x 0.5) is added"));
+    REQUIRE(base.checks.count("rate"));
+    CHECK(base.checks.at("rate") == 0.5);
+    // A base that has its own rate check keeps its factor.
+    base.checks["rate"] = 0.25;
+    CHECK(addRateCheckWhereSpeedDiffers(base, setWith(0.003)).empty());
+    CHECK(base.checks.at("rate") == 0.25);
+}

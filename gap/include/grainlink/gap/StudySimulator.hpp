@@ -41,6 +41,13 @@ BaseModel loadBaseModel(const std::string &path);
 ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                         std::vector<std::string> &left_out);
 
+/// Where an experiment states its loading speed (`speed_m_s`) and its test is simulated at
+/// another (by more than 10 %), the base's numerical checks get the loading rate check
+/// (`rate`, factor 0.5) when they lack it: the simulated rate is not the measured one, so its
+/// effect belongs in the numerical uncertainty (docs/gap.md, step 2). Returns a note naming
+/// the experiments and both speeds; empty when nothing was added.
+std::string addRateCheckWhereSpeedDiffers(BaseModel &base, const ExperimentSet &set);
+
 /// The section of the base's `tests.<type>` that sets up an experiment type's simulation: its
 /// lab test's ("bevameter", "direct_shear", ...), or "mole" (the HP3 mole of a coupled run).
 std::string testSectionOf(ExperimentType type);
