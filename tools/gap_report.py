@@ -44,6 +44,8 @@ def axis_of(kind):
         return "shear displacement [mm]", 1000.0
     if kind.startswith("wheel"):
         return "slip [-]", 1.0
+    if kind.startswith("mole"):
+        return "stroke", 1.0
     return "", 1.0
 
 
