@@ -195,8 +195,14 @@ private:
 
     /// The closest any body came to a wall (the mirror's symmetry wall, which a half wheel
     /// touches by design, left out); closer than soil.wall_clearance_m stops the run: its
-    /// grains would be crushed against the wall or the answers would depend on it.
+    /// grains would be crushed against the wall or the answers would depend on it. Only a
+    /// body's part at or below the highest grain counts: above every grain it presses none
+    /// against a wall (the mole's hull standing out of its column, tilted towards a wall).
     void watchClearance(double t) {
+        const dem::ParticleStore &p = sys_->particles();
+        double top = -1e300;
+        for (std::size_t i = 0; i < p.size(); ++i)
+            top = std::max(top, p.position[i].z() + p.radius[i]);
         for (std::size_t b = 0; b < bodyCount(); ++b)
             for (const auto &wall : sys_->planes()) {
                 if (mirror_ && std::abs(std::abs(wall.normal.y()) - 1.0) < 1e-12 &&
@@ -204,7 +210,8 @@ private:
                     continue;
                 double distance = 1e300;
                 for (const auto &v : sys_->body(int(b)).worldVertices())
-                    distance = std::min(distance, wall.normal.dot(v - wall.point_m));
+                    if (v.z() <= top)
+                        distance = std::min(distance, wall.normal.dot(v - wall.point_m));
                 if (distance < closest_.distance_m)
                     closest_ = {distance, options_.bodies[b], wall.name, t};
             }
