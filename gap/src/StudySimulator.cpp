@@ -155,6 +155,12 @@ dem::DepositionSpec depositionOf(YAML::Node soil) {
                                                                "the base model's soil.deposition"));
 }
 
+/// The gravity of a soil's simulation as the DEM reads it (a named body's or a vector).
+dem::Vec3 gravityOf(YAML::Node soil) {
+    return dem::simulationGravity(config::ConfigNode::loadString(
+        YAML::Dump(soil["simulation"]), "the base model's soil.simulation"));
+}
+
 /// An experiment's gravity and slope in its soil: the test runs under gravity of the
 /// experiment's magnitude (`gravity_m_s2`; the base's without it) tilted about y by its slope
 /// (`slope_deg`, a wheel's), (-g sin a, 0, -g cos a): a wheel driving along +x climbs. The bed
@@ -165,10 +171,7 @@ void setGravity(YAML::Node soil, const Experiment &e) {
     if (g_it == e.numbers.end() && a_it == e.numbers.end())
         return;
     YAML::Node sim = soil["simulation"];
-    const double g_base =
-        dem::simulationGravity(
-            config::ConfigNode::loadString(YAML::Dump(sim), "the base model's soil.simulation"))
-            .norm();
+    const double g_base = gravityOf(soil).norm();
     const double g = g_it != e.numbers.end() ? g_it->second : g_base;
     const double a = a_it != e.numbers.end() ? a_it->second * M_PI / 180.0 : 0.0;
     sim.remove("gravity_m_s2");
@@ -254,8 +257,7 @@ void moleRun(YAML::Node root, const YAML::Node &coupling_over, int strokes,
         "--endpoint, '{endpoint}', --out, '{out}', --bodies, '" +
         hull + "', --progress-interval, '60']}");
     // One world: the mole falls under the soil's gravity (the experiment's, set above).
-    const dem::Vec3 g = dem::simulationGravity(
-        config::ConfigNode::loadString(YAML::Dump(soil["simulation"]), "the mole run's soil"));
+    const dem::Vec3 g = gravityOf(soil);
     mole["gravity_m_s2"] = flowList({g.x(), g.y(), g.z()});
     const YAML::Node strike = soil["deposition"]["strike_off_height_m"];
     if (strike && clearance && mole["start_tip_position_m"] &&
@@ -485,8 +487,9 @@ std::string addRateCheckWhereSpeedDiffers(BaseModel &base, const ExperimentSet &
             if (section && section[key]) {
                 const double v = section[key].as<double>();
                 if (std::abs(v - speed->second) > 0.1 * std::abs(speed->second)) {
+                    if (differ.empty()) // the note's example: the first such experiment
+                        measured = speed->second, simulated = v;
                     differ.push_back(e.id);
-                    measured = speed->second, simulated = v;
                 }
             }
     }

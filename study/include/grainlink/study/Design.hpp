@@ -3,7 +3,6 @@
 // replicates over deposition seeds, and the observables; turned into the study's points.
 #include "grainlink/study/Study.hpp"
 
-#include <functional>
 #include <optional>
 #include <string>
 
@@ -11,7 +10,6 @@ namespace grainlink::study {
 
 struct DesignOptions {
     std::optional<int> threads; ///< `--threads`: every point's thread count (kind.threads_key)
-    /// The kinds a study file may name; the `grainlink` command adds the coupled run's reader.
 };
 
 /// Reads the study file and makes its points (not validated yet: `run` does that first).
