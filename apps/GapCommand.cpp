@@ -131,6 +131,12 @@ GapCommand::GapCommand(CLI::App &app) {
         ->required();
     import_csv_->add_option("--condition", csv_conditions_, "a condition KEY=VALUE (SI key names)");
     import_csv_->add_flag("--scatter", csv_scatter_, "one point per row (steady-state tests)");
+    import_csv_->add_option("--delimiter", csv_delimiter_, "how cells are separated")
+        ->check(CLI::IsMember({",", ";", "tab", "whitespace"}))
+        ->default_str(",");
+    import_csv_->add_option("--decimal", csv_decimal_, "the decimal mark: , with --delimiter ';'")
+        ->check(CLI::IsMember({".", ","}))
+        ->default_str(".");
 }
 
 int GapCommand::run() const {
@@ -243,6 +249,11 @@ int GapCommand::importCsv() const {
     csv.id = csv_id_;
     csv.type = csv_type_;
     csv.scatter = csv_scatter_;
+    csv.delimiter = csv_delimiter_;
+    csv.decimal = csv_decimal_;
+    if (csv.decimal == "," && csv.delimiter == ",")
+        throw std::invalid_argument("--decimal ,: cells separated by commas cannot have decimal "
+                                    "commas; give --delimiter ';'");
     const auto split = [](const std::string &s, char c) {
         const auto at = s.find(c);
         if (at == std::string::npos)

@@ -43,6 +43,7 @@ private:
     std::string source_, sinkage_ = "synced", csv_id_, csv_type_, csv_x_;
     std::vector<std::string> csv_y_, csv_conditions_;
     bool csv_scatter_ = false, no_wheels_ = false, no_plates_ = false;
+    std::string csv_delimiter_ = ",", csv_decimal_ = ".";
 };
 
 } // namespace grainlink::apps

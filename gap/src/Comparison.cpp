@@ -183,12 +183,18 @@ Measured measure(const ExperimentSet &set, const FeatureDesign &design) {
         if (u.x_zero_sigma > 0.0 && !e.x_name.empty())
             for (std::size_t i = 0; i < idx.size(); ++i) {
                 const Eigen::Index k = idx[i];
-                const Eigen::Index a = idx[i > 0 ? i - 1 : i];
-                const Eigen::Index b = idx[i + 1 < idx.size() ? i + 1 : i];
+                // The slope from the neighbouring bins of the same observable (an experiment's
+                // bins run observable after observable): one-sided at each one's ends.
+                const auto same = [&](std::size_t j) {
+                    return design.keys[std::size_t(idx[j])].observable ==
+                               design.keys[std::size_t(k)].observable &&
+                           std::isfinite(m.value[idx[j]]);
+                };
+                const Eigen::Index a = idx[i > 0 && same(i - 1) ? i - 1 : i];
+                const Eigen::Index b = idx[i + 1 < idx.size() && same(i + 1) ? i + 1 : i];
                 const double dx = design.keys[std::size_t(b)].centre() -
                                   design.keys[std::size_t(a)].centre();
-                if (a == b || dx <= 0.0 || design.keys[std::size_t(a)].observable !=
-                                               design.keys[std::size_t(b)].observable)
+                if (a == b || dx <= 0.0)
                     continue;
                 const double slope = (m.value[b] - m.value[a]) / dx;
                 const double zero = slope * u.x_zero_sigma / std::sqrt(std::max(1, m.trials[k]));

@@ -1,5 +1,7 @@
 #include "grainlink/gap/Experiments.hpp"
 
+#include "DataTable.hpp"
+
 #include "grainlink/config/ConfigNode.hpp"
 
 #include <algorithm>
@@ -81,125 +83,54 @@ bool endsWith(const std::string &s, const std::string &tail) {
     return s.size() >= tail.size() && s.compare(s.size() - tail.size(), tail.size(), tail) == 0;
 }
 
-/// How a data file's cells are separated (`data.delimiter`): a character, or runs of blanks.
-struct Delimiter {
-    char sep = ',';
-    bool blanks = false;
-};
-
-Delimiter parseDelimiter(const ConfigNode &data) {
-    const std::string d =
-        data.has("delimiter") ? data["delimiter"].choice({",", ";", "tab", "whitespace"}) : ",";
-    return d == "whitespace" ? Delimiter{' ', true} : Delimiter{d == "tab" ? '\t' : d[0], false};
+/// How the data files of `data` are written (docs/gap.md): comment mark, delimiter, decimal
+/// mark and, for a file without a header line, its column names.
+TableFormat parseTableFormat(const ConfigNode &data) {
+    TableFormat f;
+    f.comment = data.text("comment", "#");
+    if (data.has("delimiter")) {
+        const std::string d = data["delimiter"].choice({",", ";", "tab", "whitespace"});
+        f.blanks = d == "whitespace";
+        f.delimiter = d == "tab" ? '\t' : d == "whitespace" ? ' ' : d[0];
+    }
+    if (data.has("decimal")) {
+        f.decimal = data["decimal"].choice({".", ","})[0];
+        if (f.decimal == ',' && f.delimiter == ',' && !f.blanks)
+            data["decimal"].fail("a decimal comma needs another delimiter (delimiter: \";\", "
+                                 "tab or whitespace)");
+    }
+    if (data.has("columns")) {
+        for (const ConfigNode &c : data["columns"].items())
+            f.columns.push_back(c.text());
+        if (f.columns.empty())
+            data["columns"].fail("name the file's columns in order");
+    }
+    return f;
 }
 
-std::vector<std::string> splitCsv(const std::string &line, const Delimiter &delimiter) {
-    std::vector<std::string> out;
-    const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r'; };
-    const auto push = [&](std::string cell) {
-        while (!cell.empty() && blank(cell.back()))
-            cell.pop_back();
-        while (!cell.empty() && blank(cell.front()))
-            cell.erase(cell.begin());
-        if (cell.size() >= 2 && cell.front() == '"' && cell.back() == '"') // a quoted name
-            cell = cell.substr(1, cell.size() - 2);
-        out.push_back(cell);
-    };
-    std::string cell;
-    for (char c : line) {
-        const bool split = delimiter.blanks ? blank(c) : c == delimiter.sep;
-        if (!split) {
-            cell += c;
-            continue;
-        }
-        if (!delimiter.blanks || !cell.empty())
-            push(cell);
-        cell.clear();
+/// The column `name` of `table`; a missing one is an error at `where` listing the columns.
+std::size_t columnOf(const DataTable &table, const std::string &name, const ConfigNode &where) {
+    std::optional<std::size_t> c;
+    try {
+        c = table.find(name);
+    } catch (const config::ConfigError &e) {
+        where.fail(e.what());
     }
-    if (!delimiter.blanks || !cell.empty())
-        push(cell);
-    return out;
+    if (!c) {
+        const bool one =
+            table.header.size() == 1 && table.header[0].find_first_of(";\t ") != std::string::npos;
+        where.fail("column '" + name + "' is not in " + table.file +
+                   " (its columns: " + table.names() + ")" +
+                   (one ? "; its cells may be separated otherwise: give data.delimiter "
+                          "(; tab whitespace)"
+                        : ""));
+    }
+    return *c;
 }
-
-/// A cell that holds no value: empty, or a missing-value mark of a spreadsheet or of numpy.
-bool missingCell(const std::string &cell) {
-    std::string low;
-    for (char c : cell)
-        low += char(std::tolower(static_cast<unsigned char>(c)));
-    return low.empty() || low == "nan" || low == "-nan" || low == "na" || low == "n/a" ||
-           low == "null" || low == "none";
-}
-
-/// A CSV table: header names and rows of text cells, with the file line of every row.
-struct Table {
-    std::string file;
-    std::vector<std::string> header;
-    std::vector<std::vector<std::string>> rows;
-    std::vector<int> lines;
-    std::size_t column(const std::string &name, const ConfigNode &where) const {
-        const auto it = std::find(header.begin(), header.end(), name);
-        if (it == header.end()) {
-            std::string have;
-            for (const auto &h : header)
-                have += (have.empty() ? "" : ", ") + h;
-            const bool one =
-                header.size() == 1 && header[0].find_first_of(";\t ") != std::string::npos;
-            where.fail("column '" + name + "' is not in " + file + " (its columns: " + have + ")" +
-                       (one ? "; its cells may be separated otherwise: give data.delimiter "
-                              "(; tab whitespace)"
-                            : ""));
-        }
-        return std::size_t(it - header.begin());
-    }
-    bool missing(std::size_t row, std::size_t col) const {
-        return col >= rows[row].size() || missingCell(rows[row][col]);
-    }
-    double number(std::size_t row, std::size_t col) const {
-        const std::string &cell = col < rows[row].size() ? rows[row][col] : std::string();
-        char *end = nullptr;
-        const double v = std::strtod(cell.c_str(), &end);
-        if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v))
-            throw config::ConfigError(file + ":" + std::to_string(lines[row]) + ": column '" +
-                                      header[col] + "': '" + cell + "' is not a finite number");
-        return v;
-    }
-};
-
-Table readTable(const fs::path &path, char comment, const Delimiter &delimiter,
-                const ConfigNode &where) {
-    std::ifstream in(path);
-    if (!in)
-        where.fail("cannot read data file " + path.string());
-    Table t;
-    t.file = path.string();
-    std::string line;
-    int number = 0;
-    while (std::getline(in, line)) {
-        if (++number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0)
-            line.erase(0, 3); // a spreadsheet's byte-order mark
-        if (line.empty() || line[0] == comment)
-            continue;
-        std::vector<std::string> cells = splitCsv(line, delimiter);
-        if (std::all_of(cells.begin(), cells.end(), [](const std::string &c) { return c.empty(); }))
-            continue; // blank, or a spreadsheet's row of empty cells
-        if (t.header.empty()) {
-            t.header = std::move(cells);
-            continue;
-        }
-        t.rows.push_back(std::move(cells));
-        t.lines.push_back(number);
-    }
-    if (t.header.empty())
-        where.fail("data file " + t.file + " has no header line");
-    if (t.rows.empty())
-        where.fail("data file " + t.file + " has no data rows");
-    return t;
-}
-
 /// `{column, unit}` of one axis: the column index in `table` and the factor to SI.
-std::pair<std::size_t, double> axisColumn(const ConfigNode &node, const Table &table,
+std::pair<std::size_t, double> axisColumn(const ConfigNode &node, const DataTable &table,
                                           const std::string &si_name) {
-    const std::size_t col = table.column(node["column"].text(), node["column"]);
+    const std::size_t col = columnOf(table, node["column"].text(), node["column"]);
     const std::string unit = node["unit"].text();
     double factor = 1.0;
     try {
@@ -339,28 +270,24 @@ const Experiment &ExperimentSet::find(const std::string &id) const {
     throw std::invalid_argument("no experiment '" + id + "' in " + directory);
 }
 
-/// How many samples a recorded curve keeps: all, unless it was recorded in time order (x rising
-/// at four in five steps up to its largest x) and then ran back (an unloading, a retraction):
-/// then the loading branch up to its largest x, since the two branches binned together would
-/// read low against a loading-only simulation.
 std::size_t loadingBranch(const Curve &curve) {
     const std::size_t n = curve.x.size();
     if (n < 3)
         return n;
+    // The last sample at the largest x: a repeated x at the turn is still loading.
     const std::size_t peak =
-        std::size_t(std::max_element(curve.x.begin(), curve.x.end()) - curve.x.begin());
+        n - 1 - std::size_t(std::max_element(curve.x.rbegin(), curve.x.rend()) - curve.x.rbegin());
     if (peak + 1 >= n || peak < 2)
         return n;
-    std::size_t rising = 0;
+    // Not falling, rather than rising: an encoder's or a rounded export's x repeats.
+    std::size_t forward = 0;
     for (std::size_t i = 1; i <= peak; ++i)
-        rising += curve.x[i] > curve.x[i - 1];
-    return 5 * rising >= 4 * peak ? peak + 1 : n;
+        forward += curve.x[i] >= curve.x[i - 1];
+    return 5 * forward >= 4 * peak ? peak + 1 : n;
 }
 
 Curve applyZero(const Curve &recorded, const ZeroConvention &zero) {
-    Curve curve = recorded;
-    curve.x.resize(loadingBranch(recorded));
-    curve.y.resize(curve.x.size());
+    const Curve &curve = recorded;
     std::vector<std::size_t> order(curve.x.size());
     for (std::size_t i = 0; i < order.size(); ++i)
         order[i] = i;
@@ -380,16 +307,13 @@ Curve applyZero(const Curve &recorded, const ZeroConvention &zero) {
         return out;
     double x0 = out.x.front();
     if (zero.method == ZeroConvention::Method::ForceThreshold) {
-        // The first sample in the original order that reaches the threshold: a loading curve's
-        // first contact.
-        bool found = false;
-        for (std::size_t i = 0; i < curve.y.size() && !found; ++i)
-            if (curve.y[i] >= zero.threshold) {
-                x0 = curve.x[i];
-                found = true;
-            }
-        if (!found)
+        // From the shallowest sample on, the first that reaches the threshold: a loading
+        // curve's first contact, whichever order its file was written in.
+        const auto first =
+            std::find_if(out.y.begin(), out.y.end(), [&](double y) { return y >= zero.threshold; });
+        if (first == out.y.end())
             return Curve{}; // never reaches the threshold: nothing to compare
+        x0 = out.x[std::size_t(first - out.y.begin())];
     }
     for (double &x : out.x)
         x -= x0;
@@ -413,6 +337,13 @@ std::vector<double> scatterBinMeans(const std::vector<std::pair<double, double>>
     return sum;
 }
 
+std::string folderName(const std::string &directory) {
+    fs::path p = fs::absolute(directory).lexically_normal();
+    if (!p.has_filename())
+        p = p.parent_path(); // "meas/"
+    return p.filename().string();
+}
+
 ExperimentSet loadExperiments(const std::string &directory) {
     const fs::path dir(directory);
     const fs::path file = dir / "experiments.yaml";
@@ -422,7 +353,10 @@ ExperimentSet loadExperiments(const std::string &directory) {
     const ConfigNode root = ConfigNode::loadFile(file.string());
     ExperimentSet set;
     set.directory = directory;
-    set.name = root.text("name", dir.filename().string());
+    set.name = root.text("name", folderName(directory));
+    if (set.name.empty() || set.name.find_first_of("/\\") != std::string::npos)
+        root["name"].fail("a name is a word without slashes (it names the default output "
+                          "folder out/gap/NAME)");
     const ConfigNode list = root["experiments"];
     if (!list.isSequence())
         list.fail("must be a list of experiments");
@@ -480,7 +414,6 @@ ExperimentSet loadExperiments(const std::string &directory) {
             e.observables = {obs};
             data.finish();
         } else {
-            const std::string comment = data.text("comment", "#");
             e.scatter = data.boolean("scatter", false);
             const ConfigNode files = data["files"];
             const ConfigNode y = data["y"];
@@ -512,11 +445,16 @@ ExperimentSet loadExperiments(const std::string &directory) {
             std::replace(e.observables.begin(), e.observables.end(), std::string("force_N"),
                          std::string("pressure_Pa"));
             const auto filter = data.optional("filter");
-            const Delimiter delimiter = parseDelimiter(data);
+            const TableFormat format = parseTableFormat(data);
             for (const ConfigNode &f : files.items()) {
                 const fs::path path = dir / f.text();
-                const Table table =
-                    readTable(path, comment.empty() ? '#' : comment[0], delimiter, f);
+                const DataTable table = [&] {
+                    try {
+                        return readDataTable(path.string(), format);
+                    } catch (const config::ConfigError &e) {
+                        f.fail(e.what());
+                    }
+                }();
                 const auto [xcol, xfac] = axisColumn(data["x"], table, e.x_name);
                 std::vector<std::tuple<std::string, std::size_t, double>> ycols;
                 for (const auto &o : obs_names) {
@@ -529,7 +467,7 @@ ExperimentSet loadExperiments(const std::string &directory) {
                 std::vector<std::pair<std::size_t, double>> keep;
                 if (filter)
                     for (const auto &key : filter->keys())
-                        keep.emplace_back(table.column(key, (*filter)[key]),
+                        keep.emplace_back(columnOf(table, key, (*filter)[key]),
                                           (*filter)[key].number());
                 Trial whole;
                 whole.source = path.string();
@@ -577,13 +515,29 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     // No row passed the filter: no curve was started at all.
                     if (whole.curves.empty() || whole.curves.begin()->second.empty())
                         f.fail("no rows of " + path.string() + " pass the filter");
+                    // A plate or shear curve recorded in time order that runs back after its
+                    // largest x (unloaded, reversed) keeps its loading branch: binned with it,
+                    // the other branch would read low against a loading-only simulation.
+                    if (e.type == ExperimentType::PlateSinkage ||
+                        e.type == ExperimentType::DirectShear ||
+                        e.type == ExperimentType::BevameterShear)
+                        for (auto &[o, curve] : whole.curves)
+                            if (const std::size_t keep = loadingBranch(curve);
+                                keep < curve.x.size()) {
+                                set.notes.push_back(path.string() + ": " + o + ": the " +
+                                                    std::to_string(curve.x.size() - keep) +
+                                                    " samples after the largest " + e.x_name +
+                                                    " (an unloading) are left out");
+                                curve.x.resize(keep);
+                                curve.y.resize(keep);
+                            }
                     checkSigns(e.type, whole.curves.begin()->second, data, path.string());
                     e.trials.push_back(std::move(whole));
                 }
             }
             if (e.trials.empty())
                 files.fail("no data: give at least one file (and rows that pass the filter)");
-            if (e.scatter && y.has("sinkage_m"))
+            if (y.has("sinkage_m"))
                 checkWheelSinkage(e, data);
             if (filter)
                 filter->finish();
@@ -650,7 +604,8 @@ ExperimentSet loadExperiments(const std::string &directory) {
             for (double v : (*bins)["edges"].numbers())
                 e.bin_edges.push_back(v * f);
             if (e.bin_edges.size() < 2 ||
-                !std::is_sorted(e.bin_edges.begin(), e.bin_edges.end()))
+                std::adjacent_find(e.bin_edges.begin(), e.bin_edges.end(),
+                                   std::greater_equal<double>()) != e.bin_edges.end())
                 (*bins)["edges"].fail("give at least two increasing edges");
             bins->finish();
         }

@@ -21,7 +21,8 @@ std::optional<double> binMean(const Curve &curve, double a, double b) {
     // A curve that starts a little into its first bin (a recording's first sample at 0.2 mm of
     // a 2.5 mm bin: every CMU plate's first bin was lost) is held at its first value back to
     // the bin's start; further in, the bin is not covered.
-    if (!(b > a) || x.front() > a + 0.1 * (b - a) || x.back() < b)
+    // (A curve that ends on the bin's edge covers it: an edge of 6 x 0.1 lies above 0.6.)
+    if (!(b > a) || x.front() > a + 0.1 * (b - a) || x.back() < b - 1e-9 * (b - a))
         return std::nullopt;
     // Trapezoid rule on the interpolant clipped to [a, b].
     const auto interpolate = [&](std::size_t i, double t) {

@@ -2,6 +2,8 @@
 
 #include "grainlink/gap/Experiments.hpp"
 
+#include "DataTable.hpp"
+
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
@@ -20,84 +22,40 @@ namespace fs = std::filesystem;
 
 namespace {
 
-/// The CSV's header and rows (comment lines dropped), each row with as many cells as the header.
-struct Csv {
-    fs::path path;
-    std::vector<std::string> header;
-    std::vector<std::vector<std::string>> rows;
-    std::vector<int> lines; ///< each row's line in the file, for messages
-
-    /// Row r's cell in column c as a number; an error names the file, line and column.
-    double number(std::size_t r, std::size_t c) const {
-        const std::string &cell = rows[r][c];
-        char *end = nullptr;
-        const double v = std::strtod(cell.c_str(), &end);
-        if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v))
-            throw std::runtime_error(path.string() + ":" + std::to_string(lines[r]) +
-                                     ": column '" + header[c] + "': '" + cell +
-                                     "' is not a finite number");
-        return v;
-    }
-};
-
-std::vector<std::string> split(const std::string &line) {
-    std::vector<std::string> cells;
-    std::string cell;
-    std::istringstream in(line);
-    while (std::getline(in, cell, ','))
-        cells.push_back(cell);
-    return cells;
+DataTable readCsv(const fs::path &path) {
+    return readDataTable(path.string(), TableFormat{});
 }
 
-Csv readCsv(const fs::path &path) {
-    std::ifstream in(path);
-    if (!in)
-        throw std::runtime_error(path.string() + ": cannot read");
-    Csv c;
-    c.path = path;
-    std::string line;
-    for (int number = 1; std::getline(in, line); ++number) {
-        if (!line.empty() && line.back() == '\r')
-            line.pop_back();
-        if (line.empty() || line[0] == '#')
-            continue;
-        if (c.header.empty()) {
-            c.header = split(line);
-            continue;
-        }
-        c.rows.push_back(split(line));
-        c.lines.push_back(number);
-        if (c.rows.back().size() != c.header.size())
-            throw std::runtime_error(path.string() + ":" + std::to_string(number) + ": " +
-                                     std::to_string(c.rows.back().size()) + " cells, the header has " +
-                                     std::to_string(c.header.size()));
-    }
-    if (c.header.empty())
-        throw std::runtime_error(path.string() + ": no header line");
-    return c;
-}
-
-std::size_t column(const Csv &c, const std::string &name, const fs::path &path) {
-    const auto it = std::find(c.header.begin(), c.header.end(), name);
-    if (it == c.header.end())
-        throw std::runtime_error(path.string() + ": no column '" + name + "'");
-    return std::size_t(it - c.header.begin());
+/// The column `name` of `c`; a missing one is an error naming the file and its columns.
+std::size_t column(const DataTable &c, const std::string &name) {
+    if (const auto col = c.find(name))
+        return *col;
+    throw std::runtime_error(c.file + ": no column '" + name + "' (its columns: " + c.names() +
+                             ")");
 }
 
 /// Writes the named columns of `c` to `path` (a copy of just what the folder uses).
-void writeColumns(const Csv &c, const std::vector<std::string> &names, const fs::path &source,
+void writeColumns(const DataTable &c, const std::vector<std::string> &names, const fs::path &source,
                   const fs::path &path, const std::string &comment) {
     std::vector<std::size_t> cols;
     for (const auto &n : names)
-        cols.push_back(column(c, n, source));
+        cols.push_back(column(c, n));
     std::ofstream out(path);
     out << "# " << comment << "\n# copied from " << source.string() << "\n";
-    for (std::size_t i = 0; i < names.size(); ++i)
-        out << (i ? "," : "") << names[i];
+    for (std::size_t i = 0; i < names.size(); ++i) {
+        const bool quote = names[i].find_first_of(",\"") != std::string::npos;
+        std::string name;
+        for (char ch : names[i])
+            name += ch == '"' ? std::string("\"\"") : std::string(1, ch);
+        out << (i ? "," : "") << (quote ? "\"" + name + "\"" : name);
+    }
     out << '\n';
-    for (const auto &row : c.rows) {
-        for (std::size_t i = 0; i < cols.size(); ++i)
-            out << (i ? "," : "") << (cols[i] < row.size() ? row[cols[i]] : "");
+    for (std::size_t r = 0; r < c.rows.size(); ++r) {
+        for (std::size_t i = 0; i < cols.size(); ++i) {
+            std::string cell = c.missing(r, cols[i]) ? "" : c.rows[r][cols[i]];
+            std::replace(cell.begin(), cell.end(), c.decimal, '.'); // 0,5 beside ';'
+            out << (i ? "," : "") << cell;
+        }
         out << '\n';
     }
     if (!out)
@@ -241,8 +199,8 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
             const fs::path f = src / "steady_state_wheel" / (wheel + ".csv");
             if (!fs::exists(f))
                 continue;
-            const Csv c = readCsv(f);
-            const std::size_t beta_col = column(c, "beta_deg", f);
+            const DataTable c = readCsv(f);
+            const std::size_t beta_col = column(c, "beta_deg");
             const auto beta_of = [&](std::size_t r) {
                 return int(std::lround(c.number(r, beta_col)));
             };
@@ -257,7 +215,7 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
                          "CMU 3d-terramechanics steady-state wheel tests (MIT licence, (c) 2022 "
                          "Catherine Pavlov, CMU), " + wheel + " wheel; Z_mm with the authors' "
                          "31.5 mm offset convention");
-            const std::size_t load_col = column(c, "F_load_N", f);
+            const std::size_t load_col = column(c, "F_load_N");
             for (int beta : betas) {
                 const std::string id = wheel + "_beta" + std::to_string(beta);
                 // The load the carriage put on the wheel: the runs' mean measured F_load (the
@@ -323,21 +281,50 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
 
 void importCsv(const CsvImport &csv, const std::string &out) {
     const fs::path dst(out), src(csv.file);
-    parseType(csv.type);
-    const Csv c = readCsv(src);
-    fs::create_directories(dst / "data");
+    const ExperimentType type = parseType(csv.type);
+    if (csv.id.empty() || csv.id[0] == '.' || csv.id.find_first_of(" /\\\t\n") != std::string::npos)
+        throw std::invalid_argument("--id '" + csv.id +
+                                    "': an id is one word without spaces or "
+                                    "slashes");
+    const bool scalar = std::string(xNameOf(type)).empty();
+    if (scalar != csv.x_column.empty())
+        throw std::invalid_argument(scalar ? "--x: a " + csv.type +
+                                                 " is one value a row (its --y column): give no --x"
+                                           : "--x COLUMN:UNIT: a " + csv.type + " needs its x");
+    if (csv.y.empty() || (scalar && csv.y.size() != 1))
+        throw std::invalid_argument(scalar ? "--y: give one column of values"
+                                           : "--y: name at least one observable");
+
+    // Read and checked before anything is written: an error names the user's file and line.
+    TableFormat format;
+    format.delimiter = csv.delimiter == "tab"  ? '\t'
+                       : csv.delimiter.empty() ? ','
+                                               : csv.delimiter[0];
+    format.blanks = csv.delimiter == "whitespace";
+    format.decimal = csv.decimal.empty() ? '.' : csv.decimal[0];
+    const DataTable c = readDataTable(src.string(), format);
     std::vector<std::string> columns;
     if (!csv.x_column.empty())
         columns.push_back(csv.x_column);
     for (const auto &[obs, col] : csv.y)
         columns.push_back(col.first);
-    const std::string copy = "data/" + csv.id + ".csv";
-    writeColumns(c, columns, src, dst / copy, "imported by grainlink gap import csv");
-    YAML::Node root = loadOrNew(dst / "experiments.yaml", dst.filename().string());
+    for (const std::string &name : columns) {
+        const std::size_t col = column(c, name);
+        for (std::size_t r = 0; r < c.rows.size(); ++r)
+            if (!c.missing(r, col))
+                c.number(r, col);
+    }
+
+    const fs::path yaml = dst / "experiments.yaml";
+    YAML::Node root = loadOrNew(yaml, folderName(out));
     for (const auto &e : root["experiments"])
         if (e["id"].as<std::string>() == csv.id)
             throw std::invalid_argument("experiment id '" + csv.id + "' is already in " +
-                                        (dst / "experiments.yaml").string());
+                                        yaml.string());
+    const std::string copy = scalar ? "" : "data/" + csv.id + ".csv";
+    if (!scalar && fs::exists(dst / copy))
+        throw std::invalid_argument((dst / copy).string() + " exists already: give another --id");
+
     YAML::Node e;
     e["id"] = csv.id;
     e["type"] = csv.type;
@@ -354,27 +341,60 @@ void importCsv(const CsvImport &csv, const std::string &out) {
         e["conditions"] = flow(cond);
     }
     YAML::Node data;
-    data["files"] = flow(YAML::Node(std::vector<std::string>{copy}));
-    if (csv.scatter)
-        data["scatter"] = true;
-    if (!csv.x_column.empty()) {
+    if (scalar) {
+        const auto &[obs, col] = *csv.y.begin();
+        const std::size_t c_values = column(c, col.first);
+        std::vector<double> values;
+        for (std::size_t r = 0; r < c.rows.size(); ++r)
+            if (!c.missing(r, c_values))
+                values.push_back(c.number(r, c_values));
+        data["values"] = flow(YAML::Node(values));
+        data["unit"] = col.second;
+    } else {
+        data["files"] = flow(YAML::Node(std::vector<std::string>{copy}));
+        if (csv.scatter)
+            data["scatter"] = true;
         YAML::Node x;
         x["column"] = csv.x_column;
         x["unit"] = csv.x_unit;
         data["x"] = flow(x);
+        YAML::Node y;
+        for (const auto &[obs, col] : csv.y) {
+            YAML::Node n;
+            n["column"] = col.first;
+            n["unit"] = col.second;
+            y[obs] = flow(n);
+        }
+        data["y"] = y;
     }
-    YAML::Node y;
-    for (const auto &[obs, col] : csv.y) {
-        YAML::Node n;
-        n["column"] = col.first;
-        n["unit"] = col.second;
-        y[obs] = flow(n);
-    }
-    data["y"] = y;
     e["data"] = data;
-    root["experiments"].push_back(e);
-    save(root, dst / "experiments.yaml", "# Measurements for grainlink gap (docs/gap.md).\n");
-    loadExperiments(out);
+
+    // Written, read back strictly, and undone if it does not read: a failed import leaves the
+    // folder as it was.
+    const bool existed = fs::exists(yaml);
+    std::string before;
+    if (existed) {
+        std::ifstream in(yaml);
+        before.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    }
+    fs::create_directories(dst / "data");
+    try {
+        if (!scalar)
+            writeColumns(c, columns, src, dst / copy, "imported by grainlink gap import csv");
+        root["experiments"].push_back(e);
+        save(root, yaml, "# Measurements for grainlink gap (docs/gap.md).\n");
+        loadExperiments(out);
+    } catch (...) {
+        if (!scalar)
+            fs::remove(dst / copy);
+        if (existed) {
+            std::ofstream(yaml.string() + ".tmp") << before;
+            fs::rename(yaml.string() + ".tmp", yaml);
+        } else {
+            fs::remove(yaml);
+        }
+        throw;
+    }
 }
 
 } // namespace grainlink::gap

@@ -154,7 +154,7 @@ void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves,
     std::mt19937 rng(key.seed * 7919u + 3u);
     std::normal_distribution<double> z;
     YAML::Node root;
-    root["name"] = fs::path(out).filename().string();
+    root["name"] = folderName(out);
     YAML::Node list(YAML::NodeType::Sequence);
     for (const Experiment &e : design.set.experiments) {
         const std::string &obs = e.observables[0];

@@ -95,8 +95,8 @@ TEST_CASE("experiments.yaml: repeats in SI, and their mean and scatter per bin",
     CHECK((sim - m.value).cwiseAbs().maxCoeff() < 1e-6);
 }
 
-TEST_CASE("experiments.yaml: a force-threshold zero moves x to the first sample reaching it, an "
-          "unloading branch is left out",
+TEST_CASE("experiments.yaml: a force-threshold zero moves x to the shallowest sample reaching "
+          "it, an unloading branch is left out",
           "[gap][experiments]") {
     // p = 0 until 3 mm, then rises: with a 0.5 kPa threshold the zero is at 3.5 mm.
     Curve c{{0.0, 0.001, 0.002, 0.003, 0.0035, 0.004}, {0.0, 0.0, 0.0, 0.0, 600.0, 1200.0}};
@@ -106,24 +106,55 @@ TEST_CASE("experiments.yaml: a force-threshold zero moves x to the first sample 
     const Curve zeroed = applyZero(c, z);
     CHECK(zeroed.x.front() == Approx(-0.0035));
     CHECK(zeroed.x[4] == Approx(0.0));
+    // The same file written deepest first has the same zero (its first row reaching 0.5 kPa is
+    // its deepest).
+    const Curve reversed{{c.x.rbegin(), c.x.rend()}, {c.y.rbegin(), c.y.rend()}};
+    CHECK(applyZero(reversed, z).x.front() == Approx(-0.0035));
     z.method = ZeroConvention::Method::FirstSample;
     const Curve shifted = applyZero(Curve{{0.002, 0.001, 0.003}, {2.0, 1.0, 3.0}}, z);
     CHECK(shifted.x.front() == 0.0);
     CHECK(shifted.y.front() == 1.0); // sorted by x
 
-    // Loaded to 10 mm (p = z kPa/mm) and unloaded to 8 mm (p falling to 0): the unloading
-    // samples interleaved with the loading ones and halved the deepest bins.
+    // Loaded to 10 mm (p = z kPa/mm) and unloaded to 8 mm (p falling to 0).
     Curve cycle;
     for (int i = 0; i <= 20; ++i)
         cycle.x.push_back(0.0005 * i), cycle.y.push_back(500.0 * i);
     for (int i = 1; i <= 4; ++i)
         cycle.x.push_back(0.010 - 0.0005 * i), cycle.y.push_back(10000.0 * (1.0 - 0.25 * i));
-    const Curve loading = applyZero(cycle, ZeroConvention{});
-    CHECK(loading.x.size() == 21);
-    CHECK(*binMean(loading, 0.008, 0.010) == Approx(9000.0));
+    CHECK(loadingBranch(cycle) == 21);
     // A file sorted by x the other way round is no unloading: every sample stays.
-    Curve descending{{0.003, 0.002, 0.001, 0.0}, {3.0, 2.0, 1.0, 0.0}};
-    CHECK(applyZero(descending, ZeroConvention{}).x.size() == 4);
+    CHECK(loadingBranch(Curve{{0.003, 0.002, 0.001, 0.0}, {3.0, 2.0, 1.0, 0.0}}) == 4);
+
+    // Read from a file: an encoder's x repeats (each value three times), loaded to 1 mm and
+    // unloaded to 0.8 mm. The unloading samples interleaved with the loading ones would halve
+    // the deepest bins; they are left out, and the reading says so.
+    const fs::path dir = folder("unload");
+    {
+        std::ofstream f(dir / "enc.csv");
+        f << "z_mm,p_kPa\n";
+        for (int i = 0; i <= 10; ++i)
+            for (int k = 0; k < 3; ++k)
+                f << 0.1 * i << ',' << 10.0 * i << '\n';
+        for (int i = 9; i >= 8; --i)
+            for (int k = 0; k < 3; ++k)
+                f << 0.1 * i << ',' << 10.0 * (i - 8) << '\n';
+    }
+    // A wheel's table of slips, braking rows last: no time series, every row stays.
+    write(dir / "w.csv", "slip,F\n0,1\n0.1,2\n0.2,3\n0.3,4\n0.4,5\n-0.1,-1\n-0.2,-2\n");
+    write(dir / "experiments.yaml", "experiments:\n  - id: enc\n    type: plate_sinkage\n"
+                                    "    data: {files: [enc.csv], x: {column: z_mm, unit: mm}, "
+                                    "y: {pressure_Pa: {column: p_kPa, unit: kPa}}}\n"
+                                    "  - id: w\n    type: wheel_steady_state\n"
+                                    "    data: {files: [w.csv], x: {column: slip, unit: '-'}, "
+                                    "y: {traction_N: {column: F, unit: N}}}\n");
+    const ExperimentSet set = loadExperiments(dir.string());
+    const Curve &enc = set.find("enc").trials[0].curves.at("pressure_Pa");
+    CHECK(enc.x.size() == 33);
+    CHECK(*binMean(applyZero(enc, ZeroConvention{}), 0.00075, 0.00095) == Approx(85000.0));
+    REQUIRE(set.notes.size() == 1);
+    CHECK_THAT(set.notes[0], Catch::Contains("enc.csv: pressure_Pa: the 6 samples after the "
+                                             "largest sinkage_m (an unloading) are left out"));
+    CHECK(set.find("w").trials[0].curves.at("traction_N").x.size() == 7);
 }
 
 TEST_CASE("experiments.yaml: stated uncertainty and the zero's uncertainty enter u_D",
@@ -150,6 +181,33 @@ TEST_CASE("experiments.yaml: stated uncertainty and the zero's uncertainty enter
           "      y: {pressure_Pa: {column: pressure_kPa, unit: kPa}}\n"
           "    uncertainty: {y_sigma: 0.3, unit: kPa, beds: own}\n");
     CHECK(loadExperiments(dir.string()).experiments[0].uncertainty.own_beds);
+
+    // Two observables of one experiment: every bin of each gets its own slope times the zero's
+    // uncertainty, the first and last of each too (traction 10 N and torque 2 N m per unit slip).
+    {
+        std::ofstream f(dir / "wz.csv");
+        f << "slip,F,T\n";
+        for (int i = 0; i <= 12; ++i)
+            f << 0.05 * i << ',' << 0.5 * i << ',' << 0.1 * i << '\n';
+    }
+    write(dir / "experiments.yaml",
+          "experiments:\n  - id: w\n    type: wheel_steady_state\n"
+          "    data: {files: [wz.csv], x: {column: slip, unit: '-'}, "
+          "y: {traction_N: {column: F, unit: N}, torque_N_m: {column: T, unit: N_m}}}\n"
+          "    uncertainty: {x_zero_sigma: 0.01, x_unit: '-'}\n");
+    const ExperimentSet wheel = loadExperiments(dir.string());
+    const FeatureDesign d = designFeatures(wheel, 6);
+    const Measured mw = measure(wheel, d);
+    int checked = 0;
+    for (Eigen::Index k : d.by_experiment.at("w")) {
+        const bool traction = d.keys[std::size_t(k)].observable == "traction_N";
+        INFO(d.keys[std::size_t(k)].observable << " bin " << d.keys[std::size_t(k)].x_lo << "-"
+                                               << d.keys[std::size_t(k)].x_hi << " value "
+                                               << mw.value[k]);
+        CHECK(mw.u_D[k] == Approx(traction ? 0.1 : 0.02).epsilon(1e-6));
+        ++checked;
+    }
+    CHECK(checked >= 4);
 }
 
 TEST_CASE("experiments.yaml: scalars and scatters", "[gap][experiments]") {
@@ -283,6 +341,85 @@ TEST_CASE("data files as other tools write them: a byte-order mark, quoted names
     write(dir / "experiments.yaml",
           plateYaml().replace(plateYaml().find("[a1.csv, a2.csv, a3.csv]"), 24, "[a1.csv]"));
     CHECK_THROWS_WITH(loadExperiments(dir.string()), Catch::Contains("give data.delimiter"));
+}
+
+TEST_CASE("data files from other codes and European spreadsheets: names holding the delimiter, "
+          "decimal commas, column names on a comment line, a folder named with a slash",
+          "[gap][experiments]") {
+    const fs::path dir = folder("codes");
+    const std::string head = "experiments:\n  - id: p\n    type: plate_sinkage\n    data:\n";
+    const std::string axes = "      x: {column: 'Sinkage, mm', unit: mm}\n"
+                             "      y: {pressure_Pa: {column: 'Pressure, kPa', unit: kPa}}\n";
+    // Quoted names that hold the delimiter, and a doubled quote.
+    write(dir / "q.csv", "\"Sinkage, mm\",\"Pressure, kPa\",\"say \"\"hi\"\"\"\n1,2,x\n2,4,y\n");
+    write(dir / "experiments.yaml", head + "      files: [q.csv]\n" + axes);
+    const ExperimentSet quoted = loadExperiments(dir.string() + "/");
+    CHECK(quoted.experiments[0].trials[0].curves.at("pressure_Pa").y ==
+          std::vector<double>{2000.0, 4000.0});
+    // The folder's name, given with a trailing slash, is still its name.
+    CHECK(quoted.name == dir.filename().string());
+    CHECK(folderName(dir.string() + "/.") == dir.filename().string());
+
+    // A European spreadsheet: ';' between cells, a decimal comma.
+    write(dir / "eu.csv", "z_mm;p_kPa\n0,5;1,25\n1,0;2,5e0\n");
+    const std::string eu = head + "      files: [eu.csv]\n      delimiter: ';'\n" +
+                           "      x: {column: z_mm, unit: mm}\n"
+                           "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n";
+    write(dir / "experiments.yaml", eu);
+    CHECK_THROWS_WITH(loadExperiments(dir.string()),
+                      Catch::Contains("eu.csv:2: column 'z_mm': '0,5' is not a finite number") &&
+                          Catch::Contains("data.decimal"));
+    std::string with_decimal = eu;
+    with_decimal.replace(with_decimal.find("      x:"), 0, "      decimal: ','\n");
+    write(dir / "experiments.yaml", with_decimal);
+    const ExperimentSet european = loadExperiments(dir.string());
+    const Curve &c = european.experiments[0].trials[0].curves.at("pressure_Pa");
+    REQUIRE(c.x.size() == 2);
+    CHECK(c.x[0] == Approx(0.0005));
+    CHECK(c.x[1] == Approx(0.001));
+    CHECK(c.y[0] == Approx(1250.0));
+    CHECK(c.y[1] == Approx(2500.0));
+    checkRefused(dir,
+                 head + "      files: [eu.csv]\n      decimal: ','\n" +
+                     "      x: {column: z_mm, unit: mm}\n"
+                     "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n",
+                 "a decimal comma needs another delimiter");
+
+    // LIGGGHTS' fix ave/time file: its column names stand on a comment line.
+    write(dir / "lig.txt", "# Time-averaged data for fix out\n# TimeStep v_z v_p\n"
+                           "100 0.001 5.0\n200 0.002 10.0\n");
+    write(dir / "experiments.yaml", head + "      files: [lig.txt]\n      delimiter: whitespace\n" +
+                                        "      columns: [step, z_m, p_kPa]\n" +
+                                        "      x: {column: z_m, unit: m}\n"
+                                        "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n");
+    CHECK(loadExperiments(dir.string()).experiments[0].trials[0].curves.at("pressure_Pa").y ==
+          std::vector<double>{5000.0, 10000.0});
+    // `comment: ""` reads every line: a header starting with '#'.
+    write(dir / "hash.csv", "#z_mm,p_kPa\n1,2\n");
+    write(dir / "experiments.yaml", head + "      files: [hash.csv]\n      comment: ''\n" +
+                                        "      x: {column: '#z_mm', unit: mm}\n"
+                                        "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n");
+    CHECK(loadExperiments(dir.string()).experiments[0].trials[0].curves.at("pressure_Pa").x ==
+          std::vector<double>{0.001});
+
+    // Two columns of one name, bins with an empty bin, a wheel curve with z up: refused.
+    write(dir / "dup.csv", "z_mm,p_kPa,p_kPa\n1,2,3\n");
+    checkRefused(dir,
+                 head + "      files: [dup.csv]\n      x: {column: z_mm, unit: mm}\n"
+                        "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n",
+                 "two columns are named 'p_kPa'");
+    write(dir / "ok.csv", "z_mm,p_kPa\n1,2\n2,3\n");
+    checkRefused(dir,
+                 head + "      files: [ok.csv]\n      x: {column: z_mm, unit: mm}\n"
+                        "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n"
+                        "    bins: {edges: [0, 1, 1, 2], unit: mm}\n",
+                 "increasing edges");
+    write(dir / "ws.csv", "slip,Z_mm\n0.1,-5\n0.3,-9\n");
+    checkRefused(dir,
+                 "experiments:\n  - id: w\n    type: wheel_steady_state\n"
+                 "    data: {files: [ws.csv], x: {column: slip, unit: '-'}, "
+                 "y: {sinkage_m: {column: Z_mm, unit: mm}}}\n",
+                 "every run's sinkage is negative");
 }
 
 TEST_CASE("experiments.yaml: bad input names the file, the key and the line",

@@ -99,3 +99,70 @@ TEST_CASE("a plain CSV becomes an experiment of a measurements folder", "[gap][i
     CHECK(e.trials[0].curves.at("pressure_Pa").x.back() == Approx(0.01));
     CHECK_THROWS_WITH(importCsv(csv, out.string()), Catch::Contains("already in"));
 }
+
+TEST_CASE("import csv reads a file as the diagnosis does, and a failed import leaves the folder "
+          "as it was",
+          "[gap][import]") {
+    const fs::path out = scratch("csv-eu");
+    const auto file = [](const std::string &name, const std::string &text) {
+        const fs::path p =
+            fs::temp_directory_path() / (name + "-" + std::to_string(::getpid()) + ".csv");
+        std::ofstream(p) << text;
+        return p.string();
+    };
+    // A European spreadsheet's export: a byte-order mark, quoted names holding the delimiter,
+    // ';' between cells, decimal commas.
+    CsvImport csv;
+    csv.file = file("eu", "\xEF\xBB\xBF\"Sinkage; mm\";\"Pressure; kPa\"\n0,5;1,5\n1;3\n");
+    csv.id = "eu";
+    csv.type = "plate_sinkage";
+    csv.x_column = "Sinkage; mm";
+    csv.x_unit = "mm";
+    csv.y["pressure_Pa"] = {"Pressure; kPa", "kPa"};
+    csv.delimiter = ";";
+    csv.decimal = ",";
+    importCsv(csv, out.string() + "/");
+    const ExperimentSet set = loadExperiments(out.string());
+    CHECK(set.name == out.filename().string());
+    const Curve &c = set.find("eu").trials[0].curves.at("pressure_Pa");
+    REQUIRE(c.y.size() == 2);
+    CHECK(c.y[0] == Approx(1500.0));
+    CHECK(c.x[1] == Approx(0.001));
+
+    // A scalar: the column's values.
+    CsvImport repose;
+    repose.file = file("repose", "trial,angle\n1,29.5\n2,30.1\n");
+    repose.id = "repose";
+    repose.type = "angle_of_repose";
+    repose.y["angle_deg"] = {"angle", "deg"};
+    importCsv(repose, out.string());
+    CHECK(loadExperiments(out.string()).find("repose").trials.size() == 2);
+
+    // Refused before anything is written, naming the user's file and line: the folder reads as
+    // before, no copy is left, and the same id imports once the file is fixed.
+    std::ifstream before_in(out / "experiments.yaml");
+    const std::string before((std::istreambuf_iterator<char>(before_in)),
+                             std::istreambuf_iterator<char>());
+    CsvImport bad = csv;
+    bad.id = "units_row";
+    bad.file = file("unitsrow", "z;p\nmm;kPa\n1;2\n");
+    bad.x_column = "z";
+    bad.y = {{"pressure_Pa", {"p", "kPa"}}};
+    CHECK_THROWS_WITH(importCsv(bad, out.string()),
+                      Catch::Contains(bad.file + ":2: column 'z': 'mm' is not a finite number"));
+    // A unit of the wrong kind is found when the folder is read back: undone too.
+    CsvImport wrong_unit = csv;
+    wrong_unit.id = "wrong_unit";
+    wrong_unit.y = {{"pressure_Pa", {"Pressure; kPa", "mm"}}};
+    CHECK_THROWS_WITH(importCsv(wrong_unit, out.string()), Catch::Contains("not a pressure"));
+    CHECK_THROWS_WITH(importCsv(CsvImport{csv.file, "../up", "plate_sinkage"}, out.string()),
+                      Catch::Contains("one word"));
+    std::ifstream after_in(out / "experiments.yaml");
+    CHECK(std::string((std::istreambuf_iterator<char>(after_in)),
+                      std::istreambuf_iterator<char>()) == before);
+    CHECK_FALSE(fs::exists(out / "data" / "units_row.csv"));
+    CHECK_FALSE(fs::exists(out / "data" / "wrong_unit.csv"));
+    bad.file = file("unitsrow", "z;p\n1;2\n2;3\n");
+    importCsv(bad, out.string());
+    CHECK(loadExperiments(out.string()).experiments.size() == 3);
+}

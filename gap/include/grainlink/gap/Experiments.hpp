@@ -36,8 +36,8 @@ double unitFactor(const std::string &unit, const std::string &dimension);
 struct ZeroConvention {
     enum class Method {
         AsRecorded,     ///< the data's own zero (e.g. a hand-picked first contact)
-        FirstSample,    ///< x - x of the first sample
-        ForceThreshold, ///< x - x of the first sample whose y reaches `threshold` (SI)
+        FirstSample,    ///< x - x where the recording starts (its shallowest sample)
+        ForceThreshold, ///< x - the least x at which y reaches `threshold` (SI)
     };
     Method method = Method::AsRecorded;
     double threshold = 0.0; ///< [SI unit of the experiment's first observable]
@@ -90,15 +90,24 @@ struct ExperimentSet {
     const Experiment &find(const std::string &id) const;
 };
 
+/// A folder's own name, however it is written (`meas/`, `.`, `../meas`): a measurements set's
+/// default name.
+std::string folderName(const std::string &directory);
+
 /// Reads DIR/experiments.yaml and every data file it names, strictly: an unknown key, a
 /// missing column, a unit of the wrong kind or an unreadable file stops with the file, the key
 /// and the line.
 ExperimentSet loadExperiments(const std::string &directory);
 
 /// A curve sorted by x with equal x merged (their mean), then shifted by the zero convention;
-/// used for measured and simulated curves alike. A curve recorded in time order that runs back
-/// after its largest x (an unloading) keeps its loading branch only.
+/// used for measured and simulated curves alike.
 Curve applyZero(const Curve &curve, const ZeroConvention &zero);
+
+/// How many samples of a curve in file order are its loading branch: all, unless it was
+/// recorded in time order (x not falling at four in five steps up to its largest x) and then ran
+/// back (an unloading, a retraction): then the samples up to its largest x. Reading a plate or
+/// shear curve keeps only these.
+std::size_t loadingBranch(const Curve &curve);
 
 /// The SI dimension an observable's name implies by its unit suffix ("pressure_Pa" ->
 /// "pressure", "sinkage_m" -> "length", "slip" -> "dimensionless").

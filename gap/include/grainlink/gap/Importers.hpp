@@ -31,6 +31,8 @@ struct CsvImport {
     std::map<std::string, std::pair<std::string, std::string>> y; ///< observable -> column, unit
     std::map<std::string, std::string> conditions; ///< key -> value (numbers stay numbers)
     bool scatter = false;
+    std::string delimiter = ","; ///< ",", ";", "tab" or "whitespace"
+    std::string decimal = ".";   ///< "," for numbers with a decimal comma
 };
 void importCsv(const CsvImport &csv, const std::string &out);
 

@@ -1,0 +1,146 @@
+#include "DataTable.hpp"
+
+#include "grainlink/config/ConfigNode.hpp"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+
+namespace grainlink::gap {
+
+namespace {
+
+bool blank(char c) {
+    return c == ' ' || c == '\t' || c == '\r';
+}
+
+std::string trimmed(const std::string &s) {
+    std::size_t a = 0, b = s.size();
+    while (a < b && blank(s[a]))
+        ++a;
+    while (b > a && blank(s[b - 1]))
+        --b;
+    return s.substr(a, b - a);
+}
+
+/// A cell that holds no value: empty, or a missing-value mark of a spreadsheet or of numpy.
+bool missingCell(const std::string &cell) {
+    std::string low;
+    for (char c : cell)
+        low += char(std::tolower(static_cast<unsigned char>(c)));
+    return low.empty() || low == "nan" || low == "-nan" || low == "na" || low == "n/a" ||
+           low == "null" || low == "none";
+}
+
+} // namespace
+
+std::vector<std::string> splitCells(const std::string &line, const TableFormat &format) {
+    std::vector<std::string> out;
+    std::string cell;
+    bool quoted = false;   // inside a quoted stretch
+    bool had_text = false; // this cell has begun (for runs of blanks)
+    const auto push = [&] {
+        out.push_back(trimmed(cell));
+        cell.clear();
+        had_text = false;
+    };
+    for (std::size_t i = 0; i < line.size(); ++i) {
+        const char c = line[i];
+        if (c == '"') {
+            if (quoted && i + 1 < line.size() && line[i + 1] == '"') {
+                cell += '"'; // a doubled quote inside quotes
+                ++i;
+            } else {
+                quoted = !quoted;
+            }
+            had_text = true;
+            continue;
+        }
+        const bool split = !quoted && (format.blanks ? blank(c) : c == format.delimiter);
+        if (!split) {
+            cell += c;
+            had_text = had_text || !blank(c);
+            continue;
+        }
+        if (!format.blanks || had_text)
+            push();
+    }
+    if (!format.blanks || had_text)
+        push();
+    return out;
+}
+
+std::optional<std::size_t> DataTable::find(const std::string &name) const {
+    const auto it = std::find(header.begin(), header.end(), name);
+    if (it == header.end())
+        return std::nullopt;
+    if (std::find(it + 1, header.end(), name) != header.end())
+        throw config::ConfigError(file + ": two columns are named '" + name +
+                                  "': rename one in the file's header");
+    return std::size_t(it - header.begin());
+}
+
+std::string DataTable::names() const {
+    std::string have;
+    for (const auto &h : header)
+        have += (have.empty() ? "" : ", ") + h;
+    return have;
+}
+
+bool DataTable::missing(std::size_t row, std::size_t col) const {
+    return col >= rows[row].size() || missingCell(rows[row][col]);
+}
+
+double DataTable::number(std::size_t row, std::size_t col) const {
+    std::string cell = col < rows[row].size() ? rows[row][col] : std::string();
+    if (decimal != '.')
+        std::replace(cell.begin(), cell.end(), decimal, '.');
+    char *end = nullptr;
+    const double v = std::strtod(cell.c_str(), &end);
+    if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v)) {
+        const std::string &as_written = rows[row][col];
+        const bool comma = decimal == '.' && as_written.find(',') != std::string::npos;
+        throw config::ConfigError(
+            file + ":" + std::to_string(lines[row]) + ": column '" + header[col] + "': '" +
+            as_written + "' is not a finite number" +
+            (comma ? " (numbers with a decimal comma: give data.decimal: \",\")" : ""));
+    }
+    return v;
+}
+
+DataTable readDataTable(const std::string &path, const TableFormat &format) {
+    std::ifstream in(path);
+    if (!in)
+        throw config::ConfigError("cannot read data file " + path);
+    DataTable t;
+    t.file = path;
+    t.decimal = format.decimal;
+    t.header = format.columns;
+    std::string line;
+    int number = 0;
+    while (std::getline(in, line)) {
+        if (++number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0)
+            line.erase(0, 3); // a spreadsheet's byte-order mark
+        if (trimmed(line).empty() ||
+            (!format.comment.empty() && line.rfind(format.comment, 0) == 0))
+            continue;
+        std::vector<std::string> cells = splitCells(line, format);
+        if (std::all_of(cells.begin(), cells.end(), [](const std::string &c) { return c.empty(); }))
+            continue; // a spreadsheet's row of empty cells
+        if (t.header.empty()) {
+            t.header = std::move(cells);
+            continue;
+        }
+        t.rows.push_back(std::move(cells));
+        t.lines.push_back(number);
+    }
+    if (t.header.empty())
+        throw config::ConfigError("data file " + path + " has no header line");
+    if (t.rows.empty())
+        throw config::ConfigError("data file " + path + " has no data rows");
+    return t;
+}
+
+} // namespace grainlink::gap

@@ -1,0 +1,48 @@
+#pragma once
+// One reader of a measurement's data file, for the diagnosis and the importers alike: a table
+// as spreadsheets and other codes write it (docs/gap.md, "The measurements folder").
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace grainlink::gap {
+
+/// How a data file is written: `data.comment`, `data.delimiter`, `data.decimal`, `data.columns`.
+struct TableFormat {
+    std::string comment = "#"; ///< lines starting with it are skipped; "" skips none
+    char delimiter = ',';
+    bool blanks = false; ///< cells separated by runs of blanks (`delimiter: whitespace`)
+    char decimal = '.';  ///< ',' for a European spreadsheet's numbers (with `delimiter: ";"`)
+    /// The column names of a file without a header line (another code's output, whose names
+    /// stand on a comment line): every line not a comment is then a row.
+    std::vector<std::string> columns;
+};
+
+/// A data file's header names and rows of text cells, with the file line of every row.
+struct DataTable {
+    std::string file;
+    std::vector<std::string> header;
+    std::vector<std::vector<std::string>> rows;
+    std::vector<int> lines;
+    char decimal = '.';
+
+    /// The column of that name; none when it is missing. Throws when two columns share it.
+    std::optional<std::size_t> find(const std::string &name) const;
+    /// The header's names, comma-separated, for a message.
+    std::string names() const;
+    /// Whether row r holds no value in column c (empty, NaN, NA, null, none; or no such cell).
+    bool missing(std::size_t row, std::size_t col) const;
+    /// Row r's cell in column c; a cell that is not a finite number is an error naming the
+    /// file, line and column.
+    double number(std::size_t row, std::size_t col) const;
+};
+
+/// Splits one line into cells: quoted cells may hold the delimiter ("Sinkage, mm") and a
+/// doubled quote; blanks around a cell are dropped.
+std::vector<std::string> splitCells(const std::string &line, const TableFormat &format);
+
+/// Reads `path`; throws config::ConfigError naming the file when it cannot be read, has no
+/// header or no data rows.
+DataTable readDataTable(const std::string &path, const TableFormat &format);
+
+} // namespace grainlink::gap
