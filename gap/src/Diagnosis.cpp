@@ -149,6 +149,17 @@ bool coversBase(const Eigen::VectorXd &mean, const Eigen::VectorXd &base,
     return true;
 }
 
+/// `rows` with every feature that none of its seeds reached, where the base's seeds did, taken
+/// from the base seed by seed.
+Eigen::MatrixXd atBaseWhereUnreached(Eigen::MatrixXd rows, const Eigen::MatrixXd &base) {
+    const Eigen::Index seeds = std::min(rows.rows(), base.rows());
+    for (Eigen::Index k = 0; k < rows.cols(); ++k)
+        if (!rows.col(k).array().isFinite().any() && base.col(k).array().isFinite().any())
+            for (Eigen::Index j = 0; j < seeds; ++j)
+                rows(j, k) = base(j, k);
+    return rows;
+}
+
 /// The effect at the strength of the seeds' first n rows of `rows`.
 Eigen::MatrixXd firstRows(const Eigen::MatrixXd &rows, int n) {
     return rows.topRows(std::min<Eigen::Index>(rows.rows(), n));
@@ -605,13 +616,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                                         const Eigen::VectorXd &strength_var) -> Eigen::VectorXd {
         return u2_fixed + meanAndVariance(rows, bed_sd).second + strength_var;
     };
-    const auto evaluateModel = [&](const Eigen::MatrixXd &rows, HeldOutScore &score,
+    const auto evaluateModel = [&](const Eigen::MatrixXd &model_rows, HeldOutScore &score,
                                    DensityComparison &versus_null, GapVerdict &after,
                                    Eigen::VectorXd &mean, Eigen::VectorXd &z,
                                    const Eigen::VectorXd &strength_var) {
-        const auto mv = meanAndVariance(rows, bed_sd);
-        mean = mv.first;
-        if (!coversBase(mean, V.simulated, meas.keys)) { // its runs failed somewhere: it predicts nothing there
+        if (!coversBase(meanAndVariance(model_rows, bed_sd).first, V.simulated, meas.keys)) {
+            // its runs failed somewhere: it predicts nothing there
             const double inf = std::numeric_limits<double>::infinity();
             score = HeldOutScore{};
             score.gap = score.relative_rmse = score.smse = inf;
@@ -621,6 +631,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             after.summary = "its confirming runs failed on some experiment";
             return false;
         }
+        // A bin the model's curves no longer reach (a zero offset moving them past the first)
+        // is taken at the base, as in its fit (step 6): judged without it, a model would gain
+        // by dropping the bin it misses most.
+        const Eigen::MatrixXd rows = atBaseWhereUnreached(model_rows, base_rows);
+        const auto mv = meanAndVariance(rows, bed_sd);
+        mean = mv.first;
         const Eigen::VectorXd var = u2_fixed + mv.second;
         const Eigen::VectorXd predictive = predictiveVariance(rows, strength_var);
         score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);

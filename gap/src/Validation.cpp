@@ -104,15 +104,33 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
             for (Eigen::Index k : idx) {
                 if (c.count[k] == 0 || !std::isfinite(b.mean[k]) || b.mean[k] == 0.0)
                     continue;
-                // Pooled scatter of the base's and the check's seeds.
-                const double nb = b.count[k], nc = c.count[k];
-                const double sb2 = std::isfinite(b.sd[k]) ? b.sd[k] * b.sd[k] : 0.0;
-                const double sc2 = nc >= 2 && std::isfinite(c.sd[k]) ? c.sd[k] * c.sd[k] : sb2;
-                const double dof = std::max(1.0, nb + nc - 2.0);
-                const double pooled = ((nb - 1.0) * sb2 + std::max(0.0, nc - 1.0) * sc2) / dof;
-                const double d = c.mean[k] - b.mean[k];
+                // Check seed j is base seed j (the same deposition seed): a check that leaves
+                // the bed as it is (the loading rate) runs on the very same packing, and its
+                // difference from the base has almost none of the beds' scatter. Paired
+                // differences measure what is left whether the beds are shared or not; with
+                // fewer than two pairs, the pooled scatter of the two means stands in.
+                std::vector<double> pairs;
+                for (Eigen::Index j = 0; j < std::min(check.rows.rows(), base.rows()); ++j)
+                    if (std::isfinite(check.rows(j, k)) && std::isfinite(base(j, k)))
+                        pairs.push_back(check.rows(j, k) - base(j, k));
+                double d = 0.0, var_d = 0.0;
+                if (pairs.size() >= 2) {
+                    for (double x : pairs)
+                        d += x / double(pairs.size());
+                    for (double x : pairs)
+                        var_d += (x - d) * (x - d) / double(pairs.size() - 1);
+                    var_d /= double(pairs.size());
+                } else {
+                    const double nb = b.count[k], nc = c.count[k];
+                    const double sb2 = std::isfinite(b.sd[k]) ? b.sd[k] * b.sd[k] : 0.0;
+                    const double sc2 = nc >= 2 && std::isfinite(c.sd[k]) ? c.sd[k] * c.sd[k] : sb2;
+                    const double dof = std::max(1.0, nb + nc - 2.0);
+                    const double pooled = ((nb - 1.0) * sb2 + std::max(0.0, nc - 1.0) * sc2) / dof;
+                    d = c.mean[k] - b.mean[k];
+                    var_d = pooled * (1.0 / nc + 1.0 / std::max(1.0, nb));
+                }
                 sum2 += d * d;
-                var += pooled * (1.0 / nc + 1.0 / std::max(1.0, nb));
+                var += var_d;
                 level2 += b.mean[k] * b.mean[k];
                 ++k_used;
             }
@@ -145,8 +163,10 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
         const double nu_rep = measured.trials[k] - 1.0;
         const double u_rep = measured.u_repeats.size() == n ? measured.u_repeats[k] : 0.0;
         double den = 0.0;
+        // u_seed and u_bed are one estimate (the seeds' sd), not two: their squares add
+        // before Welch-Satterthwaite, so one measured trial gives Student's t of S - 1 dof.
         if (nu_seed > 0.0)
-            den += (std::pow(v.u_seed[k], 4) + std::pow(v.u_bed[k], 4)) / nu_seed;
+            den += std::pow(v.u_seed[k] * v.u_seed[k] + v.u_bed[k] * v.u_bed[k], 2) / nu_seed;
         if (nu_rep > 0.0 && u_rep > 0.0)
             den += std::pow(u_rep, 4) / nu_rep;
         v.dof[k] = den > 0.0 ? std::pow(v.u_val[k], 4) / den
