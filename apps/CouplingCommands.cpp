@@ -8,6 +8,7 @@
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/dem/SteadySignal.hpp"
 #include "grainlink/mbs/Mole.hpp"
+#include "grainlink/mbs/RockerBogie.hpp"
 #include "grainlink/mbs/WheelTest.hpp"
 
 #include <nlohmann/json.hpp>
@@ -144,11 +145,11 @@ void printRigVerdict(const std::string &directory) {
 
 /// One window's row of a soil node's series (soil.csv) for one body.
 struct SoilRow {
-    double time_s, sinkage_m, end_wall_ahead_N, end_wall_behind_N;
+    double time_s, sinkage_m, end_wall_ahead_N, end_wall_behind_N, fx_N, fz_N;
 };
 
-/// The rows of `body` in the soil series `path`, in time order; a column the file lacks (a
-/// series from before the end-wall columns were written) reads NaN.
+/// The rows of `body` (every body's, for "") in the soil series `path`, in time order; a
+/// column the file lacks (a series from before the end-wall columns were written) reads NaN.
 std::vector<SoilRow> soilSeries(const std::string &path, const std::string &body) {
     std::ifstream series(path);
     std::string line;
@@ -172,12 +173,28 @@ std::vector<SoilRow> soilSeries(const std::string &path, const std::string &body
                        ? std::nan("")
                        : std::strtod(cells[c->second].c_str(), nullptr);
         };
-        if (cells.size() < 2 || cells[1] != body)
+        if (cells.size() < 2 || (!body.empty() && cells[1] != body))
             continue;
         rows.push_back({value("time_s"), value("sinkage_m"), value("end_wall_ahead_N"),
-                        value("end_wall_behind_N")});
+                        value("end_wall_behind_N"), value("Fx_N"), value("Fz_N")});
     }
     return rows;
+}
+
+double meanOf(const std::vector<double> &v) {
+    double sum = 0.0;
+    for (double x : v)
+        sum += x;
+    return sum / double(v.size());
+}
+
+/// The mean, sd and standard error of v's rise over `minus` (dem::summarizeSignal).
+nlohmann::json riseStatistics(const std::vector<double> &v, double minus) {
+    std::vector<double> rise;
+    for (double x : v)
+        rise.push_back(x - minus);
+    const auto s = dem::summarizeSignal(rise);
+    return nlohmann::json{{"mean", s.mean}, {"sd", s.sd}, {"standard_error", s.standard_error}};
 }
 
 void writeJsonAtomically(const std::string &path, const nlohmann::json &j) {
@@ -219,6 +236,86 @@ void addMoleDepths(const config::ConfigNode &root, const std::string &directory,
                 1e3 * rows.back().sinkage_m, summary["strokes"].size(), summary_path.c_str());
 }
 
+/// A rover's strips (mbs_summary.json, `end_walls`): for each soil section, the rise of the
+/// push on its end walls over the run's second half above their push at the end of the drop,
+/// and its share of the section's wheels' push along x (dem::endWallShare; the wheels' weight
+/// floors it). A share above rover.end_wall_limit refuses the run, as the rig's steady state:
+/// the soil the wheels push reached a strip's end. Returns whether the run stands.
+bool addRoverEndWalls(const config::ConfigNode &root, const std::string &directory,
+                      const std::vector<std::string> &sections) {
+    const std::string summary_path = directory + "/mbs_summary.json";
+    if (!std::filesystem::exists(summary_path))
+        return true;
+    auto summary = nlohmann::json::parse(std::ifstream(summary_path));
+    if (!summary.contains("second_half_from_s"))
+        return true;
+    const mbs::RockerBogieSettings rover = mbs::parseRockerBogie(root["rover"]);
+    const double from = summary["second_half_from_s"];
+    // At rest on the beds: the drop's second half (the run's first tenth without a drop).
+    const double rest_to = rover.release_time_s.value_or(0.2 * from);
+    bool stands = true;
+    std::string why;
+    for (const std::string &section : sections) {
+        // One sample per window: the walls' push (the same on every body's row), the wheels'
+        // forces summed.
+        std::map<double, SoilRow> windows;
+        for (const SoilRow &r : soilSeries(directory + "/" + section + ".csv", "")) {
+            auto [it, first] = windows.emplace(r.time_s, r);
+            if (!first)
+                it->second.fx_N += r.fx_N, it->second.fz_N += r.fz_N;
+        }
+        std::vector<double> ahead, behind, rest_ahead, rest_behind, fx, fz;
+        for (const auto &[t, r] : windows) {
+            if (t >= from - 1e-9) {
+                ahead.push_back(r.end_wall_ahead_N);
+                behind.push_back(r.end_wall_behind_N);
+                fx.push_back(r.fx_N);
+                fz.push_back(r.fz_N);
+            } else if (t > 0.5 * rest_to && t <= rest_to + 1e-9) {
+                rest_ahead.push_back(r.end_wall_ahead_N);
+                rest_behind.push_back(r.end_wall_behind_N);
+            }
+        }
+        if (ahead.empty() || rest_ahead.empty() || !std::isfinite(meanOf(ahead)) ||
+            !std::isfinite(meanOf(rest_ahead)))
+            continue; // no end walls along x, or a series from before they were written
+        nlohmann::json walls;
+        walls["ahead_N"] = riseStatistics(ahead, meanOf(rest_ahead));
+        walls["behind_N"] = riseStatistics(behind, meanOf(rest_behind));
+        // The wheels' push on the soil along x is the soil's force on them, reversed.
+        const double push = -meanOf(fx);
+        walls["push_N"] = push;
+        const double share = dem::endWallShare(walls["ahead_N"]["mean"], walls["behind_N"]["mean"],
+                                               push, std::abs(meanOf(fz)));
+        walls["share"] = share;
+        summary["end_walls"][section] = walls;
+        std::printf("run: %s's end walls %+.3g N ahead, %+.3g N behind over the second half "
+                    "(share %.2f of the wheels' push)\n",
+                    section.c_str(), walls["ahead_N"]["mean"].get<double>(),
+                    walls["behind_N"]["mean"].get<double>(), share);
+        if (share > rover.end_wall_limit) {
+            std::ostringstream w;
+            w << section << "'s end walls took " << std::lround(100.0 * share)
+              << " % of its wheels' push along x over the run's second half, more than "
+                 "rover.end_wall_limit = "
+              << rover.end_wall_limit
+              << ": the soil the wheels pushed reached the strip's end, and the slips are the "
+                 "strip's, not the soil's. Lengthen the strip (its walls and deposition region "
+                 "along x); the results are written to "
+              << directory;
+            why += (why.empty() ? "" : "; ") + w.str();
+            stands = false;
+        }
+    }
+    if (!stands) {
+        summary["end_walls_refused"] = why;
+        std::fprintf(stderr, "run: %s\n", why.c_str());
+    }
+    if (summary.contains("end_walls"))
+        writeJsonAtomically(summary_path, summary);
+    return stands;
+}
+
 } // namespace
 
 /// A mole's strokes get their depths below the bed surface (above). The rig's steady report
@@ -232,6 +329,8 @@ bool addSoilMeasures(const config::ConfigNode &root, const std::string &director
     const auto sections = nodesIn(root).soil_sections;
     if (root.has("mole") && sections.size() == 1)
         addMoleDepths(root, directory, sections[0]);
+    if (root.has("rover"))
+        return addRoverEndWalls(root, directory, sections);
     const std::string summary_path = directory + "/rig_summary.json";
     if (!root.has("rig") || sections.size() != 1 || !std::filesystem::exists(summary_path))
         return true;
@@ -255,30 +354,17 @@ bool addSoilMeasures(const config::ConfigNode &root, const std::string &director
     }
     if (sinkage.empty())
         return true;
-    const auto statistics = [](const std::vector<double> &v, double minus) {
-        std::vector<double> rise;
-        for (double x : v)
-            rise.push_back(x - minus);
-        const auto s = dem::summarizeSignal(rise);
-        return nlohmann::json{{"mean", s.mean}, {"sd", s.sd}, {"standard_error", s.standard_error}};
-    };
-    const auto mean = [](const std::vector<double> &v) {
-        double sum = 0.0;
-        for (double x : v)
-            sum += x;
-        return sum / double(v.size());
-    };
-    summary["sinkage_m"] = statistics(sinkage, 0.0);
+    summary["sinkage_m"] = riseStatistics(sinkage, 0.0);
     std::printf("run: steady sinkage %.2f +- %.2f mm (se %.2f) in %s\n",
                 1e3 * summary["sinkage_m"]["mean"].get<double>(),
                 1e3 * summary["sinkage_m"]["sd"].get<double>(),
                 1e3 * summary["sinkage_m"]["standard_error"].get<double>(), summary_path.c_str());
     bool stands = true;
     // (A series without the end-wall columns, from before they were written, reads NaN.)
-    if (!hold_ahead.empty() && std::isfinite(mean(ahead)) && std::isfinite(mean(hold_ahead)) &&
+    if (!hold_ahead.empty() && std::isfinite(meanOf(ahead)) && std::isfinite(meanOf(hold_ahead)) &&
         summary.contains("drawbar_pull_N") && summary.contains("normal_load_N")) {
-        summary["end_wall_ahead_N"] = statistics(ahead, mean(hold_ahead));
-        summary["end_wall_behind_N"] = statistics(behind, mean(hold_behind));
+        summary["end_wall_ahead_N"] = riseStatistics(ahead, meanOf(hold_ahead));
+        summary["end_wall_behind_N"] = riseStatistics(behind, meanOf(hold_behind));
         // The wheel's push on the soil along x is the soil's force on it, reversed.
         const double share = dem::endWallShare(
             summary["end_wall_ahead_N"]["mean"], summary["end_wall_behind_N"]["mean"],

@@ -409,6 +409,8 @@ RockerBogieSettings parseRockerBogie(const config::ConfigNode &node) {
         s.release_time_s = node["release_time_s"].positive();
     }
     s.hold_chassis_in_drop = node.boolean("hold_chassis_in_drop", false);
+    if (node.has("end_wall_limit"))
+        s.end_wall_limit = node["end_wall_limit"].number(0.01, 1.0);
     if (s.hold_chassis_in_drop && !s.release_time_s)
         node["hold_chassis_in_drop"].fail("a hold in the drop needs the drop's end: give "
                                           "release_time_s");

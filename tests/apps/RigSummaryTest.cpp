@@ -138,3 +138,50 @@ TEST_CASE("a mole's strokes get the tip's depth below the bed surface at each st
     CHECK(s["depth_before_strokes_m"].get<double>() == Approx(-0.02)); // the first release: 0.2 s
     fs::remove_all(dir);
 }
+
+TEST_CASE("a rover's strips get their end walls' push over the run's second half, and a strip "
+          "whose wall took the wheels' push refuses the run",
+          "[apps][rover]") {
+    // Two strips, three wheels each, every 10 ms to 2 s (the second half from 1 s), dropped
+    // until 0.4 s. Left: the walls rest at 3 N ahead and 5 N behind and stay there, the wheels
+    // pushing the soil 40 N back (Fx = +40 N on them) under 550 N: share 0. Right: its wall
+    // ahead rises by 30 N over the second half while the wheels push 20 N forward (Fx = -20 N):
+    // share 30 / max(20, 55) = 0.55, over the default limit 0.5.
+    const fs::path dir = fs::temp_directory_path() / "grainlink-rover-walls";
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    std::ofstream(dir / "scenario.yaml")
+        << "participants:\n"
+           "  - {name: rover, role: multibody, command: [grainlink, mbs-node]}\n"
+           "  - {name: soil_left, role: soil, command: [grainlink, dem-node, --section, "
+           "soil_left]}\n"
+           "  - {name: soil_right, role: soil, command: [grainlink, dem-node, --section, "
+           "soil_right]}\n"
+           "rover: {start_position_m: [0, 0, 0.5], release_time_s: 0.4}\n";
+    std::ofstream(dir / "mbs_summary.json")
+        << nlohmann::json{{"time_s", 2.0}, {"second_half_from_s", 1.0}}.dump(2);
+    for (const char *side : {"soil_left", "soil_right"}) {
+        const bool right = std::string(side) == "soil_right";
+        std::ofstream series(dir / (std::string(side) + ".csv"));
+        series << "time_s,body,sinkage_m,Fx_N,Fy_N,Fz_N,Tx_N_m,Ty_N_m,Tz_N_m,contacts,"
+                  "end_wall_ahead_N,end_wall_behind_N\n";
+        for (int k = 1; k <= 200; ++k) {
+            const double t = 0.01 * k;
+            const double ahead = 3.0 + (right && t > 0.995 ? 30.0 : 0.0);
+            for (const char *wheel : {"front", "middle", "rear"})
+                series << t << ',' << wheel << ",0.05," << (right ? -20.0 : 40.0) / 3.0 << ",0,"
+                       << 550.0 / 3.0 << ",0,0,0,9," << ahead << ",5\n";
+        }
+    }
+    CHECK_FALSE(grainlink::apps::addSoilMeasures(
+        grainlink::config::ConfigNode::loadFile((dir / "scenario.yaml").string()), dir.string()));
+    const auto s = nlohmann::json::parse(std::ifstream(dir / "mbs_summary.json"));
+    CHECK(s["end_walls"]["soil_left"]["share"].get<double>() == Approx(0.0).margin(1e-9));
+    CHECK(s["end_walls"]["soil_left"]["push_N"].get<double>() == Approx(-40.0));
+    CHECK(s["end_walls"]["soil_right"]["ahead_N"]["mean"].get<double>() == Approx(30.0));
+    CHECK(s["end_walls"]["soil_right"]["share"].get<double>() == Approx(30.0 / 55.0));
+    CHECK_THAT(s["end_walls_refused"].get<std::string>(),
+               Catch::Contains("soil_right's end walls took 55 %") &&
+                   Catch::Contains("rover.end_wall_limit = 0.5"));
+    fs::remove_all(dir);
+}

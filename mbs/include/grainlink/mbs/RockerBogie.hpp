@@ -52,6 +52,9 @@ struct RockerBogieSettings {
     /// In the drop, hold the chassis' horizontal velocity at zero: it comes down onto a slope
     /// without sliding down it (the rig's hold_carriage_in_drop).
     bool hold_chassis_in_drop = false;
+    /// With the DEM soil, `grainlink run` refuses a run in which a strip's end walls took more
+    /// than this share of its wheels' push over the run's second half (dem::endWallShare).
+    double end_wall_limit = 0.5;
     Vec3 gravity_m_s2 = Vec3(0, 0, -3.71); ///< [m/s^2] Mars
     IntegratorSettings integrator;
 
