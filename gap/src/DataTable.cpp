@@ -94,13 +94,13 @@ bool DataTable::missing(std::size_t row, std::size_t col) const {
 }
 
 double DataTable::number(std::size_t row, std::size_t col) const {
-    std::string cell = col < rows[row].size() ? rows[row][col] : std::string();
+    const std::string as_written = col < rows[row].size() ? rows[row][col] : std::string();
+    std::string cell = as_written;
     if (decimal != '.')
         std::replace(cell.begin(), cell.end(), decimal, '.');
     char *end = nullptr;
     const double v = std::strtod(cell.c_str(), &end);
     if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v)) {
-        const std::string &as_written = rows[row][col];
         const bool comma = decimal == '.' && as_written.find(',') != std::string::npos;
         throw config::ConfigError(
             file + ":" + std::to_string(lines[row]) + ": column '" + header[col] + "': '" +
