@@ -185,10 +185,11 @@ Measured measure(const ExperimentSet &set, const FeatureDesign &design) {
                 const Eigen::Index k = idx[i];
                 // The slope from the neighbouring bins of the same observable (an experiment's
                 // bins run observable after observable): one-sided at each one's ends.
+                const auto &bins = idx; // (a structured binding is not captured in C++17)
                 const auto same = [&](std::size_t j) {
-                    return design.keys[std::size_t(idx[j])].observable ==
+                    return design.keys[std::size_t(bins[j])].observable ==
                                design.keys[std::size_t(k)].observable &&
-                           std::isfinite(m.value[idx[j]]);
+                           std::isfinite(m.value[bins[j]]);
                 };
                 const Eigen::Index a = idx[i > 0 && same(i - 1) ? i - 1 : i];
                 const Eigen::Index b = idx[i + 1 < idx.size() && same(i + 1) ? i + 1 : i];
