@@ -16,6 +16,12 @@ struct TableFormat {
     /// The column names of a file without a header line (another code's output, whose names
     /// stand on a comment line): every line not a comment is then a row.
     std::vector<std::string> columns;
+
+    /// Cells separated by ",", ";", "tab" or "whitespace" (runs of blanks).
+    void delimitedBy(const std::string &name) {
+        blanks = name == "whitespace";
+        delimiter = name == "tab" ? '\t' : blanks ? ' ' : name.empty() ? ',' : name[0];
+    }
 };
 
 /// A data file's header names and rows of text cells, with the file line of every row.

@@ -88,11 +88,8 @@ bool endsWith(const std::string &s, const std::string &tail) {
 TableFormat parseTableFormat(const ConfigNode &data) {
     TableFormat f;
     f.comment = data.text("comment", "#");
-    if (data.has("delimiter")) {
-        const std::string d = data["delimiter"].choice({",", ";", "tab", "whitespace"});
-        f.blanks = d == "whitespace";
-        f.delimiter = d == "tab" ? '\t' : d == "whitespace" ? ' ' : d[0];
-    }
+    if (data.has("delimiter"))
+        f.delimitedBy(data["delimiter"].choice({",", ";", "tab", "whitespace"}));
     if (data.has("decimal")) {
         f.decimal = data["decimal"].choice({".", ","})[0];
         if (f.decimal == ',' && f.delimiter == ',' && !f.blanks)
@@ -127,6 +124,7 @@ std::size_t columnOf(const DataTable &table, const std::string &name, const Conf
     }
     return *c;
 }
+
 /// `{column, unit}` of one axis: the column index in `table` and the factor to SI.
 std::pair<std::size_t, double> axisColumn(const ConfigNode &node, const DataTable &table,
                                           const std::string &si_name) {
@@ -286,8 +284,7 @@ std::size_t loadingBranch(const Curve &curve) {
     return 5 * forward >= 4 * peak ? peak + 1 : n;
 }
 
-Curve applyZero(const Curve &recorded, const ZeroConvention &zero) {
-    const Curve &curve = recorded;
+Curve applyZero(const Curve &curve, const ZeroConvention &zero) {
     std::vector<std::size_t> order(curve.x.size());
     for (std::size_t i = 0; i < order.size(); ++i)
         order[i] = i;

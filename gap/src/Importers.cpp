@@ -297,10 +297,7 @@ void importCsv(const CsvImport &csv, const std::string &out) {
 
     // Read and checked before anything is written: an error names the user's file and line.
     TableFormat format;
-    format.delimiter = csv.delimiter == "tab"  ? '\t'
-                       : csv.delimiter.empty() ? ','
-                                               : csv.delimiter[0];
-    format.blanks = csv.delimiter == "whitespace";
+    format.delimitedBy(csv.delimiter);
     format.decimal = csv.decimal.empty() ? '.' : csv.decimal[0];
     const DataTable c = readDataTable(src.string(), format);
     std::vector<std::string> columns;

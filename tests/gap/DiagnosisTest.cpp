@@ -444,13 +444,14 @@ private:
 };
 
 /// The analytic soil, except that every run of one effect fails on some experiments (the DEM
-/// stopping at its overlap limit under a plate, as soft grains did with LIGGGHTS' data).
+/// stopping at its overlap limit under a plate, as soft grains did with LIGGGHTS' data), or
+/// with `first_bin_only` no longer reaches their first bin (a zero offset moving a curve past it).
 class FailingEffectSimulator final : public Simulator {
 public:
     FailingEffectSimulator(std::string effect, std::set<std::string> failing,
-                           bool only_confirming = false)
+                           bool only_confirming = false, bool first_bin_only = false)
         : effect_(std::move(effect)), failing_(std::move(failing)),
-          only_confirming_(only_confirming) {}
+          only_confirming_(only_confirming), first_bin_only_(first_bin_only) {}
     std::vector<std::string> checks() const override { return inner_.checks(); }
     YAML::Node referenceScenario() const override { return inner_.referenceScenario(); }
     std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &set, const FeatureDesign &design,
@@ -461,8 +462,11 @@ public:
                  (requests[i].second && requests[i].second->name == effect_)) &&
                 (!only_confirming_ || requests[i].label.rfind("confirm", 0) == 0))
                 for (const auto &id : failing_)
-                    for (Eigen::Index k : design.by_experiment.at(id))
+                    for (Eigen::Index k : design.by_experiment.at(id)) {
                         rows[i].col(k).setConstant(std::numeric_limits<double>::quiet_NaN());
+                        if (first_bin_only_)
+                            break;
+                    }
         return rows;
     }
 
@@ -470,36 +474,9 @@ private:
     AnalyticSimulator inner_;
     std::string effect_;
     std::set<std::string> failing_;
-    bool only_confirming_ = false;
+    bool only_confirming_ = false, first_bin_only_ = false;
 };
 } // namespace
-
-/// The analytic soil, except that `effect`'s confirming runs no longer reach the first bin of
-/// `experiments` (a zero offset moving a curve past it).
-class FirstBinUnreached final : public Simulator {
-public:
-    FirstBinUnreached(std::string effect, std::set<std::string> experiments)
-        : effect_(std::move(effect)), experiments_(std::move(experiments)) {}
-    std::vector<std::string> checks() const override { return inner_.checks(); }
-    YAML::Node referenceScenario() const override { return inner_.referenceScenario(); }
-    std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &set, const FeatureDesign &design,
-                                          const std::vector<VariantRequest> &requests) override {
-        auto rows = inner_.simulate(set, design, requests);
-        for (std::size_t i = 0; i < requests.size(); ++i)
-            if (requests[i].effect && requests[i].effect->name == effect_ && !requests[i].second &&
-                requests[i].label.rfind("confirm", 0) == 0)
-                for (const auto &id : experiments_)
-                    rows[i]
-                        .col(design.by_experiment.at(id).front())
-                        .setConstant(std::numeric_limits<double>::quiet_NaN());
-        return rows;
-    }
-
-private:
-    AnalyticSimulator inner_;
-    std::string effect_;
-    std::set<std::string> experiments_;
-};
 
 TEST_CASE("diagnosis: failed simulations are never read as agreement, nor bins they do not reach",
           "[gap][diagnosis]") {
@@ -671,7 +648,7 @@ TEST_CASE("diagnosis: a confirmed model is judged on every held-out bin the base
     const ExperimentSet set = measuredSet({"cohesion", 4.0e4}, 7);
     AnalyticSimulator whole;
     const Diagnosis reached = diagnose(set, c.diagnosable(), whole, analyticOptions());
-    FirstBinUnreached missing("cohesion", {"large_90", "large_110"});
+    FailingEffectSimulator missing("cohesion", {"large_90", "large_110"}, true, true);
     const Diagnosis d = diagnose(set, c.diagnosable(), missing, analyticOptions());
     const CandidateResult &full = candidate(reached, "cohesion");
     const CandidateResult &part = candidate(d, "cohesion");
