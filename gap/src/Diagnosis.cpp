@@ -302,7 +302,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 measured += std::isfinite(meas.value[k]);
                 compared += std::isfinite(V.standardised[k]);
             }
-        if (compared == 0)
+        if (measured == 0) // said apart: the measurement, not the model, gives no bin here
+            D.not_compared.push_back(e.id + " (no measured bin: its curves end before the first "
+                                            "bin ends; see bins: in docs/gap.md)");
+        else if (compared == 0)
             D.not_compared.push_back(e.id);
         else if (compared < measured)
             D.partly_compared.push_back(e.id + " (" + std::to_string(measured - compared) + " of " +

@@ -512,6 +512,12 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     // No row passed the filter: no curve was started at all.
                     if (whole.curves.empty() || whole.curves.begin()->second.empty())
                         f.fail("no rows of " + path.string() + " pass the filter");
+                    // One sample covers no bin: the experiment would drop out of the diagnosis.
+                    for (const auto &[o, curve] : whole.curves)
+                        if (curve.x.size() < 2)
+                            f.fail(path.string() + ": '" + o + "' has " +
+                                   std::to_string(curve.x.size()) + " sample(s) with " + e.x_name +
+                                   " and a value; a curve needs two or more");
                     // A plate or shear curve recorded in time order that runs back after its
                     // largest x (unloaded, reversed) keeps its loading branch: binned with it,
                     // the other branch would read low against a loading-only simulation.

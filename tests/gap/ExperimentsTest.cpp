@@ -395,12 +395,12 @@ TEST_CASE("data files from other codes and European spreadsheets: names holding 
     CHECK(loadExperiments(dir.string()).experiments[0].trials[0].curves.at("pressure_Pa").y ==
           std::vector<double>{5000.0, 10000.0});
     // `comment: ""` reads every line: a header starting with '#'.
-    write(dir / "hash.csv", "#z_mm,p_kPa\n1,2\n");
+    write(dir / "hash.csv", "#z_mm,p_kPa\n1,2\n2,4\n");
     write(dir / "experiments.yaml", head + "      files: [hash.csv]\n      comment: ''\n" +
                                         "      x: {column: '#z_mm', unit: mm}\n"
                                         "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n");
     CHECK(loadExperiments(dir.string()).experiments[0].trials[0].curves.at("pressure_Pa").x ==
-          std::vector<double>{0.001});
+          std::vector<double>{0.001, 0.002});
 
     // Two columns of one name, bins with an empty bin, a wheel curve with z up: refused.
     write(dir / "dup.csv", "z_mm,p_kPa,p_kPa\n1,2,3\n");
@@ -446,6 +446,10 @@ TEST_CASE("experiments.yaml: bad input names the file, the key and the line",
           "used twice");
     fails(plateYaml("    uncertainty: {beds: separate}\n"), "experiments.yaml:10");
     fails(plateYaml("    uncertainty: {beds: separate}\n"), "'separate'");
+    // A file of one row covers no bin: refused by name instead of dropping out of the diagnosis.
+    write(dir / "a2.csv", "sinkage_mm,pressure_kPa\n3.0,12.0\n");
+    fails(plateYaml(), "a2.csv: 'pressure_Pa' has 1 sample(s)");
+    fails(plateYaml(), "experiments.yaml:7: key 'experiments[0].data.files[1]'");
 }
 
 // Another code's output: the plate's force in N with z up (force and sinkage negative). Read
