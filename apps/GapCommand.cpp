@@ -58,6 +58,56 @@ gap::DiagnosisOptions diagnosisOptions(const gap::BaseModel &base) {
     return o;
 }
 
+/// `gap diagnose --dry-run`: what the diagnosis compares, how it splits, and the runs it needs.
+int printPlan(const gap::DiagnosisPlan &plan, const gap::ExperimentSet &set,
+              const gap::StudySimulator &sim, const gap::DiagnosisOptions &options) {
+    std::printf("design: %zu experiments, %zu features\n", set.experiments.size(),
+                plan.design.size());
+    for (const gap::Experiment &e : set.experiments) {
+        const auto it = plan.design.by_experiment.find(e.id);
+        const std::size_t bins = it == plan.design.by_experiment.end() ? 0 : it->second.size();
+        std::string range;
+        if (bins > 0 && !e.x_name.empty()) {
+            const auto &keys = plan.design.keys;
+            char text[96];
+            std::snprintf(text, sizeof text, " over %s %.4g to %.4g", e.x_name.c_str(),
+                          keys[std::size_t(it->second.front())].x_lo,
+                          keys[std::size_t(it->second.back())].x_hi);
+            range = text;
+        }
+        const bool held =
+            std::find(plan.held_out.begin(), plan.held_out.end(), e.id) != plan.held_out.end();
+        std::printf("  %-20s %-16s %zu feature(s)%s, %zu trial(s); %s%s\n", e.id.c_str(),
+                    gap::typeName(e.type), bins, range.c_str(), e.trials.size(),
+                    held ? "held out" : "calibration",
+                    bins == 0 ? "  (no measured bin: not compared)" : "");
+    }
+    std::string checks;
+    for (const std::string &c : sim.checks())
+        checks += (checks.empty() ? "" : ", ") + c;
+    std::printf("numerical checks: %s\n", checks.empty() ? "none" : checks.c_str());
+    std::printf("effects: %zu applicable", plan.applicable.size());
+    for (const auto &[name, why] : plan.inapplicable)
+        std::printf("\n  not applicable: %s: %s", name.c_str(), why.c_str());
+    std::printf("\n");
+    // Scenarios are checked here, as a study checks its points before it runs one.
+    const auto first = sim.plan(set, plan.first);
+    auto all = plan.first;
+    all.insert(all.end(), plan.signatures.begin(), plan.signatures.end());
+    const auto both = sim.plan(set, all);
+    std::printf("runs before the gap test (base x %d seeds, checks x %d): %zu, %zu in the cache "
+                "(%zu failed there)\n",
+                options.seeds, options.check_seeds, first.runs, first.done, first.failed);
+    std::printf("runs of the signatures, once a gap shows (x %d seeds): %zu more, %zu in the cache "
+                "(%zu failed there)\n",
+                options.signature_seeds, both.runs - first.runs, both.done - first.done,
+                both.failed - first.failed);
+    std::printf("then up to %d candidates and 2 pairs confirmed at %d seeds each; every scenario "
+                "above is valid; nothing was run\n",
+                options.max_confirmed, options.seeds);
+    return 0;
+}
+
 } // namespace
 
 GapCommand::GapCommand(CLI::App &app) {
@@ -74,6 +124,9 @@ GapCommand::GapCommand(CLI::App &app) {
                           "experiment ids to hold out (comma separated; default: docs/gap.md's rule)")
         ->delimiter(',');
     diagnose_->add_option("--only", only_, "diagnose with these catalogue effects only")->delimiter(',');
+    diagnose_->add_flag("--dry-run", dry_run_,
+                        "read and check everything, print the design and the runs it needs "
+                        "(and the cache holds); run nothing");
 
     twin_ = command_->add_subcommand(
         "twin", "simulated measurements with one effect hidden; the key goes to a separate file");
@@ -176,6 +229,8 @@ int GapCommand::diagnose() const {
                             executorOptions(executor_));
     gap::DiagnosisOptions options = diagnosisOptions(base);
     options.held_out = held_out_;
+    if (dry_run_)
+        return printPlan(gap::planDiagnosis(set, effects, sim, options), set, sim, options);
     const gap::Diagnosis d = gap::diagnose(set, effects, sim, options);
     const auto files = gap::writeDiagnosis(d, set, out, shipped("tools/gap_report.py"));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

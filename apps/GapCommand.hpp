@@ -31,6 +31,7 @@ private:
     // diagnose
     std::string measurements_;
     std::vector<std::string> held_out_, only_;
+    bool dry_run_ = false;
     // twin
     std::string design_, effect_, key_;
     std::optional<double> strength_;

@@ -263,6 +263,79 @@ std::vector<std::string> defaultHeldOut(const ExperimentSet &set) {
     return held;
 }
 
+namespace {
+
+/// Step 1's runs: the base over its seeds, and each numerical check.
+std::vector<VariantRequest> firstRequests(const Simulator &simulator, const DiagnosisOptions &opt) {
+    std::vector<VariantRequest> first{{"base", nullptr, 0.0, nullptr, 0.0, "", opt.seeds}};
+    for (const std::string &c : simulator.checks())
+        first.push_back({"check " + c, nullptr, 0.0, nullptr, 0.0, c, opt.check_seeds});
+    return first;
+}
+
+/// `raw` resolved against the base's reference scenario into `resolved`; why it cannot act on
+/// this base ("" where it can: then `resolved` is set; else `resolved` is `raw`).
+std::string resolveEffect(const Effect &raw, const YAML::Node &reference, Effect &resolved) {
+    std::string why = inapplicable(raw, reference);
+    if (why.empty()) {
+        try {
+            resolved = resolveAgainst(raw, reference);
+            return "";
+        } catch (const std::exception &e) {
+            why = e.what();
+        }
+    }
+    resolved = raw;
+    return why;
+}
+
+/// Step 2's runs of one applicable effect (`e` resolved from `raw`): its signature strengths,
+/// or for a measuring-chain effect a grid over its prior (tabulated on the base's runs).
+std::vector<VariantRequest> signatureRequests(const Effect &raw, const Effect &e,
+                                              const DiagnosisOptions &opt) {
+    std::vector<double> strengths;
+    if (e.kind == Effect::Kind::Measurement)
+        for (int i = 0; i < opt.measurement_grid; ++i)
+            strengths.push_back(
+                e.prior.fromScale(e.prior.toScale(e.prior.lo) +
+                                  (e.prior.toScale(e.prior.hi) - e.prior.toScale(e.prior.lo)) * i /
+                                      (opt.measurement_grid - 1.0)));
+    else
+        strengths = e.signature;
+    std::vector<VariantRequest> out;
+    for (double s : strengths) {
+        if (std::abs(s - e.prior.off) <= 1e-12 * (1.0 + std::abs(s)))
+            continue; // the base itself
+        out.push_back({e.name + " " + fmt(s), &raw, s, nullptr, 0.0, "", opt.signature_seeds});
+    }
+    return out;
+}
+
+} // namespace
+
+DiagnosisPlan planDiagnosis(const ExperimentSet &set, const std::vector<const Effect *> &effects,
+                            const Simulator &simulator, const DiagnosisOptions &opt) {
+    DiagnosisPlan P;
+    P.design = designFeatures(set);
+    P.measured = measure(set, P.design);
+    P.held_out = opt.held_out.empty() ? defaultHeldOut(set) : opt.held_out;
+    for (const std::string &id : P.held_out)
+        set.find(id); // throws naming an unknown id
+    P.first = firstRequests(simulator, opt);
+    const YAML::Node reference = simulator.referenceScenario();
+    for (const Effect *raw : effects) {
+        Effect resolved;
+        if (const std::string why = resolveEffect(*raw, reference, resolved); !why.empty())
+            P.inapplicable.emplace_back(raw->name, why);
+        else {
+            P.applicable.push_back(raw->name);
+            for (VariantRequest &r : signatureRequests(*raw, resolved, opt))
+                P.signatures.push_back(std::move(r));
+        }
+    }
+    return P;
+}
+
 Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &effects,
                    Simulator &simulator, const DiagnosisOptions &opt) {
     const auto log = [&](const std::string &line) {
@@ -279,9 +352,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         std::to_string(n) + " features");
 
     // 1. Numerical uncertainty: the base over its seeds, and each numerical check.
-    std::vector<VariantRequest> first{{"base", nullptr, 0.0, nullptr, 0.0, "", opt.seeds}};
-    for (const std::string &c : simulator.checks())
-        first.push_back({"check " + c, nullptr, 0.0, nullptr, 0.0, c, opt.check_seeds});
+    const std::vector<VariantRequest> first = firstRequests(simulator, opt);
     const auto first_rows = simulator.simulate(set, design, first);
     for (const auto &r : first)
         D.simulations += r.seeds;
@@ -459,36 +530,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     for (const Effect *raw : effects) {
         Live L;
         L.result.name = raw->name;
-        L.result.applicability = inapplicable(*raw, reference);
-        if (L.result.applicability.empty()) {
-            try {
-                L.result.effect = resolveAgainst(*raw, reference);
-            } catch (const std::exception &e) {
-                L.result.applicability = e.what();
+        L.result.applicability = resolveEffect(*raw, reference, L.result.effect);
+        if (L.result.applicability.empty())
+            for (VariantRequest &r : signatureRequests(*raw, L.result.effect, opt)) {
+                sig_of.emplace_back(live.size(), r.strength);
+                sig.push_back(std::move(r));
             }
-        }
-        if (!L.result.applicability.empty()) {
-            L.result.effect = *raw;
-            live.push_back(std::move(L));
-            continue;
-        }
-        const Effect &e = L.result.effect;
-        const bool measurement = e.kind == Effect::Kind::Measurement;
-        std::vector<double> strengths;
-        if (measurement)
-            for (int i = 0; i < opt.measurement_grid; ++i)
-                strengths.push_back(e.prior.fromScale(
-                    e.prior.toScale(e.prior.lo) +
-                    (e.prior.toScale(e.prior.hi) - e.prior.toScale(e.prior.lo)) * i /
-                        (opt.measurement_grid - 1.0)));
-        else
-            strengths = e.signature;
-        for (double s : strengths) {
-            if (std::abs(s - e.prior.off) <= 1e-12 * (1.0 + std::abs(s)))
-                continue; // the base itself
-            sig.push_back({e.name + " " + fmt(s), raw, s, nullptr, 0.0, "", opt.signature_seeds});
-            sig_of.emplace_back(live.size(), s);
-        }
         live.push_back(std::move(L));
     }
     log("signatures: " + std::to_string(sig.size()) + " variants");

@@ -799,22 +799,15 @@ std::string StudySimulator::scenarioText(const ExperimentSet &design,
     return study::emitYaml(scenarioNode(design, group, request, seed));
 }
 
-std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
-                                                    const std::vector<VariantRequest> &requests,
-                                                    std::vector<int> &seeds_of) {
+study::Study StudySimulator::studyOf(const ExperimentSet &design,
+                                     const std::vector<VariantRequest> &requests,
+                                     std::vector<Slot> &slots) const {
     const auto gs = groups(design);
-    // Every (request, seed, group) is a point; equal scenarios are one point.
     study::Study st;
     st.name = "gap";
     st.directory = directory_;
     std::map<std::string, std::size_t> index; // point id -> position in st.points
-    struct Slot {
-        std::size_t request;
-        int seed;
-        std::size_t group;
-        std::size_t point;
-    };
-    std::vector<Slot> slots;
+    slots.clear();
     for (std::size_t r = 0; r < requests.size(); ++r)
         for (int s = 0; s < requests[r].seeds; ++s)
             for (std::size_t g = 0; g < gs.size(); ++g) {
@@ -836,6 +829,29 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
                     st.points.push_back(p);
                 slots.push_back({r, s, g, it->second});
             }
+    return st;
+}
+
+StudySimulator::RunCount StudySimulator::plan(const ExperimentSet &design,
+                                              const std::vector<VariantRequest> &requests) const {
+    std::vector<Slot> slots;
+    const study::Study st = studyOf(design, requests, slots);
+    study::validate(st);
+    RunCount count;
+    for (const study::PointResult &r : study::collect(st)) {
+        ++count.runs;
+        count.done += r.status == study::PointStatus::Done;
+        count.failed += r.status == study::PointStatus::Failed;
+    }
+    return count;
+}
+
+std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
+                                                    const std::vector<VariantRequest> &requests,
+                                                    std::vector<int> &seeds_of) {
+    const auto gs = groups(design);
+    std::vector<Slot> slots;
+    const study::Study st = studyOf(design, requests, slots);
     const auto results = study::run(st, executor_);
     for (const auto &res : results)
         (res.ran_now ? runs_done_ : runs_reused_)++;

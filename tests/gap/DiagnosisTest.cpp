@@ -229,6 +229,66 @@ TEST_CASE("diagnosis on an analytic soil names the hidden effect and its strengt
     }
 }
 
+namespace {
+
+/// The analytic simulator, with the labels of every call's requests recorded.
+class RecordingSimulator final : public Simulator {
+public:
+    AnalyticSimulator inner;
+    std::vector<std::vector<std::string>> calls;
+    std::vector<std::string> checks() const override { return inner.checks(); }
+    YAML::Node referenceScenario() const override { return inner.referenceScenario(); }
+    std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &set, const FeatureDesign &design,
+                                          const std::vector<VariantRequest> &requests) override {
+        calls.emplace_back();
+        for (const VariantRequest &r : requests)
+            calls.back().push_back(r.label + " x" + std::to_string(r.seeds));
+        return inner.simulate(set, design, requests);
+    }
+};
+
+std::vector<std::string> labels(const std::vector<VariantRequest> &requests) {
+    std::vector<std::string> out;
+    for (const VariantRequest &r : requests)
+        out.push_back(r.label + " x" + std::to_string(r.seeds));
+    return out;
+}
+
+} // namespace
+
+TEST_CASE("a dry run plans the runs the diagnosis then asks for, and names what cannot act",
+          "[gap][diagnosis]") {
+    const EffectCatalogue c = shippedEffects();
+    std::vector<const Effect *> effects = c.diagnosable();
+    // One that cannot act on this base: it needs a rolling model the base does not have.
+    Effect needs = c.find("rolling_resistance");
+    needs.name = "rolling_resistance_on_grain_shape";
+    needs.requires_text = {"soil.contact.rolling.model=grain_shape"};
+    effects.push_back(&needs);
+    const ExperimentSet set = measuredSet({"cohesion", 4.0e4}, 7);
+    RecordingSimulator sim;
+    const DiagnosisPlan plan = planDiagnosis(set, effects, sim, analyticOptions());
+    const Diagnosis d = diagnose(set, effects, sim, analyticOptions());
+    REQUIRE(d.verdict.gap); // else the signatures are never asked for
+    REQUIRE(sim.calls.size() >= 2);
+    CHECK(labels(plan.first) == sim.calls[0]);
+    CHECK(labels(plan.signatures) == sim.calls[1]);
+    CHECK(labels(plan.first) == std::vector<std::string>{"base x4", "check resolution x2"});
+    CHECK(plan.design.size() == d.design.size());
+    CHECK(plan.held_out == analyticOptions().held_out);
+    // Every diagnosable effect is either planned or named with why not, as in the diagnosis.
+    CHECK(plan.applicable.size() + plan.inapplicable.size() == effects.size());
+    REQUIRE(plan.inapplicable.size() >= 1);
+    CHECK(plan.inapplicable.back().first == "rolling_resistance_on_grain_shape");
+    for (const auto &[name, why] : plan.inapplicable) {
+        CHECK_FALSE(why.empty());
+        bool same = false;
+        for (const CandidateResult &r : d.candidates)
+            same = same || (r.name == name && r.applicability == why);
+        CHECK(same);
+    }
+}
+
 TEST_CASE("diagnosis: every candidate is fitted against the same base runs, the measuring "
           "chain's effects too",
           "[gap][diagnosis]") {

@@ -35,3 +35,27 @@ endif()
 if(err MATCHES "\\[gap\\] run [0-9a-f]+ ")
     message(FATAL_ERROR "a run failed:\n${err}")
 endif()
+# A dry run of the same diagnosis: the design and the split as the diagnosis made them, and
+# every run before the gap test found in the cache; it runs nothing and writes no report.
+file(GLOB points_before ${OUT}/sims/points/*)
+execute_process(COMMAND ${GRAINLINK} gap diagnose ${OUT}/twin --model ${BASE} --out ${OUT}/dry
+                        --sims ${OUT}/sims --only tool_friction --dry-run
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("${out}")
+if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "diagnose --dry-run failed (exit ${rc}):\n${err}")
+endif()
+if(NOT out MATCHES "mole_mars +mole +[1-9][0-9]* feature")
+    message(FATAL_ERROR "the dry run does not list the mole experiment's features")
+endif()
+if(NOT out MATCHES "runs before the gap test \\([^)]*\\): ([0-9]+), ([0-9]+) in the cache")
+    message(FATAL_ERROR "the dry run does not count the runs before the gap test")
+endif()
+if(NOT CMAKE_MATCH_1 EQUAL CMAKE_MATCH_2 OR CMAKE_MATCH_1 EQUAL 0)
+    message(FATAL_ERROR "the diagnosis ran ${CMAKE_MATCH_1} runs before its gap test; the dry "
+                        "run finds ${CMAKE_MATCH_2} of them in the cache")
+endif()
+file(GLOB points_after ${OUT}/sims/points/*)
+if(NOT points_before STREQUAL points_after OR EXISTS ${OUT}/dry/diagnosis.json)
+    message(FATAL_ERROR "the dry run ran or wrote something")
+endif()

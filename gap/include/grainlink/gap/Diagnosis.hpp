@@ -191,6 +191,21 @@ ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidat
 /// down).
 std::vector<std::string> defaultHeldOut(const ExperimentSet &set);
 
+/// What a diagnosis will simulate before its first result, worked out without simulating
+/// (`grainlink gap diagnose --dry-run`): its features, its split, the base's runs and numerical
+/// checks, and every applicable effect's signature runs (needed once a gap shows).
+struct DiagnosisPlan {
+    FeatureDesign design;
+    Measured measured;
+    std::vector<std::string> held_out;      ///< experiment ids
+    std::vector<VariantRequest> first;      ///< the base and its numerical checks
+    std::vector<VariantRequest> signatures; ///< every applicable effect's strengths
+    std::vector<std::string> applicable;    ///< effect names
+    std::vector<std::pair<std::string, std::string>> inapplicable; ///< effect, why not
+};
+DiagnosisPlan planDiagnosis(const ExperimentSet &set, const std::vector<const Effect *> &effects,
+                            const Simulator &simulator, const DiagnosisOptions &opt);
+
 /// Runs the whole pipeline on measured `set` with the catalogue's diagnosable `effects`.
 Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &effects,
                    Simulator &simulator, const DiagnosisOptions &options);

@@ -85,7 +85,24 @@ public:
     int runsDone() const { return runs_done_; }
     int runsReused() const { return runs_reused_; }
 
+    /// The runs `requests` would need (equal scenarios once), each validated as a study point
+    /// is before it runs, and how many the cache holds finished or failed. Runs nothing.
+    struct RunCount {
+        std::size_t runs = 0, done = 0, failed = 0;
+    };
+    RunCount plan(const ExperimentSet &design, const std::vector<VariantRequest> &requests) const;
+
 private:
+    /// Where one (request, seed, test group) runs: a point of the study.
+    struct Slot {
+        std::size_t request;
+        int seed;
+        std::size_t group;
+        std::size_t point;
+    };
+    /// The study of every (request, seed, group), equal scenarios one point; `slots` says which.
+    study::Study studyOf(const ExperimentSet &design, const std::vector<VariantRequest> &requests,
+                         std::vector<Slot> &slots) const;
     struct Overlay {
         std::string condition, value;
         YAML::Node soil;
