@@ -471,7 +471,18 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             rho[Eigen::Index(i)] = (meas.value[k] - V.simulated[k]) / V.simulated[k];
             sd[Eigen::Index(i)] = V.u_val[k] / std::abs(V.simulated[k]);
         }
-        const Discrepancy disc = Discrepancy::fit(cal_points, rho, sd);
+        // A bed that shifts an experiment's whole curve is one draw of noise, not a
+        // discrepancy seen at every bin: the same correlation the fits use (step 6).
+        Eigen::MatrixXd within(rho.size(), rho.size());
+        for (Eigen::Index i = 0; i < rho.size(); ++i)
+            for (Eigen::Index j = 0; j < rho.size(); ++j) {
+                const std::string &a =
+                    meas.keys[std::size_t(D.calibration[std::size_t(i)])].experiment;
+                const std::string &b =
+                    meas.keys[std::size_t(D.calibration[std::size_t(j)])].experiment;
+                within(i, j) = i == j ? 1.0 : a == b ? correlation.rho(a) : 0.0;
+            }
+        const Discrepancy disc = Discrepancy::fit(cal_points, rho, sd, within);
         std::vector<RegimePoint> held_points;
         for (Eigen::Index k : D.held_out)
             held_points.push_back(points[std::size_t(k)]);

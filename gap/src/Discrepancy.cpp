@@ -20,8 +20,12 @@ double kernel(const Discrepancy::Hyper &h, const Eigen::VectorXd &a, const Eigen
 } // namespace
 
 Discrepancy Discrepancy::fit(const std::vector<RegimePoint> &points, const Eigen::VectorXd &rho,
-                             const Eigen::VectorXd &noise_sd) {
-    if (Eigen::Index(points.size()) != rho.size() || rho.size() != noise_sd.size())
+                             const Eigen::VectorXd &noise_sd,
+                             const Eigen::MatrixXd &noise_correlation) {
+    const bool correlated = noise_correlation.size() > 0;
+    if (Eigen::Index(points.size()) != rho.size() || rho.size() != noise_sd.size() ||
+        (correlated &&
+         (noise_correlation.rows() != rho.size() || noise_correlation.cols() != rho.size())))
         throw std::invalid_argument("Discrepancy::fit: points, residuals and noise differ in size");
     std::map<std::string, std::vector<Eigen::Index>> by_kind;
     for (std::size_t i = 0; i < points.size(); ++i)
@@ -35,12 +39,18 @@ Discrepancy Discrepancy::fit(const std::vector<RegimePoint> &points, const Eigen
     Discrepancy d;
     for (const auto &[kind, idx] : by_kind) {
         const Eigen::Index n = Eigen::Index(idx.size());
-        Eigen::VectorXd y(n), noise2(n);
+        Eigen::VectorXd y(n);
+        Eigen::MatrixXd noise(n, n); // the noise's covariance
         std::vector<Eigen::VectorXd> x;
         for (Eigen::Index i = 0; i < n; ++i) {
-            y[i] = rho[idx[std::size_t(i)]];
-            noise2[i] = noise_sd[idx[std::size_t(i)]] * noise_sd[idx[std::size_t(i)]];
-            x.push_back(points[std::size_t(idx[std::size_t(i)])].x);
+            const Eigen::Index a = idx[std::size_t(i)];
+            y[i] = rho[a];
+            x.push_back(points[std::size_t(a)].x);
+            for (Eigen::Index j = 0; j < n; ++j) {
+                const Eigen::Index b = idx[std::size_t(j)];
+                const double c = i == j ? 1.0 : correlated ? noise_correlation(a, b) : 0.0;
+                noise(i, j) = c * noise_sd[a] * noise_sd[b];
+            }
         }
         KindFit best;
         best.hyper.log_marginal = -std::numeric_limits<double>::infinity();
@@ -52,8 +62,7 @@ Discrepancy Discrepancy::fit(const std::vector<RegimePoint> &points, const Eigen
                     Eigen::MatrixXd K(n, n);
                     for (Eigen::Index i = 0; i < n; ++i)
                         for (Eigen::Index j = 0; j < n; ++j)
-                            K(i, j) = kernel(h, x[std::size_t(i)], x[std::size_t(j)]) +
-                                      (i == j ? noise2[i] : 0.0);
+                            K(i, j) = kernel(h, x[std::size_t(i)], x[std::size_t(j)]) + noise(i, j);
                     Eigen::LLT<Eigen::MatrixXd> llt(K);
                     if (llt.info() != Eigen::Success)
                         continue;

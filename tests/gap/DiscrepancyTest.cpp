@@ -92,3 +92,33 @@ TEST_CASE("regime coordinates are scaled by the calibration's range, labels one 
     CHECK((pts[2].x.tail(2) - pts[0].x.tail(2)).norm() == Approx(1.0));
     CHECK(pts[3].x.size() == 0);
 }
+
+TEST_CASE("noise shared by a curve's bins counts as one draw: the closed form of equicorrelated "
+          "repeats",
+          "[gap][discrepancy]") {
+    // n residuals at one regime, all y, noise sd sigma with correlation c between any two:
+    // their mean is sufficient, with noise variance v = sigma^2 (c + (1 - c) / n) (not
+    // sigma^2 / n), so at that regime mean = s^2 y / (s^2 + v), variance = s^2 - s^4 / (s^2 + v).
+    const int n = 10;
+    const double y = 0.3, sigma = 0.1;
+    std::vector<RegimePoint> pts(n, at("plate", 0.2));
+    const Eigen::VectorXd rho = Eigen::VectorXd::Constant(n, y);
+    const Eigen::VectorXd sd = Eigen::VectorXd::Constant(n, sigma);
+    for (double c : {0.0, 0.5, 0.8}) {
+        Eigen::MatrixXd corr = Eigen::MatrixXd::Constant(n, n, c);
+        corr.diagonal().setOnes();
+        const auto d = Discrepancy::fit(pts, rho, sd, corr);
+        const double s2 = std::pow(d.hyperparameters().at("plate").sd, 2);
+        const double v = sigma * sigma * (c + (1.0 - c) / n);
+        const auto p = d.predict({at("plate", 0.2)});
+        INFO("c = " << c << ", s = " << std::sqrt(s2));
+        REQUIRE(s2 > 0.0);
+        CHECK(p.mean[0] == Approx(s2 * y / (s2 + v)).epsilon(1e-9));
+        CHECK(p.variance[0] == Approx(s2 - s2 * s2 / (s2 + v)).epsilon(1e-6));
+    }
+    // The correlation is the noise's own: an empty matrix is independent noise.
+    const auto independent = Discrepancy::fit(pts, rho, sd).predict({at("plate", 0.2)});
+    Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(n, n);
+    const auto same = Discrepancy::fit(pts, rho, sd, identity).predict({at("plate", 0.2)});
+    CHECK(independent.mean[0] == Approx(same.mean[0]).epsilon(1e-12));
+}

@@ -38,8 +38,12 @@ public:
     };
 
     /// Fits one process per kind to the relative residuals `rho` with noise sd `noise_sd`.
+    /// `noise_correlation` (points x points; empty: independent) is the noise's correlation:
+    /// a bed or a measuring chain that shifts a whole curve is one draw of noise for all of
+    /// its features, not a discrepancy seen many times over.
     static Discrepancy fit(const std::vector<RegimePoint> &points, const Eigen::VectorXd &rho,
-                           const Eigen::VectorXd &noise_sd);
+                           const Eigen::VectorXd &noise_sd,
+                           const Eigen::MatrixXd &noise_correlation = Eigen::MatrixXd());
 
     /// The posterior mean and variance of the discrepancy at `points`. A kind the calibration
     /// never saw gets none (mean 0, variance 0): there the null model is the base model.
