@@ -231,6 +231,14 @@ TEST_CASE("diagnosis on an analytic soil names the hidden effect and its strengt
 
 namespace {
 
+/// Each request as "label xSEEDS".
+std::vector<std::string> labels(const std::vector<VariantRequest> &requests) {
+    std::vector<std::string> out;
+    for (const VariantRequest &r : requests)
+        out.push_back(r.label + " x" + std::to_string(r.seeds));
+    return out;
+}
+
 /// The analytic simulator, with the labels of every call's requests recorded.
 class RecordingSimulator final : public Simulator {
 public:
@@ -240,19 +248,10 @@ public:
     YAML::Node referenceScenario() const override { return inner.referenceScenario(); }
     std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &set, const FeatureDesign &design,
                                           const std::vector<VariantRequest> &requests) override {
-        calls.emplace_back();
-        for (const VariantRequest &r : requests)
-            calls.back().push_back(r.label + " x" + std::to_string(r.seeds));
+        calls.push_back(labels(requests));
         return inner.simulate(set, design, requests);
     }
 };
-
-std::vector<std::string> labels(const std::vector<VariantRequest> &requests) {
-    std::vector<std::string> out;
-    for (const VariantRequest &r : requests)
-        out.push_back(r.label + " x" + std::to_string(r.seeds));
-    return out;
-}
 
 } // namespace
 
