@@ -265,6 +265,13 @@ std::vector<std::string> defaultHeldOut(const ExperimentSet &set) {
 
 namespace {
 
+/// The held-out experiments: the user's, each checked to exist, or the default split.
+std::vector<std::string> heldOutIds(const ExperimentSet &set, const DiagnosisOptions &opt) {
+    for (const std::string &id : opt.held_out)
+        set.find(id); // throws naming an unknown id
+    return opt.held_out.empty() ? defaultHeldOut(set) : opt.held_out;
+}
+
 /// Step 1's runs: the base over its seeds, and each numerical check.
 std::vector<VariantRequest> firstRequests(const Simulator &simulator, const DiagnosisOptions &opt) {
     std::vector<VariantRequest> first{{"base", nullptr, 0.0, nullptr, 0.0, "", opt.seeds}};
@@ -318,9 +325,7 @@ DiagnosisPlan planDiagnosis(const ExperimentSet &set, const std::vector<const Ef
     DiagnosisPlan P;
     P.design = designFeatures(set);
     P.measured = measure(set, P.design);
-    P.held_out = opt.held_out.empty() ? defaultHeldOut(set) : opt.held_out;
-    for (const std::string &id : P.held_out)
-        set.find(id); // throws naming an unknown id
+    P.held_out = heldOutIds(set, opt);
     P.first = firstRequests(simulator, opt);
     const YAML::Node reference = simulator.referenceScenario();
     for (const Effect *raw : effects) {
@@ -409,10 +414,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     const Eigen::VectorXd u2_val = V.u_val.array().square();
 
     // Calibration and held-out features.
-    const std::vector<std::string> held_ids = opt.held_out.empty() ? defaultHeldOut(set) : opt.held_out;
+    const std::vector<std::string> held_ids = heldOutIds(set, opt);
     const std::set<std::string> held_set(held_ids.begin(), held_ids.end());
-    for (const std::string &id : held_ids)
-        set.find(id); // throws naming an unknown id
     for (const Experiment &e : set.experiments)
         (held_set.count(e.id) ? D.held_out_experiments : D.calibration_experiments).push_back(e.id);
     for (Eigen::Index k = 0; k < n; ++k) {

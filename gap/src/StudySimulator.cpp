@@ -800,9 +800,9 @@ std::string StudySimulator::scenarioText(const ExperimentSet &design,
 }
 
 study::Study StudySimulator::studyOf(const ExperimentSet &design,
+                                     const std::vector<std::vector<std::string>> &gs,
                                      const std::vector<VariantRequest> &requests,
                                      std::vector<Slot> &slots) const {
-    const auto gs = groups(design);
     study::Study st;
     st.name = "gap";
     st.directory = directory_;
@@ -835,7 +835,7 @@ study::Study StudySimulator::studyOf(const ExperimentSet &design,
 StudySimulator::RunCount StudySimulator::plan(const ExperimentSet &design,
                                               const std::vector<VariantRequest> &requests) const {
     std::vector<Slot> slots;
-    const study::Study st = studyOf(design, requests, slots);
+    const study::Study st = studyOf(design, groups(design), requests, slots);
     study::validate(st);
     RunCount count;
     for (const study::PointResult &r : study::collect(st)) {
@@ -851,7 +851,7 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
                                                     std::vector<int> &seeds_of) {
     const auto gs = groups(design);
     std::vector<Slot> slots;
-    const study::Study st = studyOf(design, requests, slots);
+    const study::Study st = studyOf(design, gs, requests, slots);
     const auto results = study::run(st, executor_);
     for (const auto &res : results)
         (res.ran_now ? runs_done_ : runs_reused_)++;

@@ -100,8 +100,11 @@ private:
         std::size_t group;
         std::size_t point;
     };
-    /// The study of every (request, seed, group), equal scenarios one point; `slots` says which.
-    study::Study studyOf(const ExperimentSet &design, const std::vector<VariantRequest> &requests,
+    /// The study of every (request, seed, test group of `groups`), equal scenarios one point;
+    /// `slots` says which.
+    study::Study studyOf(const ExperimentSet &design,
+                         const std::vector<std::vector<std::string>> &groups,
+                         const std::vector<VariantRequest> &requests,
                          std::vector<Slot> &slots) const;
     struct Overlay {
         std::string condition, value;
