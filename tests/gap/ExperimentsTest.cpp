@@ -95,6 +95,40 @@ TEST_CASE("experiments.yaml: repeats in SI, and their mean and scatter per bin",
     CHECK((sim - m.value).cwiseAbs().maxCoeff() < 1e-6);
 }
 
+// The factors against NIST SP 811's table (B.9, to 7 digits) and by hand: a table entry
+// mistyped, or a unit taken for one of another kind, fails here.
+TEST_CASE("units as other tools and the older literature write them convert to SI",
+          "[gap][experiments]") {
+    CHECK(unitFactor("psi", "pressure") == Approx(6.894757e3).epsilon(1e-6));
+    CHECK(unitFactor("lbf", "force") == Approx(4.448222).epsilon(1e-6));
+    CHECK(unitFactor("kgf/cm2", "pressure") == Approx(9.806650e4).epsilon(1e-6));
+    CHECK(unitFactor("lbf_in", "torque") == Approx(1.129848e-1).epsilon(1e-6));
+    CHECK(unitFactor("ft", "length") == Approx(0.3048).epsilon(1e-12));
+    CHECK(unitFactor("lb", "mass") == Approx(0.4535924).epsilon(1e-6));
+    CHECK(unitFactor("kN/m^2", "pressure") == 1e3);
+    CHECK(unitFactor("N/m2", "pressure") == 1.0);
+    CHECK(unitFactor("mm/min", "speed") == Approx(1.0 / 60000.0));
+    CHECK(unitFactor("g/cm3", "density") == 1e3);
+    CHECK(unitFactor("\u00b5m", "length") == 1e-6); // the micro sign, as a spreadsheet writes it
+    CHECK(unitFactor("\u03bcm", "length") == 1e-6); // the Greek mu
+    CHECK(unitFactor("g0", "acceleration") == 9.80665);
+    CHECK_THROWS_WITH(unitFactor("psi", "length"),
+                      Catch::Contains("unit 'psi' is a pressure, not a length"));
+    CHECK_THROWS_WITH(unitFactor("kN/mm2", "pressure"), Catch::Contains("unknown unit 'kN/mm2'"));
+
+    // Read from a file: a plate curve in inches and psi is the same curve in SI.
+    const fs::path dir = folder("customary");
+    write(dir / "p.csv", "z_in,p_psi\n0,0\n0.1,2\n0.2,5\n");
+    write(dir / "experiments.yaml", "experiments:\n  - id: p\n    type: plate_sinkage\n"
+                                    "    conditions: {plate_diameter_m: 0.0508}\n"
+                                    "    data: {files: [p.csv], x: {column: z_in, unit: in}, "
+                                    "y: {pressure_Pa: {column: p_psi, unit: psi}}}\n");
+    const Curve &c =
+        loadExperiments(dir.string()).experiments.at(0).trials.at(0).curves.at("pressure_Pa");
+    CHECK(c.x.back() == Approx(0.00508));
+    CHECK(c.y.back() == Approx(5 * 6894.757).epsilon(1e-6));
+}
+
 TEST_CASE("experiments.yaml: a force-threshold zero moves x to the shallowest sample reaching "
           "it, an unloading branch is left out",
           "[gap][experiments]") {
