@@ -11,6 +11,7 @@
 #include <set>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 namespace grainlink::gap {
 
@@ -123,6 +124,12 @@ const std::vector<Unit> &units() {
     };
     return u;
 }
+
+/// Conditions under another size's name: (that name, grainlink's, the factor to it).
+constexpr std::tuple<const char *, const char *, double> kOtherSizeNames[] = {
+    {"plate_radius_m", "plate_diameter_m", 2.0},
+    {"wheel_diameter_m", "wheel_radius_m", 0.5},
+};
 
 /// Suffix -> dimension of grainlink's SI names (`plate_diameter_m`, `normal_stress_Pa`).
 const std::vector<std::pair<std::string, std::string>> &suffixes() {
@@ -438,6 +445,24 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     e.labels[key] = c.text();
                 else
                     e.numbers[key] = c.number();
+            }
+            // A radius where grainlink takes a diameter, or the other way round: read as the
+            // condition it is, so the test is not set up from the base's size in its place.
+            for (const auto &[other, name, factor] : kOtherSizeNames) {
+                const auto given = e.numbers.find(other);
+                if (given == e.numbers.end())
+                    continue;
+                const double value = factor * given->second;
+                const auto named = e.numbers.find(name);
+                if (named != e.numbers.end() &&
+                    std::abs(named->second - value) > 1e-9 * std::abs(value)) {
+                    std::ostringstream m;
+                    m << other << " " << given->second << " and " << name << " " << named->second
+                      << " disagree: give one of them";
+                    (*cond)[other].fail(m.str());
+                }
+                e.numbers[name] = value;
+                e.numbers.erase(given);
             }
             cond->finish();
         }

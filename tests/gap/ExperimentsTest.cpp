@@ -484,6 +484,36 @@ TEST_CASE("experiments.yaml: bad input names the file, the key and the line",
     write(dir / "a2.csv", "sinkage_mm,pressure_kPa\n3.0,12.0\n");
     fails(plateYaml(), "a2.csv: 'pressure_Pa' has 1 sample(s)");
     fails(plateYaml(), "experiments.yaml:7: key 'experiments[0].data.files[1]'");
+    linearTrial(dir / "a2.csv", 1.0);
+    // A plate's radius beside a diameter that is not twice it.
+    std::string both = plateYaml();
+    both.replace(both.find("box: large"), 10, "box: large, plate_radius_m: 0.02");
+    fails(both, "plate_radius_m 0.02 and plate_diameter_m 0.06 disagree");
+    fails(both, "experiments.yaml:5: key 'experiments[0].conditions.plate_radius_m'");
+}
+
+// A size under the other name (a plate's radius, a wheel's diameter) sets up the test as the
+// condition it is: read as it was, it would be "not simulated" and the base's size would stand.
+TEST_CASE(
+    "experiments.yaml: a plate's radius and a wheel's diameter are read as the sizes they are",
+    "[gap][experiments]") {
+    const fs::path dir = folder("sizes");
+    linearTrial(dir / "a1.csv", 1.0);
+    linearTrial(dir / "a2.csv", 1.0);
+    linearTrial(dir / "a3.csv", 1.0);
+    std::string radius = plateYaml();
+    radius.replace(radius.find("plate_diameter_m: 0.06"), 22, "plate_radius_m: 0.03");
+    write(dir / "experiments.yaml",
+          radius + "  - id: w\n    type: wheel_steady_state\n"
+                   "    conditions: {wheel_diameter_m: 0.116, load_N: 23}\n"
+                   "    data: {files: [w.csv], scatter: true, x: {column: slip, unit: '-'}, "
+                   "y: {traction_N: {column: F, unit: N}}}\n");
+    write(dir / "w.csv", "slip,F\n0.1,1\n0.3,3\n");
+    const ExperimentSet set = loadExperiments(dir.string());
+    CHECK(set.experiments[0].numbers.at("plate_diameter_m") == Approx(0.06));
+    CHECK(set.experiments[0].numbers.count("plate_radius_m") == 0);
+    CHECK(set.experiments[1].numbers.at("wheel_radius_m") == Approx(0.058));
+    CHECK(set.experiments[1].numbers.count("wheel_diameter_m") == 0);
 }
 
 // Another code's output: the plate's force in N with z up (force and sinkage negative). Read
