@@ -422,7 +422,7 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     ExperimentSet out = set;
     out.experiments.clear();
     // A condition the simulation does not read is said, once with its experiments:
-    // `wheel_diameter_m` for `wheel_radius_m` would otherwise leave the base's wheel in silence.
+    // `wheel_load_N` for `load_N` would otherwise leave the base's load in silence.
     std::map<std::string, std::vector<std::string>> unused;
     std::map<std::pair<std::string, std::string>, std::vector<std::string>> undescribed;
     for (const Experiment &e : set.experiments)

@@ -182,17 +182,17 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     REQUIRE(left_out.size() == 1);
     CHECK(left_out[0].find("smooth_beta120 (wheel_steady_state: slip angle 120") == 0);
     CHECK(kept.notes.empty()); // every condition of these wheels sets up their test
-    // A condition the simulation does not read is said, with the ones it does: a diameter
-    // given for the radius left the base's wheel in its place without a word.
+    // A condition the simulation does not read is said, with the ones it does: a load under
+    // another name left the base's load in its place without a word.
     ExperimentSet renamed = set;
     renamed.experiments = {set.experiments.front()};
-    renamed.experiments[0].numbers.erase("wheel_radius_m");
-    renamed.experiments[0].numbers["wheel_diameter_m"] = 0.116;
+    renamed.experiments[0].numbers.erase("load_N");
+    renamed.experiments[0].numbers["wheel_load_N"] = 23.6;
     const ExperimentSet said = simulable(renamed, base, left_out);
     REQUIRE(said.notes.size() == 1);
-    CHECK_THAT(said.notes[0], Catch::Contains("condition 'wheel_diameter_m' is not simulated") &&
+    CHECK_THAT(said.notes[0], Catch::Contains("condition 'wheel_load_N' is not simulated") &&
                                   Catch::Contains("in smooth_beta0 (1 experiment") &&
-                                  Catch::Contains("radius"));
+                                  Catch::Contains("the wheel's radius"));
 
     const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-wheel-test";
     fs::remove_all(scratch);
