@@ -341,8 +341,12 @@ EffectCatalogue loadEffects(const std::string &path) {
                 }
                 if (en.has("remove"))
                     ed.op = EffectEdit::Op::Remove, ++ops, (void)en["remove"].boolean();
+                if (en.has("keep_inherited_from"))
+                    ed.op = EffectEdit::Op::Keep, ed.source = en["keep_inherited_from"].text(),
+                    ++ops;
                 if (ops != 1)
-                    en.fail("give exactly one of set, scale, text, node, remove");
+                    en.fail(
+                        "give exactly one of set, scale, text, node, remove, keep_inherited_from");
                 if (en.has("when"))
                     ed.when = en["when"].text();
                 if (en.has("if")) {
@@ -460,6 +464,15 @@ YAML::Node applyEffect(const Effect &effect, double s, const YAML::Node &scenari
             removeKey(out, ed.key);
             continue;
         }
+        if (ed.op == EffectEdit::Op::Keep) {
+            // A contact type that takes the grains' value keeps it when a later edit changes
+            // the grains' (an effect on grain-grain contacts only); its own value stands.
+            const std::vector<YAML::Node> from = findNodes(out, ed.source, false);
+            if (findNodes(out, ed.key, false).empty() && from.size() == 1)
+                for (YAML::Node n : findNodes(out, ed.key, true))
+                    n = YAML::Clone(from[0]); // a copy: the grains' value changes next
+            continue;
+        }
         std::vector<YAML::Node> nodes = findNodes(out, ed.key, false);
         const bool absent = nodes.empty();
         if (absent) {
@@ -493,6 +506,7 @@ YAML::Node applyEffect(const Effect &effect, double s, const YAML::Node &scenari
                 n = instantiate(ed.node, s, base);
                 break;
             case EffectEdit::Op::Remove:
+            case EffectEdit::Op::Keep:
                 break;
             }
         }

@@ -131,6 +131,39 @@ TEST_CASE("a soft surface layer is a crust of softer grains in the prepared beds
     CHECK_FALSE(poured["soil"]["deposition"]["crust"]);
 }
 
+// The full self-test's second effect outside the catalogue. The angles by hand:
+// atan(0.6 tan 32 deg) = atan(0.374922) = 20.553 deg, atan(0.6 tan 30 deg) = atan(0.346410) =
+// 19.107 deg.
+TEST_CASE("sliding friction scales the tangents of the stick and slip angles, outside the "
+          "catalogue",
+          "[gap][effects]") {
+    const YAML::Node base = YAML::Load(kScenario);
+    const EffectCatalogue c = shippedEffects();
+    const Effect &friction = c.find("sliding_friction");
+    CHECK_FALSE(friction.in_catalogue);
+    const YAML::Node low = applyEffect(friction, 0.6, base, ExperimentType::DirectShear);
+    const YAML::Node t = low["soil"]["contact"]["tangential"];
+    CHECK(t["stick_angle_deg"].as<double>() == Approx(20.553).margin(1e-3));
+    CHECK(t["slip_angle_deg"].as<double>() == Approx(19.107).margin(1e-3));
+    CHECK(t["stiffness_N_m"].as<double>() == 200.0);
+    // Between grains only: walls and tools keep the angles they took from the grains.
+    for (const char *type : {"contact_wall", "contact_tool"}) {
+        INFO(type);
+        CHECK(low["soil"][type]["tangential"]["stick_angle_deg"].as<double>() == 32.0);
+        CHECK(low["soil"][type]["tangential"]["slip_angle_deg"].as<double>() == 30.0);
+    }
+    CHECK(base["soil"]["contact"]["tangential"]["stick_angle_deg"].as<double>() == 32.0);
+    // A wall of its own keeps its own.
+    YAML::Node own = YAML::Clone(base);
+    own["soil"]["contact_wall"]["tangential"]["stick_angle_deg"] = 20.0;
+    const YAML::Node kept = applyEffect(friction, 0.6, own, ExperimentType::DirectShear);
+    CHECK(kept["soil"]["contact_wall"]["tangential"]["stick_angle_deg"].as<double>() == 20.0);
+    CHECK_FALSE(kept["soil"]["contact_wall"]["tangential"]["slip_angle_deg"]);
+    CHECK(kept["soil"]["contact_tool"]["tangential"]["stick_angle_deg"].as<double>() == 32.0);
+    const YAML::Node off = applyEffect(friction, 1.0, base, ExperimentType::DirectShear);
+    CHECK(off["soil"]["contact"]["tangential"]["stick_angle_deg"].as<double>() == Approx(32.0));
+}
+
 TEST_CASE("polydispersity keeps the mean radius and the solid volume, domain size the depth",
           "[gap][effects]") {
     const YAML::Node base = YAML::Load(kScenario);

@@ -24,17 +24,19 @@ namespace grainlink::gap {
 /// present value, or `fallback` when absent).
 struct EffectEdit {
     enum class Op {
-        Set,     ///< key = value (a number)
-        Scale,   ///< every number under key *= value
-        Text,    ///< key = the text `text` (a model name)
-        Node,    ///< key = the YAML `node`, whose string leaves starting with '=' are expressions
-        Remove,  ///< drop the key
+        Set,    ///< key = value (a number)
+        Scale,  ///< every number under key *= value
+        Text,   ///< key = the text `text` (a model name)
+        Node,   ///< key = the YAML `node`, whose string leaves starting with '=' are expressions
+        Remove, ///< drop the key
+        Keep,   ///< where key is absent, key = the value at `source` (what it inherits now)
     };
     std::string key;
     Op op = Op::Set;
     std::string value;                 ///< expression (Set, Scale)
     std::string text;                  ///< Text
     YAML::Node node;                   ///< Node
+    std::string source;                ///< Keep: the key whose value `key` inherits
     std::optional<std::string> when;   ///< expression; the edit applies where it is non-zero
     std::optional<std::string> only_if; ///< `if: key=value|value`: the scenario must hold it
     std::optional<double> fallback;    ///< `base` where the key is absent (else absent = error)
