@@ -43,7 +43,9 @@ TEST_CASE("Networked two-mass runs equal the in-process scheme bit for bit",
     // The transport must not change a single bit: same scheme, same participants' arithmetic.
     for (auto kind :
          {SchemeKind::ExplicitSerial, SchemeKind::ExplicitParallel, SchemeKind::Implicit}) {
-        const std::string ipc = "ipc:///tmp/grainlink-test-" + std::to_string(::getpid());
+        // In the test program's own temporary folder (catch_main.cpp), removed with it.
+        const std::string ipc =
+            "ipc://" + (std::filesystem::temp_directory_path() / "two-mass.ipc").string();
         for (const std::string &endpoint : {std::string("inproc://two-mass-") + schemeName(kind),
                                             std::string("tcp://127.0.0.1:*"), ipc}) {
             auto config = twoMassRun(kind, endpoint, 0.01, 0.5);
