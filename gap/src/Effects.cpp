@@ -327,6 +327,7 @@ EffectCatalogue loadEffects(const std::string &path) {
                 const YAML::Node raw_edit = raw_effect["edits"][k++];
                 EffectEdit ed;
                 ed.key = en["key"].text();
+                ed.where = en.file() + ":" + std::to_string(en.line());
                 int ops = 0;
                 if (en.has("set"))
                     ed.op = EffectEdit::Op::Set, ed.value = en["set"].text(), ++ops;
@@ -468,7 +469,14 @@ YAML::Node applyEffect(const Effect &effect, double s, const YAML::Node &scenari
             // A contact type that takes the grains' value keeps it when a later edit changes
             // the grains' (an effect on grain-grain contacts only); its own value stands.
             const std::vector<YAML::Node> from = findNodes(out, ed.source, false);
-            if (findNodes(out, ed.key, false).empty() && from.size() == 1)
+            // Without its source the key would inherit the changed value, silently.
+            if (from.size() != 1)
+                throw std::invalid_argument(
+                    ed.where + ": effect '" + effect.name + "', keep_inherited_from '" + ed.source +
+                    "': the scenario " +
+                    (from.empty() ? "has no such key" : "has it more than once") + ", so '" +
+                    ed.key + "' cannot keep what it inherits");
+            if (findNodes(out, ed.key, false).empty())
                 for (YAML::Node n : findNodes(out, ed.key, true))
                     n = YAML::Clone(from[0]); // a copy: the grains' value changes next
             continue;

@@ -162,6 +162,15 @@ TEST_CASE("sliding friction scales the tangents of the stick and slip angles, ou
     CHECK(kept["soil"]["contact_tool"]["tangential"]["stick_angle_deg"].as<double>() == 32.0);
     const YAML::Node off = applyEffect(friction, 1.0, base, ExperimentType::DirectShear);
     CHECK(off["soil"]["contact"]["tangential"]["stick_angle_deg"].as<double>() == Approx(32.0));
+
+    // A source the scenario lacks (a typo in a user's catalogue) would let the walls inherit
+    // the grains' new friction unnoticed: it stops, naming the edit's line, the effect, the keys.
+    Effect typo = friction;
+    typo.edits[0].source = "soil.contact.tangentail";
+    CHECK_THROWS_WITH(applyEffect(typo, 0.6, base, ExperimentType::DirectShear),
+                      Catch::Contains("effects.yaml:") && Catch::Contains("'sliding_friction'") &&
+                          Catch::Contains("'soil.contact.tangentail': the scenario has no such "
+                                          "key, so 'soil.contact_wall.tangential'"));
 }
 
 TEST_CASE("polydispersity keeps the mean radius and the solid volume, domain size the depth",

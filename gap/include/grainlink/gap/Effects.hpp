@@ -41,6 +41,7 @@ struct EffectEdit {
     std::optional<std::string> only_if; ///< `if: key=value|value`: the scenario must hold it
     std::optional<double> fallback;    ///< `base` where the key is absent (else absent = error)
     std::vector<std::string> types;    ///< experiment types it applies to (empty: all)
+    std::string where;                 ///< "file:line" of the edit, for errors found on a base
 };
 
 struct Effect {
