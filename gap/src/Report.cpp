@@ -154,7 +154,8 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     for (const Diagnosis::Rival &r : d.rivals)
         j["rivals"].push_back({{"effect", r.name},
                                {"p_value_claimed_over_it", r.p_value},
-                               {"at_prior_edge", r.at_prior_edge}});
+                               {"at_prior_edge", r.at_prior_edge},
+                               {"beats_null", r.beats_null}});
     j["indistinguishable_from_leader"] = d.indistinguishable;
     j["separating_experiment"] = d.separating_experiment;
     j["separating_chi2"] = number(d.separating_chi2);

@@ -125,13 +125,15 @@ struct Diagnosis {
     /// Signature overlap on the whole design: overlap[i][j] = how much of candidate i's
     /// signature candidate j reproduces (candidates in `candidates` order; applicable ones).
     std::vector<std::vector<double>> overlap;
-    /// A claim's rivals: other confirmed candidates that beat the null and leave no held-out
-    /// gap (at their prior's edge too), each with the p of the claimed model predicting the
-    /// held-out experiments better than it (the test against the null, the rival as null).
+    /// A claim's rivals: other confirmed candidates that leave no held-out gap (at their
+    /// prior's edge too, and whether or not they beat the null), each with the p of the claimed
+    /// model predicting the held-out experiments better than it (the test against the null,
+    /// the rival as null).
     struct Rival {
         std::string name;
         double p_value = 1.0;
         bool at_prior_edge = false;
+        bool beats_null = true;
     };
     std::vector<Rival> rivals;
     std::vector<std::string> indistinguishable; ///< candidates the design cannot tell from the leader
