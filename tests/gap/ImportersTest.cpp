@@ -155,8 +155,9 @@ TEST_CASE("import csv reads a file as the diagnosis does, and a failed import le
     wrong_unit.id = "wrong_unit";
     wrong_unit.y = {{"pressure_Pa", {"Pressure; kPa", "mm"}}};
     CHECK_THROWS_WITH(importCsv(wrong_unit, out.string()), Catch::Contains("not a pressure"));
-    CHECK_THROWS_WITH(importCsv(CsvImport{csv.file, "../up", "plate_sinkage"}, out.string()),
-                      Catch::Contains("one word"));
+    CsvImport bad_id = csv;
+    bad_id.id = "../up";
+    CHECK_THROWS_WITH(importCsv(bad_id, out.string()), Catch::Contains("one word"));
     std::ifstream after_in(out / "experiments.yaml");
     CHECK(std::string((std::istreambuf_iterator<char>(after_in)),
                       std::istreambuf_iterator<char>()) == before);
