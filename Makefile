@@ -35,7 +35,7 @@ bench: build
 	@bench/run-all $(BUILD)
 
 # The full blind self-test of the sim-to-real diagnosis (docs/gap.md, "The self-test"): about
-# 17 min on two cores from an empty cache; prints the score line and the confusion matrix.
+# 17-27 min on two cores from an empty cache; prints the score line and the confusion matrix.
 gap-selftest: build
 	OMP_WAIT_POLICY=PASSIVE $(BUILD)/apps/grainlink gap selftest --scale full --jobs 2
 
