@@ -77,6 +77,8 @@ StudyCommand::StudyCommand(CLI::App &app) {
                          "threads per run (sets each point's simulation.threads)");
     command_->add_flag("--submit-only", submit_only_,
                        "slurm: submit and return; `grainlink study collect DIR` later");
+    command_->add_flag("--dry-run", dry_run_,
+                       "check every point's scenario and count what would run; run nothing");
     collect_ = command_->add_subcommand(
         "collect", "tables of a study folder as it stands (after --submit-only)");
     collect_->add_option("directory", directory_, "the study folder")->required();
@@ -108,6 +110,8 @@ int StudyCommand::runStudy() const {
     if (threads_ > 0)
         design.threads = threads_;
     const study::Study s = study::loadStudy(study_path_, directory_, design);
+    if (dry_run_)
+        return dryRun(s);
 
     study::ExecutorOptions options = executor_.options();
     options.slurm.submit_only = submit_only_;
@@ -141,6 +145,21 @@ int StudyCommand::runStudy() const {
         std::printf("submitted: follow with squeue, then grainlink study collect %s\n",
                     s.directory.c_str());
     return submit_only_ ? 0 : code;
+}
+
+int StudyCommand::dryRun(const study::Study &s) const {
+    // What `run` checks before it starts, and what it would then run; nothing is written.
+    study::validate(s);
+    std::size_t done = 0, failed = 0;
+    for (const PointResult &r : study::collect(s)) {
+        done += r.status == PointStatus::Done;
+        failed += r.status == PointStatus::Failed;
+    }
+    const std::size_t to_run = s.points.size() - done - (executor_.retry_failed ? 0 : failed);
+    std::printf("study '%s': %zu points, every scenario valid; %zu done, %zu failed, %zu to run "
+                "into %s\n",
+                s.name.c_str(), s.points.size(), done, failed, to_run, s.directory.c_str());
+    return 0;
 }
 
 int StudyCommand::collect() const {

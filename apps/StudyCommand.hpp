@@ -7,6 +7,10 @@
 #include <string>
 #include <vector>
 
+namespace grainlink::study {
+struct Study;
+}
+
 namespace grainlink::apps {
 
 class StudyCommand {
@@ -19,6 +23,7 @@ public:
 
 private:
     int runStudy() const;
+    int dryRun(const study::Study &s) const;
     int collect() const;
     int runPoint() const;
 
@@ -27,6 +32,7 @@ private:
     ExecutorFlags executor_;
     int threads_ = 0; ///< 0: each scenario's own simulation.threads
     bool submit_only_ = false;
+    bool dry_run_ = false;
 };
 
 } // namespace grainlink::apps
