@@ -785,7 +785,7 @@ TEST_CASE("diagnosis: a claim names a rival that leaves no gap without beating t
     c.effects.push_back(loose);
     AnalyticSimulator sim;
     sim.alias["cohesion_loose"] = "cohesion";
-    // 0.125: at 0.12 and 0.13 (tried) its p against the null (0.05) misses the level (0.025) while
+    // 0.125: there (and at 0.12 and 0.13) its p against the null, 0.052, misses the level 0.025 while
     // its mean of four beds stays close enough to leave no gap; at 0.11 it beats the null, at
     // 0.15 its mean drifts into a gap.
     sim.confirm_scatter_of["cohesion_loose"] = 0.125;
