@@ -150,12 +150,12 @@ int StudyCommand::runStudy() const {
 int StudyCommand::dryRun(const study::Study &s) const {
     // What `run` checks before it starts, and what it would then run; nothing is written.
     study::validate(s);
-    std::size_t done = 0, failed = 0;
+    std::size_t done = 0, failed = 0, to_run = 0;
     for (const PointResult &r : study::collect(s)) {
         done += r.status == PointStatus::Done;
         failed += r.status == PointStatus::Failed;
+        to_run += study::runsAgain(r, executor_.retry_failed);
     }
-    const std::size_t to_run = s.points.size() - done - (executor_.retry_failed ? 0 : failed);
     std::printf("study '%s': %zu points, every scenario valid; %zu done, %zu failed, %zu to run "
                 "into %s\n",
                 s.name.c_str(), s.points.size(), done, failed, to_run, s.directory.c_str());

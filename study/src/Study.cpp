@@ -62,6 +62,11 @@ std::vector<PointResult> collect(const Study &study) {
     return results;
 }
 
+bool runsAgain(const PointResult &result, bool retry_failed) {
+    return result.status == PointStatus::Unfinished ||
+           (result.status == PointStatus::Failed && retry_failed);
+}
+
 std::vector<PointResult> run(const Study &study, const ExecutorOptions &options) {
     if (options.grainlink.empty())
         throw std::invalid_argument("ExecutorOptions::grainlink: name the grainlink executable");
@@ -71,8 +76,7 @@ std::vector<PointResult> run(const Study &study, const ExecutorOptions &options)
     std::vector<PointResult> results = collect(study);
     std::vector<std::size_t> todo;
     for (std::size_t k = 0; k < results.size(); ++k)
-        if (results[k].status == PointStatus::Unfinished ||
-            (results[k].status == PointStatus::Failed && options.retry_failed))
+        if (runsAgain(results[k], options.retry_failed))
             todo.push_back(k);
     if (todo.empty())
         return results;

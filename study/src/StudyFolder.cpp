@@ -211,7 +211,7 @@ PointResult StudyFolder::runPoint(const Point &point, const std::string &grainli
         return busy;
     }
     PointResult r = state(point);
-    if (r.status == PointStatus::Done || (r.status == PointStatus::Failed && !retry_failed))
+    if (!runsAgain(r, retry_failed))
         return r;
     fs::remove_all(failedPath(point));
     r = PointResult();

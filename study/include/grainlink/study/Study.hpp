@@ -100,5 +100,7 @@ void validate(const Study &study);
 std::vector<PointResult> run(const Study &study, const ExecutorOptions &options);
 /// Every point's result as the study folder holds it now; runs nothing.
 std::vector<PointResult> collect(const Study &study);
+/// Whether a point in this state is run (again): unfinished, or failed with `retry_failed`.
+bool runsAgain(const PointResult &result, bool retry_failed);
 
 } // namespace grainlink::study
