@@ -8,6 +8,7 @@
 #include "grainlink/gap/StudySimulator.hpp"
 #include "grainlink/gap/Twin.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -58,6 +59,32 @@ gap::DiagnosisOptions diagnosisOptions(const gap::BaseModel &base) {
     return o;
 }
 
+/// The user's --hold-out ids, trimmed ("a, b" from a shell), each one the diagnosis compares:
+/// one left out (no test for it in the base) is named with why, and holding out every
+/// experiment leaves nothing to fit a candidate on.
+std::vector<std::string> checkedHeldOut(std::vector<std::string> ids, const gap::ExperimentSet &set,
+                                        const std::vector<std::string> &left_out) {
+    for (std::string &id : ids) {
+        id.erase(0, id.find_first_not_of(" \t"));
+        id.erase(id.find_last_not_of(" \t") + 1);
+        const bool compared = std::any_of(set.experiments.begin(), set.experiments.end(),
+                                          [&](const gap::Experiment &e) { return e.id == id; });
+        if (compared)
+            continue;
+        for (const std::string &why : left_out)
+            if (why.rfind(id + " (", 0) == 0)
+                throw std::invalid_argument("--hold-out " + id +
+                                            ": that experiment is left out of "
+                                            "the diagnosis: " +
+                                            why);
+        set.find(id); // throws naming an unknown id
+    }
+    if (!ids.empty() && ids.size() >= set.experiments.size())
+        throw std::invalid_argument("--hold-out names every experiment the diagnosis compares: "
+                                    "none is left to fit a candidate's strength on");
+    return ids;
+}
+
 /// `gap diagnose --dry-run`: what the diagnosis compares, how it splits, and the runs it needs.
 int printPlan(const gap::DiagnosisPlan &plan, const gap::ExperimentSet &set,
               const gap::StudySimulator &sim, const gap::DiagnosisOptions &options) {
@@ -81,7 +108,26 @@ int printPlan(const gap::DiagnosisPlan &plan, const gap::ExperimentSet &set,
                     gap::typeName(e.type), bins, range.c_str(), e.trials.size(),
                     held ? "held out" : "calibration",
                     bins == 0 ? "  (no measured bin: not compared)" : "");
+        // The values as read, in SI: a unit mistaken (kPa for Pa, m for mm) shows here.
+        std::string measured;
+        for (const std::string &o : e.observables) {
+            double lo = INFINITY, hi = -INFINITY;
+            for (const gap::Trial &t : e.trials)
+                if (const auto c = t.curves.find(o); c != t.curves.end())
+                    for (double y : c->second.y)
+                        lo = std::min(lo, y), hi = std::max(hi, y);
+            char text[96];
+            std::snprintf(text, sizeof text, "%s%s %.4g to %.4g", measured.empty() ? "" : ", ",
+                          o.c_str(), lo, hi);
+            measured += text;
+        }
+        std::printf("  %-20s measured %s\n", "", measured.c_str());
     }
+    if (plan.held_out.size() < 2)
+        std::printf("note: %s held out: the diagnosis can locate a gap but claim no effect (a "
+                    "claim needs two or more held-out experiments: two or more of a type, or "
+                    "--hold-out)\n",
+                    plan.held_out.empty() ? "no experiment is" : "one experiment is");
     std::string checks;
     for (const std::string &c : sim.checks())
         checks += (checks.empty() ? "" : ", ") + c;
@@ -173,8 +219,10 @@ GapCommand::GapCommand(CLI::App &app) {
         ->check(CLI::IsMember({"synced", "authors", "deflection_corrected"}));
     import_cmu_->add_flag("--no-wheels", no_wheels_, "plates only");
     import_cmu_->add_flag("--no-plates", no_plates_, "wheels only");
-    import_csv_ = import_->add_subcommand("csv", "one CSV file as one experiment (appended)");
-    import_csv_->add_option("file", source_, "CSV file with a header line")->required();
+    import_csv_ = import_->add_subcommand(
+        "csv", "CSV files as one experiment (appended): one file, or one per repeat of the test");
+    import_csv_->add_option("files", csv_files_, "CSV file(s), each one repeat of the test")
+        ->required();
     import_csv_->add_option("--out", out_, "measurements folder")->required();
     import_csv_->add_option("--id", csv_id_, "experiment id")->required();
     import_csv_->add_option("--type", csv_type_, "experiment type (plate_sinkage, direct_shear, ...)")
@@ -187,9 +235,18 @@ GapCommand::GapCommand(CLI::App &app) {
     import_csv_->add_option("--delimiter", csv_delimiter_, "how cells are separated")
         ->check(CLI::IsMember({",", ";", "tab", "whitespace"}))
         ->default_str(",");
-    import_csv_->add_option("--decimal", csv_decimal_, "the decimal mark: , with --delimiter ';'")
+    import_csv_
+        ->add_option("--decimal", csv_decimal_,
+                     "the decimal mark: , with --delimiter ';' (or quoted cells)")
         ->check(CLI::IsMember({".", ","}))
         ->default_str(".");
+    import_csv_->add_option("--comment", csv_comment_, "lines starting with it are skipped")
+        ->default_str("#");
+    import_csv_
+        ->add_option("--columns", csv_columns_,
+                     "the columns' names of files without a header line (comma separated)")
+        ->delimiter(',');
+    import_csv_->add_flag("--units-row", csv_units_row_, "the line under the header holds units");
 }
 
 int GapCommand::run() const {
@@ -228,7 +285,7 @@ int GapCommand::diagnose() const {
     gap::StudySimulator sim(base, sims_.empty() ? out + "/sims" : sims_,
                             executorOptions(executor_));
     gap::DiagnosisOptions options = diagnosisOptions(base);
-    options.held_out = held_out_;
+    options.held_out = checkedHeldOut(held_out_, set, left_out);
     if (dry_run_)
         return printPlan(gap::planDiagnosis(set, effects, sim, options), set, sim, options);
     const gap::Diagnosis d = gap::diagnose(set, effects, sim, options);
@@ -300,15 +357,15 @@ int GapCommand::importCmu() const {
 
 int GapCommand::importCsv() const {
     gap::CsvImport csv;
-    csv.file = source_;
+    csv.files = csv_files_;
+    csv.comment = csv_comment_;
+    csv.columns = csv_columns_;
+    csv.units_row = csv_units_row_;
     csv.id = csv_id_;
     csv.type = csv_type_;
     csv.scatter = csv_scatter_;
     csv.delimiter = csv_delimiter_;
     csv.decimal = csv_decimal_;
-    if (csv.decimal == "," && csv.delimiter == ",")
-        throw std::invalid_argument("--decimal ,: cells separated by commas cannot have decimal "
-                                    "commas; give --delimiter ';'");
     const auto split = [](const std::string &s, char c) {
         const auto at = s.find(c);
         if (at == std::string::npos)

@@ -42,9 +42,9 @@ private:
     std::string scale_ = "ci", plan_;
     // import
     std::string source_, sinkage_ = "synced", csv_id_, csv_type_, csv_x_;
-    std::vector<std::string> csv_y_, csv_conditions_;
-    bool csv_scatter_ = false, no_wheels_ = false, no_plates_ = false;
-    std::string csv_delimiter_ = ",", csv_decimal_ = ".";
+    std::vector<std::string> csv_files_, csv_y_, csv_conditions_, csv_columns_;
+    bool csv_scatter_ = false, csv_units_row_ = false, no_wheels_ = false, no_plates_ = false;
+    std::string csv_delimiter_ = ",", csv_decimal_ = ".", csv_comment_ = "#";
 };
 
 } // namespace grainlink::apps

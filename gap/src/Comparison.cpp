@@ -119,9 +119,20 @@ FeatureDesign designFeatures(const ExperimentSet &set, int bins) {
                         d.keys.push_back({e.id, o, e.kind(o), edges[b], edges[b + 1]});
                     }
             } else {
+                // A bin is a feature where a trial has a sample in it: where none has, its
+                // value would be the line between two samples, not a measurement (sparse
+                // data, a few readings over a plate's travel).
+                std::vector<double> sampled;
+                for (const Curve &c : zeroedTrials(e, o))
+                    sampled.insert(sampled.end(), c.x.begin(), c.x.end());
+                const auto measured = [&](double lo, double hi) {
+                    const double tol = 1e-9 * (hi - lo);
+                    return std::any_of(sampled.begin(), sampled.end(),
+                                       [&](double x) { return x >= lo - tol && x <= hi + tol; });
+                };
                 const double reach = d.x_reach[s];
                 for (std::size_t b = 0; b + 1 < edges.size(); ++b)
-                    if (edges[b + 1] <= reach * (1.0 + 1e-12)) {
+                    if (edges[b + 1] <= reach * (1.0 + 1e-12) && measured(edges[b], edges[b + 1])) {
                         d.by_experiment[e.id].push_back(Eigen::Index(d.keys.size()));
                         d.keys.push_back({e.id, o, e.kind(o), edges[b], edges[b + 1]});
                     }

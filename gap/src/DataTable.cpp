@@ -25,13 +25,24 @@ std::string trimmed(const std::string &s) {
     return s.substr(a, b - a);
 }
 
+/// Whether `cell` is written as a decimal number: digits, one sign, one decimal mark `decimal`
+/// and an exponent. strtod alone would also take "0x10" as 16 and, with the decimal mark
+/// swapped in, "1.000" (a thousands separator beside a decimal comma) as 1.
+bool decimalNumber(const std::string &cell, char decimal) {
+    for (char c : cell)
+        if (!(std::isdigit(static_cast<unsigned char>(c)) || c == decimal || c == '+' || c == '-' ||
+              c == 'e' || c == 'E'))
+            return false;
+    return true;
+}
+
 /// A cell that holds no value: empty, or a missing-value mark of a spreadsheet or of numpy.
 bool missingCell(const std::string &cell) {
     std::string low;
     for (char c : cell)
         low += char(std::tolower(static_cast<unsigned char>(c)));
     return low.empty() || low == "nan" || low == "-nan" || low == "na" || low == "n/a" ||
-           low == "null" || low == "none";
+           low == "#n/a" || low == "null" || low == "none" || low == "-" || low == "--";
 }
 
 } // namespace
@@ -96,16 +107,25 @@ bool DataTable::missing(std::size_t row, std::size_t col) const {
 double DataTable::number(std::size_t row, std::size_t col) const {
     const std::string as_written = col < rows[row].size() ? rows[row][col] : std::string();
     std::string cell = as_written;
-    if (decimal != '.')
-        std::replace(cell.begin(), cell.end(), decimal, '.');
+    std::replace(cell.begin(), cell.end(), decimal, '.');
     char *end = nullptr;
     const double v = std::strtod(cell.c_str(), &end);
-    if (cell.empty() || end != cell.c_str() + cell.size() || !std::isfinite(v)) {
+    if (cell.empty() || !decimalNumber(as_written, decimal) || end != cell.c_str() + cell.size() ||
+        !std::isfinite(v)) {
         const bool comma = decimal == '.' && as_written.find(',') != std::string::npos;
+        const bool dot = decimal == ',' && as_written.find('.') != std::string::npos;
+        // A word in the first row of a file with a header: most often a row of units.
+        const bool units =
+            row == 0 && !header_given &&
+            !std::isdigit(static_cast<unsigned char>(as_written.empty() ? 'x' : as_written[0]));
         throw config::ConfigError(
             file + ":" + std::to_string(lines[row]) + ": column '" + header[col] + "': '" +
             as_written + "' is not a finite number" +
-            (comma ? " (numbers with a decimal comma: give data.decimal: \",\")" : ""));
+            (comma ? " (numbers with a decimal comma: give data.decimal: \",\")" : "") +
+            (dot ? " (data.decimal is \",\": a '.' would be a thousands separator; write the "
+                   "numbers without one)"
+                 : "") +
+            (units ? " (a row of units under the header? give data.units_row: true)" : ""));
     }
     return v;
 }
@@ -118,6 +138,8 @@ DataTable readDataTable(const std::string &path, const TableFormat &format) {
     t.file = path;
     t.decimal = format.decimal;
     t.header = format.columns;
+    t.header_given = !format.columns.empty();
+    bool units_row = format.units_row && !t.header_given;
     std::string line;
     int number = 0;
     while (std::getline(in, line)) {
@@ -133,6 +155,27 @@ DataTable readDataTable(const std::string &path, const TableFormat &format) {
             t.header = std::move(cells);
             continue;
         }
+        if (units_row) {
+            units_row = false;
+            continue;
+        }
+        // More cells than columns: a delimiter inside a number (0,5 in a comma-separated
+        // file), or data.columns naming too few. Cells would be read under the wrong names.
+        // Trailing empty cells (a trailing delimiter) are no cells.
+        while (cells.size() > t.header.size() && cells.back().empty())
+            cells.pop_back();
+        if (cells.size() > t.header.size() || (t.header_given && cells.size() < t.header.size()))
+            throw config::ConfigError(
+                path + ":" + std::to_string(number) + ": " + std::to_string(cells.size()) +
+                " cells where " +
+                (t.header_given ? "data.columns names " : "the header line names ") +
+                std::to_string(t.header.size()) + " (" + t.names() + ")" +
+                (format.decimal == format.delimiter && !format.blanks
+                     ? ": with a decimal comma in a comma-separated file, quote each number "
+                       "(\"0,5\")"
+                 : t.header_given ? ": name every column of the file, in order"
+                                  : ": a decimal comma in a comma-separated file? give "
+                                    "data.delimiter and data.decimal"));
         t.rows.push_back(std::move(cells));
         t.lines.push_back(number);
     }

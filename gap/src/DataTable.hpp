@@ -16,6 +16,8 @@ struct TableFormat {
     /// The column names of a file without a header line (another code's output, whose names
     /// stand on a comment line): every line not a comment is then a row.
     std::vector<std::string> columns;
+    /// The line under the header holds units (a spreadsheet's "mm;kPa"): skipped.
+    bool units_row = false;
 
     /// Cells separated by ",", ";", "tab" or "whitespace" (runs of blanks).
     void delimitedBy(const std::string &name) {
@@ -31,12 +33,14 @@ struct DataTable {
     std::vector<std::vector<std::string>> rows;
     std::vector<int> lines;
     char decimal = '.';
+    bool header_given = false; ///< the names came from data.columns, not from the file
 
     /// The column of that name; none when it is missing. Throws when two columns share it.
     std::optional<std::size_t> find(const std::string &name) const;
     /// The header's names, comma-separated, for a message.
     std::string names() const;
-    /// Whether row r holds no value in column c (empty, NaN, NA, null, none; or no such cell).
+    /// Whether row r holds no value in column c (empty, NaN, NA, N/A, #N/A, null, none, "-",
+    /// "--"; or no such cell).
     bool missing(std::size_t row, std::size_t col) const;
     /// Row r's cell in column c; a cell that is not a finite number is an error naming the
     /// file, line and column.

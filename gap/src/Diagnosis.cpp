@@ -318,6 +318,26 @@ std::vector<VariantRequest> signatureRequests(const Effect &raw, const Effect &e
     return out;
 }
 
+/// An effect's signature runs on this design, or why it cannot act here ("" where it can):
+/// resolved against the base, and every variant a scenario the simulator can run. A variant
+/// that does not validate (a wider size distribution coarsening the grains below a plate's
+/// resolution) makes the effect inapplicable here, said with the reason, instead of stopping
+/// the whole diagnosis over one candidate.
+std::string effectSignatures(const Effect &raw, const YAML::Node &reference,
+                             const Simulator &simulator, const ExperimentSet &set,
+                             const DiagnosisOptions &opt, Effect &resolved,
+                             std::vector<VariantRequest> &requests) {
+    if (std::string why = resolveEffect(raw, reference, resolved); !why.empty())
+        return why;
+    requests = signatureRequests(raw, resolved, opt);
+    for (const VariantRequest &r : requests)
+        if (const std::string why = simulator.refusal(set, r); !why.empty()) {
+            requests.clear();
+            return "at strength " + fmt(r.strength) + " it is no valid scenario here: " + why;
+        }
+    return "";
+}
+
 } // namespace
 
 DiagnosisPlan planDiagnosis(const ExperimentSet &set, const std::vector<const Effect *> &effects,
@@ -330,11 +350,14 @@ DiagnosisPlan planDiagnosis(const ExperimentSet &set, const std::vector<const Ef
     const YAML::Node reference = simulator.referenceScenario();
     for (const Effect *raw : effects) {
         Effect resolved;
-        if (const std::string why = resolveEffect(*raw, reference, resolved); !why.empty())
+        std::vector<VariantRequest> requests;
+        if (const std::string why =
+                effectSignatures(*raw, reference, simulator, set, opt, resolved, requests);
+            !why.empty())
             P.inapplicable.emplace_back(raw->name, why);
         else {
             P.applicable.push_back(raw->name);
-            for (VariantRequest &r : signatureRequests(*raw, resolved, opt))
+            for (VariantRequest &r : requests)
                 P.signatures.push_back(std::move(r));
         }
     }
@@ -544,12 +567,15 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     for (const Effect *raw : effects) {
         Live L;
         L.result.name = raw->name;
-        L.result.applicability = resolveEffect(*raw, reference, L.result.effect);
-        if (L.result.applicability.empty())
-            for (VariantRequest &r : signatureRequests(*raw, L.result.effect, opt)) {
-                sig_of.emplace_back(live.size(), r.strength);
-                sig.push_back(std::move(r));
-            }
+        std::vector<VariantRequest> requests;
+        L.result.applicability =
+            effectSignatures(*raw, reference, simulator, set, opt, L.result.effect, requests);
+        if (!L.result.applicability.empty())
+            log("not applicable: " + raw->name + ": " + L.result.applicability);
+        for (VariantRequest &r : requests) {
+            sig_of.emplace_back(live.size(), r.strength);
+            sig.push_back(std::move(r));
+        }
         live.push_back(std::move(L));
     }
     log("signatures: " + std::to_string(sig.size()) + " variants");

@@ -151,13 +151,14 @@ TableFormat parseTableFormat(const ConfigNode &data) {
     TableFormat f;
     f.comment = data.text("comment", "#");
     if (data.has("delimiter"))
-        f.delimitedBy(data["delimiter"].choice({",", ";", "tab", "whitespace"}));
-    if (data.has("decimal")) {
+        f.delimitedBy(data["delimiter"].text() == "\t"
+                          ? "tab"
+                          : data["delimiter"].choice({",", ";", "tab", "whitespace"}));
+    // A decimal comma beside the comma delimiter reads only quoted numbers ("0,5"); an
+    // unquoted one splits its row into too many cells, which the reader refuses.
+    if (data.has("decimal"))
         f.decimal = data["decimal"].choice({".", ","})[0];
-        if (f.decimal == ',' && f.delimiter == ',' && !f.blanks)
-            data["decimal"].fail("a decimal comma needs another delimiter (delimiter: \";\", "
-                                 "tab or whitespace)");
-    }
+    f.units_row = data.boolean("units_row", false);
     if (data.has("columns")) {
         for (const ConfigNode &c : data["columns"].items())
             f.columns.push_back(c.text());
@@ -488,6 +489,14 @@ ExperimentSet loadExperiments(const std::string &directory) {
             }
             if (e.trials.empty())
                 values.fail("give at least one value");
+            // An angle of repose lies between 0 and 90 deg (angle_deg's unit): outside, the
+            // unit is wrong (rad for deg, or 1690 deg for 29.5 rad).
+            for (const Trial &t : e.trials)
+                if (const double a = t.curves.at(obs).y[0];
+                    obs == "angle_deg" && !(a > 0.0 && a < 90.0))
+                    values.fail("an angle of repose lies between 0 and 90 deg; in " +
+                                data["unit"].text() + " this value is " + std::to_string(a) +
+                                " deg (is the unit right?)");
             e.observables = {obs};
             data.finish();
         } else {
@@ -598,6 +607,13 @@ ExperimentSet loadExperiments(const std::string &directory) {
                             f.fail(path.string() + ": '" + o + "' has " +
                                    std::to_string(curve.x.size()) + " sample(s) with " + e.x_name +
                                    " and a value; a curve needs two or more");
+                    // Every sample at one x: the wrong column, or the x of a constant.
+                    for (const auto &[o, curve] : whole.curves)
+                        if (std::all_of(curve.x.begin(), curve.x.end(),
+                                        [&](double x) { return x == curve.x.front(); }))
+                            data["x"].fail(path.string() + ": every sample of '" + o + "' is at " +
+                                           e.x_name + " = " + std::to_string(curve.x.front()) +
+                                           ": the x column does not vary (is it the right one?)");
                     // A plate or shear curve recorded in time order that runs back after its
                     // largest x (unloaded, reversed) keeps its loading branch: binned with it,
                     // the other branch would read low against a loading-only simulation.
@@ -674,6 +690,9 @@ ExperimentSet loadExperiments(const std::string &directory) {
             if (e.uncertainty.y_sigma < 0 || e.uncertainty.y_relative < 0 ||
                 e.uncertainty.y_systematic < 0 || e.uncertainty.x_zero_sigma < 0)
                 u->fail("uncertainties must be >= 0");
+            // A fraction: 5 would be a 500 % error, most likely 5 % meant.
+            if (e.uncertainty.y_relative >= 1.0)
+                (*u)["y_relative"].fail("a fraction of the value (0.05 for 5 %), below 1");
             u->finish();
         }
         if (const auto bins = node.optional("bins")) {

@@ -4,6 +4,8 @@
 
 #include "DataTable.hpp"
 
+#include "grainlink/config/ConfigNode.hpp"
+
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
@@ -279,8 +281,26 @@ std::vector<std::string> importCmu(const std::string &cmu_directory, const std::
     return ids;
 }
 
+namespace {
+
+/// A reader's message, which names data.* keys of experiments.yaml, with the importer's
+/// options instead.
+std::string withImportOptions(std::string message) {
+    const std::pair<const char *, const char *> keys[] = {{"data.decimal: \",\"", "--decimal ,"},
+                                                          {"data.delimiter", "--delimiter"},
+                                                          {"data.decimal", "--decimal"},
+                                                          {"data.units_row: true", "--units-row"},
+                                                          {"data.columns", "--columns"}};
+    for (const auto &[key, option] : keys)
+        for (std::size_t at; (at = message.find(key)) != std::string::npos;)
+            message.replace(at, std::string(key).size(), option);
+    return message;
+}
+
+} // namespace
+
 void importCsv(const CsvImport &csv, const std::string &out) {
-    const fs::path dst(out), src(csv.file);
+    const fs::path dst(out);
     const ExperimentType type = parseType(csv.type);
     if (csv.id.empty() || csv.id[0] == '.' || csv.id.find_first_of(" /\\\t\n") != std::string::npos)
         throw std::invalid_argument("--id '" + csv.id +
@@ -295,21 +315,50 @@ void importCsv(const CsvImport &csv, const std::string &out) {
         throw std::invalid_argument(scalar ? "--y: give one column of values"
                                            : "--y: name at least one observable");
 
+    if (csv.files.empty())
+        throw std::invalid_argument("give the CSV file (or one file per repeat)");
+    // Units before anything is read or written: an error names the option, not a file the
+    // import would have written and undone.
+    const auto checkUnit = [](const std::string &option, const std::string &unit,
+                              const std::string &si_name) {
+        try {
+            unitFactor(unit, dimensionOf(si_name));
+        } catch (const std::invalid_argument &e) {
+            throw std::invalid_argument(option + ": " + e.what());
+        }
+    };
+    if (!scalar)
+        checkUnit("--x " + csv.x_column + ":" + csv.x_unit, csv.x_unit, xNameOf(type));
+    for (const auto &[obs, col] : csv.y)
+        if (!scalar)
+            checkUnit("--y " + obs + "=" + col.first + ":" + col.second, col.second, obs);
+
     // Read and checked before anything is written: an error names the user's file and line.
     TableFormat format;
     format.delimitedBy(csv.delimiter);
     format.decimal = csv.decimal.empty() ? '.' : csv.decimal[0];
-    const DataTable c = readDataTable(src.string(), format);
+    format.comment = csv.comment;
+    format.columns = csv.columns;
+    format.units_row = csv.units_row;
     std::vector<std::string> columns;
     if (!csv.x_column.empty())
         columns.push_back(csv.x_column);
     for (const auto &[obs, col] : csv.y)
         columns.push_back(col.first);
-    for (const std::string &name : columns) {
-        const std::size_t col = column(c, name);
-        for (std::size_t r = 0; r < c.rows.size(); ++r)
-            if (!c.missing(r, col))
-                c.number(r, col);
+    std::vector<DataTable> tables;
+    for (const std::string &file : csv.files) {
+        try {
+            tables.push_back(readDataTable(file, format));
+            const DataTable &c = tables.back();
+            for (const std::string &name : columns) {
+                const std::size_t col = column(c, name);
+                for (std::size_t r = 0; r < c.rows.size(); ++r)
+                    if (!c.missing(r, col))
+                        c.number(r, col);
+            }
+        } catch (const config::ConfigError &e) {
+            throw config::ConfigError(withImportOptions(e.what()));
+        }
     }
 
     const fs::path yaml = dst / "experiments.yaml";
@@ -318,9 +367,16 @@ void importCsv(const CsvImport &csv, const std::string &out) {
         if (e["id"].as<std::string>() == csv.id)
             throw std::invalid_argument("experiment id '" + csv.id + "' is already in " +
                                         yaml.string());
-    const std::string copy = scalar ? "" : "data/" + csv.id + ".csv";
-    if (!scalar && fs::exists(dst / copy))
-        throw std::invalid_argument((dst / copy).string() + " exists already: give another --id");
+    // The copies: data/ID.csv, or data/ID_1.csv ... for repeats.
+    std::vector<std::string> copies;
+    for (std::size_t k = 0; !scalar && k < tables.size(); ++k) {
+        copies.push_back("data/" + csv.id +
+                         (tables.size() > 1 ? "_" + std::to_string(k + 1) : std::string()) +
+                         ".csv");
+        if (fs::exists(dst / copies.back()))
+            throw std::invalid_argument((dst / copies.back()).string() +
+                                        " exists already: give another --id");
+    }
 
     YAML::Node e;
     e["id"] = csv.id;
@@ -340,15 +396,17 @@ void importCsv(const CsvImport &csv, const std::string &out) {
     YAML::Node data;
     if (scalar) {
         const auto &[obs, col] = *csv.y.begin();
-        const std::size_t c_values = column(c, col.first);
         std::vector<double> values;
-        for (std::size_t r = 0; r < c.rows.size(); ++r)
-            if (!c.missing(r, c_values))
-                values.push_back(c.number(r, c_values));
+        for (const DataTable &c : tables) {
+            const std::size_t c_values = column(c, col.first);
+            for (std::size_t r = 0; r < c.rows.size(); ++r)
+                if (!c.missing(r, c_values))
+                    values.push_back(c.number(r, c_values));
+        }
         data["values"] = flow(YAML::Node(values));
         data["unit"] = col.second;
     } else {
-        data["files"] = flow(YAML::Node(std::vector<std::string>{copy}));
+        data["files"] = flow(YAML::Node(copies));
         if (csv.scatter)
             data["scatter"] = true;
         YAML::Node x;
@@ -376,13 +434,14 @@ void importCsv(const CsvImport &csv, const std::string &out) {
     }
     fs::create_directories(dst / "data");
     try {
-        if (!scalar)
-            writeColumns(c, columns, src, dst / copy, "imported by grainlink gap import csv");
+        for (std::size_t k = 0; k < copies.size(); ++k)
+            writeColumns(tables[k], columns, csv.files[k], dst / copies[k],
+                         "imported by grainlink gap import csv");
         root["experiments"].push_back(e);
         save(root, yaml, "# Measurements for grainlink gap (docs/gap.md).\n");
         loadExperiments(out);
     } catch (...) {
-        if (!scalar)
+        for (const std::string &copy : copies)
             fs::remove(dst / copy);
         if (existed) {
             std::ofstream(yaml.string() + ".tmp") << before;

@@ -832,6 +832,16 @@ study::Study StudySimulator::studyOf(const ExperimentSet &design,
     return st;
 }
 
+std::string StudySimulator::refusal(const ExperimentSet &design,
+                                    const VariantRequest &request) const {
+    try {
+        plan(design, {request});
+    } catch (const std::exception &e) {
+        return e.what();
+    }
+    return "";
+}
+
 StudySimulator::RunCount StudySimulator::plan(const ExperimentSet &design,
                                               const std::vector<VariantRequest> &requests) const {
     std::vector<Slot> slots;

@@ -74,6 +74,8 @@ BevameterScenario parseBevameter(const config::ConfigNode &root) {
                 << " (seed: Gamma >= 10 for bevameter tests); use larger plates or finer grains";
             b["plate_radii_m"].fail(msg.str());
         }
+    for (double r : t.plate_radii_m)
+        refuseBeyondBed(b["plate_radii_m"], s.soil, t.centre_m, r, "plate");
     root.finish();
     return s;
 }

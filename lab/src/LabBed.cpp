@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iomanip>
+#include <sstream>
 #include <stdexcept>
 
 namespace grainlink::lab {
@@ -58,6 +59,22 @@ Eigen::Vector2d testCentre(const dem::DemScenario &soil,
     const auto &d = soil.deposition;
     return centre.value_or(Eigen::Vector2d(0.5 * (d.region_lower_m.x() + d.region_upper_m.x()),
                                            0.5 * (d.region_lower_m.y() + d.region_upper_m.y())));
+}
+
+void refuseBeyondBed(const config::ConfigNode &where, const dem::DemScenario &soil,
+                     const std::optional<Eigen::Vector2d> &centre, double radius_m,
+                     const std::string &tool) {
+    const auto &d = soil.deposition;
+    const Eigen::Vector2d c = testCentre(soil, centre);
+    const double room = std::min({c.x() - d.region_lower_m.x(), d.region_upper_m.x() - c.x(),
+                                  c.y() - d.region_lower_m.y(), d.region_upper_m.y() - c.y()});
+    if (radius_m > room) {
+        std::ostringstream msg;
+        msg << tool << " of radius " << radius_m * 1e3 << " mm about (" << c.x() * 1e3 << ", "
+            << c.y() * 1e3 << ") mm reaches past the bed, whose nearest side is " << room * 1e3
+            << " mm away (soil.deposition.region): a larger bin, or a smaller " << tool;
+        where.fail(msg.str());
+    }
 }
 
 double highestGrainUnder(const dem::ParticleStore &grains, const Eigen::Vector2d &centre,

@@ -317,6 +317,7 @@ ShearAnnulusScenario parseShearAnnulus(const config::ConfigNode &root) {
             << " < min_resolution " << t.min_resolution << "; use a wider annulus or finer grains";
         b["outer_radius_m"].fail(msg.str());
     }
+    refuseBeyondBed(b["outer_radius_m"], s.soil, t.centre_m, g.outer_radius_m, "annulus");
     root.finish();
     return s;
 }

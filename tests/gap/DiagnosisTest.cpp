@@ -542,6 +542,31 @@ private:
     std::set<std::string> failing_;
     bool only_confirming_ = false, first_bin_only_ = false;
 };
+
+/// The analytic model whose study refuses one effect's variants (as a lab scenario whose grains
+/// a wider size distribution coarsens below a plate's resolution): running one is an error.
+class RefusingEffectSimulator final : public Simulator {
+public:
+    explicit RefusingEffectSimulator(std::string effect) : effect_(std::move(effect)) {}
+    std::vector<std::string> checks() const override { return inner_.checks(); }
+    YAML::Node referenceScenario() const override { return inner_.referenceScenario(); }
+    std::string refusal(const ExperimentSet &, const VariantRequest &r) const override {
+        const bool refused =
+            (r.effect && r.effect->name == effect_) || (r.second && r.second->name == effect_);
+        return refused ? "key 'bevameter.plate_radii_m': Gamma = 2.9 < min_resolution 3" : "";
+    }
+    std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &set, const FeatureDesign &design,
+                                          const std::vector<VariantRequest> &requests) override {
+        for (const VariantRequest &r : requests)
+            if (!refusal(set, r).empty())
+                throw std::runtime_error("a refused variant was run: " + r.label);
+        return inner_.simulate(set, design, requests);
+    }
+
+private:
+    AnalyticSimulator inner_;
+    std::string effect_;
+};
 } // namespace
 
 TEST_CASE("diagnosis: failed simulations are never read as agreement, nor bins they do not reach",
@@ -831,6 +856,29 @@ TEST_CASE("diagnosis: an effect whose runs failed is not fitted as if it agreed"
             poly = &cand;
     REQUIRE(poly);
     CHECK(poly->applicability.find("signature runs failed") != std::string::npos);
+    CHECK(d.outcome == Diagnosis::Outcome::Explained);
+    CHECK(d.explained_by == "cohesion");
+}
+
+TEST_CASE("diagnosis: an effect whose variants are no valid scenario on this design is not "
+          "applicable, said with why, and the diagnosis goes on",
+          "[gap][diagnosis]") {
+    // One candidate's variants cannot run here (a user's small plates and the wider size
+    // distribution's coarser grains): that stopped the whole diagnosis, the dry run included.
+    const EffectCatalogue c = shippedEffects();
+    RefusingEffectSimulator sim("polydispersity");
+    const DiagnosisOptions o = analyticOptions();
+    const ExperimentSet set = measuredSet({"cohesion", 4.0e4}, 7);
+    const DiagnosisPlan plan = planDiagnosis(set, c.diagnosable(), sim, o);
+    const auto refused = std::find_if(plan.inapplicable.begin(), plan.inapplicable.end(),
+                                      [](const auto &p) { return p.first == "polydispersity"; });
+    REQUIRE(refused != plan.inapplicable.end());
+    CHECK_THAT(refused->second,
+               Catch::StartsWith("at strength ") && Catch::Contains("no valid scenario here: key "
+                                                                    "'bevameter.plate_radii_m'"));
+    const Diagnosis d = diagnose(set, c.diagnosable(), sim, o);
+    INFO(d.claim);
+    CHECK(candidate(d, "polydispersity").applicability == refused->second);
     CHECK(d.outcome == Diagnosis::Outcome::Explained);
     CHECK(d.explained_by == "cohesion");
 }

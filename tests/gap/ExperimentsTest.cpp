@@ -413,11 +413,47 @@ TEST_CASE("data files from other codes and European spreadsheets: names holding 
     CHECK(c.x[1] == Approx(0.001));
     CHECK(c.y[0] == Approx(1250.0));
     CHECK(c.y[1] == Approx(2500.0));
+    // A decimal comma in a comma-separated file reads only quoted numbers: unquoted, a row has
+    // more cells than the header names, and is refused rather than read under the wrong names.
     checkRefused(dir,
                  head + "      files: [eu.csv]\n      decimal: ','\n" +
                      "      x: {column: z_mm, unit: mm}\n"
                      "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n",
-                 "a decimal comma needs another delimiter");
+                 "eu.csv:2: 3 cells where the header line names 1");
+    const std::string zp = "      x: {column: z_mm, unit: mm}\n"
+                           "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n";
+    write(dir / "quoted.csv", "z_mm,p_kPa\n\"0,5\",\"1,25\"\n\"1\",\"2,5\"\n");
+    write(dir / "experiments.yaml", head + "      files: [quoted.csv]\n      decimal: ','\n" + zp);
+    CHECK(loadExperiments(dir.string()).experiments[0].trials[0].curves.at("pressure_Pa").y ==
+          std::vector<double>{1250.0, 2500.0});
+    write(dir / "commas.csv", "z_mm,p_kPa\n0,5,1,25\n1,0,2,5\n");
+    checkRefused(dir, head + "      files: [commas.csv]\n" + zp,
+                 "commas.csv:2: 4 cells where the header line names 2 (z_mm, p_kPa)");
+    // A trailing delimiter is no extra cell.
+    write(dir / "trailing.csv", "z_mm,p_kPa,\n1,2,\n2,4,\n");
+    write(dir / "experiments.yaml", head + "      files: [trailing.csv]\n" + zp);
+    CHECK(loadExperiments(dir.string()).experiments[0].trials[0].curves.at("pressure_Pa").y ==
+          std::vector<double>{2000.0, 4000.0});
+    // Beside a decimal comma a '.' is a thousands separator: refused, not read as 1 and 1.5.
+    write(dir / "thousands.csv", "z_um;p_kPa\n750;0,6\n1.000;0,8\n1.500;1,3\n");
+    checkRefused(dir,
+                 head + "      files: [thousands.csv]\n      delimiter: ';'\n      decimal: ','\n" +
+                     "      x: {column: z_um, unit: um}\n"
+                     "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n",
+                 "thousands.csv:3: column 'z_um': '1.000' is not a finite number (data.decimal is "
+                 "\",\": a '.' would be a thousands separator");
+    // strtod's hexadecimal is no measurement.
+    write(dir / "hex.csv", "z_mm,p_kPa\n1,2\n0x10,4\n");
+    checkRefused(dir, head + "      files: [hex.csv]\n" + zp,
+                 "hex.csv:3: column 'z_mm': '0x10' is not a finite number");
+    // A units row under the header: named as the likely cause, and skipped on request.
+    write(dir / "units.csv", "z_mm;p_kPa\nmm;kPa\n1;2\n2;-\n3;6\n");
+    const std::string units = head + "      files: [units.csv]\n      delimiter: ';'\n";
+    checkRefused(dir, units + zp, "give data.units_row: true");
+    write(dir / "experiments.yaml", units + "      units_row: true\n" + zp);
+    const ExperimentSet with_units = loadExperiments(dir.string());
+    const Curve &after_units = with_units.experiments[0].trials[0].curves.at("pressure_Pa");
+    CHECK(after_units.y == std::vector<double>{2000.0, 6000.0}); // "-" is a missing value
 
     // LIGGGHTS' fix ave/time file: its column names stand on a comment line.
     write(dir / "lig.txt", "# Time-averaged data for fix out\n# TimeStep v_z v_p\n"
@@ -426,6 +462,23 @@ TEST_CASE("data files from other codes and European spreadsheets: names holding 
                                         "      columns: [step, z_m, p_kPa]\n" +
                                         "      x: {column: z_m, unit: m}\n"
                                         "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n");
+    CHECK(loadExperiments(dir.string()).experiments[0].trials[0].curves.at("pressure_Pa").y ==
+          std::vector<double>{5000.0, 10000.0});
+    // Too few or too many names for its columns: refused, never read under the wrong names.
+    const std::string lig_axes = "      x: {column: z_m, unit: m}\n"
+                                 "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n";
+    checkRefused(dir,
+                 head + "      files: [lig.txt]\n      delimiter: whitespace\n" +
+                     "      columns: [z_m, p_kPa]\n" + lig_axes,
+                 "lig.txt:3: 3 cells where data.columns names 2 (z_m, p_kPa)");
+    checkRefused(dir,
+                 head + "      files: [lig.txt]\n      delimiter: whitespace\n" +
+                     "      columns: [step, z_m, p_kPa, extra]\n" + lig_axes,
+                 "lig.txt:3: 3 cells where data.columns names 4");
+    // A tab given as the character itself.
+    write(dir / "tab.txt", "z_m\tp_kPa\n0.001\t5\n0.002\t10\n");
+    write(dir / "experiments.yaml",
+          head + "      files: [tab.txt]\n      delimiter: \"\\t\"\n" + lig_axes);
     CHECK(loadExperiments(dir.string()).experiments[0].trials[0].curves.at("pressure_Pa").y ==
           std::vector<double>{5000.0, 10000.0});
     // `comment: ""` reads every line: a header starting with '#'.

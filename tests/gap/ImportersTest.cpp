@@ -80,7 +80,7 @@ TEST_CASE("a plain CSV becomes an experiment of a measurements folder", "[gap][i
         f << "z_mm,p_kPa,other\n0,0,1\n5,10,1\n10,25,1\n";
     }
     CsvImport csv;
-    csv.file = src.string();
+    csv.files = {src.string()};
     csv.id = "p50";
     csv.type = "plate_sinkage";
     csv.x_column = "z_mm";
@@ -113,7 +113,7 @@ TEST_CASE("import csv reads a file as the diagnosis does, and a failed import le
     // A European spreadsheet's export: a byte-order mark, quoted names holding the delimiter,
     // ';' between cells, decimal commas.
     CsvImport csv;
-    csv.file = file("eu", "\xEF\xBB\xBF\"Sinkage; mm\";\"Pressure; kPa\"\n0,5;1,5\n1;3\n");
+    csv.files = {file("eu", "\xEF\xBB\xBF\"Sinkage; mm\";\"Pressure; kPa\"\n0,5;1,5\n1;3\n")};
     csv.id = "eu";
     csv.type = "plate_sinkage";
     csv.x_column = "Sinkage; mm";
@@ -131,7 +131,7 @@ TEST_CASE("import csv reads a file as the diagnosis does, and a failed import le
 
     // A scalar: the column's values.
     CsvImport repose;
-    repose.file = file("repose", "trial,angle\n1,29.5\n2,30.1\n");
+    repose.files = {file("repose", "trial,angle\n1,29.5\n2,30.1\n")};
     repose.id = "repose";
     repose.type = "angle_of_repose";
     repose.y["angle_deg"] = {"angle", "deg"};
@@ -145,16 +145,21 @@ TEST_CASE("import csv reads a file as the diagnosis does, and a failed import le
                              std::istreambuf_iterator<char>());
     CsvImport bad = csv;
     bad.id = "units_row";
-    bad.file = file("unitsrow", "z;p\nmm;kPa\n1;2\n");
+    bad.files = {file("unitsrow", "z;p\nmm;kPa\n1;2\n2;5\n")};
     bad.x_column = "z";
     bad.y = {{"pressure_Pa", {"p", "kPa"}}};
-    CHECK_THROWS_WITH(importCsv(bad, out.string()),
-                      Catch::Contains(bad.file + ":2: column 'z': 'mm' is not a finite number"));
-    // A unit of the wrong kind is found when the folder is read back: undone too.
+    // The reader's hint names the importer's option, not a key of experiments.yaml.
+    CHECK_THROWS_WITH(
+        importCsv(bad, out.string()),
+        Catch::Contains(bad.files[0] + ":2: column 'z': 'mm' is not a finite number") &&
+            Catch::Contains("give --units-row") && !Catch::Contains("data.units_row"));
+    // A unit of the wrong kind is named by its option, before any file is read or written.
     CsvImport wrong_unit = csv;
     wrong_unit.id = "wrong_unit";
     wrong_unit.y = {{"pressure_Pa", {"Pressure; kPa", "mm"}}};
-    CHECK_THROWS_WITH(importCsv(wrong_unit, out.string()), Catch::Contains("not a pressure"));
+    CHECK_THROWS_WITH(importCsv(wrong_unit, out.string()),
+                      Catch::Contains("--y pressure_Pa=Pressure; kPa:mm: ") &&
+                          Catch::Contains("not a pressure"));
     CsvImport bad_id = csv;
     bad_id.id = "../up";
     CHECK_THROWS_WITH(importCsv(bad_id, out.string()), Catch::Contains("one word"));
@@ -163,7 +168,21 @@ TEST_CASE("import csv reads a file as the diagnosis does, and a failed import le
                       std::istreambuf_iterator<char>()) == before);
     CHECK_FALSE(fs::exists(out / "data" / "units_row.csv"));
     CHECK_FALSE(fs::exists(out / "data" / "wrong_unit.csv"));
-    bad.file = file("unitsrow", "z;p\n1;2\n2;3\n");
+    bad.units_row = true; // the units row skipped, as the copy's reader needs no such flag
     importCsv(bad, out.string());
-    CHECK(loadExperiments(out.string()).experiments.size() == 3);
+    CHECK(loadExperiments(out.string()).find("units_row").trials[0].curves.at("pressure_Pa").y ==
+          (std::vector<double>{2000.0, 5000.0}));
+
+    // Repeats of one test: one experiment, a trial per file, a copy per file.
+    CsvImport repeats = csv;
+    repeats.id = "repeats";
+    repeats.files = {file("rep1", "\"Sinkage; mm\";\"Pressure; kPa\"\n0,5;1,5\n1;3\n"),
+                     file("rep2", "\"Sinkage; mm\";\"Pressure; kPa\"\n0,5;1,7\n1;3,2\n")};
+    importCsv(repeats, out.string());
+    const ExperimentSet with_repeats = loadExperiments(out.string());
+    const Experiment &r = with_repeats.find("repeats");
+    REQUIRE(r.trials.size() == 2);
+    CHECK(r.trials[1].curves.at("pressure_Pa").y[0] == Approx(1700.0));
+    CHECK(fs::exists(out / "data" / "repeats_1.csv"));
+    CHECK(fs::exists(out / "data" / "repeats_2.csv"));
 }

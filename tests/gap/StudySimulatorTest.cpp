@@ -459,6 +459,9 @@ TEST_CASE("an experiment's bed depth makes its bed: poured deeper and struck off
                        plateExperiment("shallow", {{"bed_depth_m", 0.015}}, {}),
                        plateExperiment("as_base", {}, {}),
                        plateExperiment("no_depth", {{"bed_depth_m", -0.01}}, {}), shear};
+    for (Experiment &e : set.experiments)
+        if (e.type == ExperimentType::PlateSinkage)
+            e.numbers["plate_diameter_m"] = 0.04; // in the 50 mm box
     std::vector<std::string> left_out;
     const ExperimentSet kept = simulable(set, base, left_out);
     REQUIRE(left_out.size() == 1);

@@ -91,4 +91,11 @@ TEST_CASE("Bevameter input errors name the key and the line", "[lab][bevameter]"
                       Contains("unknown key 'bevameter.depth_m'"));
     CHECK_THROWS_WITH(parseBevameterText(editedBevameter("max_sinkage_m", "max_sinkage_mm")),
                       Contains("wrong unit"));
+    // A plate wider than the 50 mm bed (a diameter given as a radius) presses on the walls.
+    CHECK_THROWS_WITH(
+        parseBevameterText(editedBevameter("[0.010, 0.013]", "[0.010, 0.026]")),
+        Contains("bevameter.plate_radii_m") &&
+            Contains("plate of radius 26 mm about (25, 25) mm reaches past the bed, whose "
+                     "nearest side is 25 mm away"));
+    CHECK_NOTHROW(parseBevameterText(editedBevameter("[0.010, 0.013]", "[0.010, 0.025]")));
 }

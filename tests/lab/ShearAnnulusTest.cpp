@@ -227,6 +227,11 @@ TEST_CASE("Shear annulus input errors name the key and the line", "[lab][shear_a
     CHECK_THROWS_WITH(
         parseAnnulusText(editedAnnulus("outer_radius_m: 0.022", "outer_radius_m: 0.010")),
         Contains("bevameter_shear.outer_radius_m") && Contains("must exceed inner_radius_m"));
+    // An annulus wider than the 60 mm bed.
+    CHECK_THROWS_WITH(
+        parseAnnulusText(editedAnnulus("outer_radius_m: 0.022", "outer_radius_m: 0.031")),
+        Contains("bevameter_shear.outer_radius_m") &&
+            Contains("annulus of radius 31 mm about (30, 30) mm reaches past the bed"));
     CHECK_THROWS_WITH(parseAnnulusText(editedAnnulus("[1000, 2000]", "[1000, -5]")),
                       Contains("bevameter_shear.normal_pressures_Pa") && Contains("> 0"));
     CHECK_THROWS_WITH(parseAnnulusText(editedAnnulus("gain_m_s_per_N: 0.1, ", "")),

@@ -51,6 +51,13 @@ public:
     }
     /// The scenario effects are resolved against (their off values, their applicability).
     virtual YAML::Node referenceScenario() const = 0;
+    /// Why `request` cannot run on `design` (a scenario that does not validate: a variant
+    /// coarsening the grains below a plate's resolution); "" where it can. Runs nothing.
+    virtual std::string refusal(const ExperimentSet &design, const VariantRequest &request) const {
+        (void)design;
+        (void)request;
+        return "";
+    }
     /// Experiments the simulator runs on the same beds (a seed's one packing) share a group:
     /// held-out evidence is counted per group, since the model's error from its few beds is
     /// shared by every experiment in them. Default: each experiment its own beds.

@@ -22,9 +22,10 @@ struct CmuImportOptions {
 std::vector<std::string> importCmu(const std::string &cmu_directory, const std::string &out,
                                    const CmuImportOptions &options = {});
 
-/// One plain CSV file as one experiment, added to DIR/experiments.yaml (created if absent).
+/// Plain CSV files as one experiment, added to DIR/experiments.yaml (created if absent): one
+/// file, or one file per repeat of the test (its trials).
 struct CsvImport {
-    std::string file;
+    std::vector<std::string> files;
     std::string id;
     std::string type;                ///< an experiment type (plate_sinkage, ...)
     std::string x_column, x_unit;    ///< empty for a scalar experiment
@@ -33,6 +34,9 @@ struct CsvImport {
     bool scatter = false;
     std::string delimiter = ","; ///< ",", ";", "tab" or "whitespace"
     std::string decimal = ".";   ///< "," for numbers with a decimal comma
+    std::string comment = "#";   ///< lines starting with it are skipped
+    std::vector<std::string> columns; ///< the names of a file without a header line
+    bool units_row = false;           ///< the line under the header holds units
 };
 void importCsv(const CsvImport &csv, const std::string &out);
 

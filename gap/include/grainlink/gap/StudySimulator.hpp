@@ -64,6 +64,7 @@ public:
                                           const std::vector<VariantRequest> &requests) override;
     std::vector<ExperimentSet> probes(const ExperimentSet &design) const override;
     YAML::Node referenceScenario() const override;
+    std::string refusal(const ExperimentSet &design, const VariantRequest &request) const override;
     /// One type in one box: its runs at one seed share one cached packing.
     std::string bedGroup(const Experiment &experiment) const override;
 

@@ -2,6 +2,7 @@
 // The prepared bed of the lab tests (docs/lab.md): settled once through the packing cache and
 // copied per run, measured for summary.json; the test's axis in the deposition region, the
 // highest grain under a round tool, the lab CSVs and the wall clock.
+#include "grainlink/config/ConfigNode.hpp"
 #include "grainlink/dem/DemSystem.hpp"
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/LabSummary.hpp"
@@ -53,6 +54,12 @@ double secondsSince(std::chrono::steady_clock::time_point since);
 /// The test's axis (x, y) [m]: `centre` when set, else the middle of the deposition region.
 Eigen::Vector2d testCentre(const dem::DemScenario &soil,
                            const std::optional<Eigen::Vector2d> &centre);
+
+/// Refuses, at `where`, a round tool of `radius_m` about the test's axis that reaches past the
+/// bed (the deposition region) in x or y: it would press on the wall, not on the soil.
+void refuseBeyondBed(const config::ConfigNode &where, const dem::DemScenario &soil,
+                     const std::optional<Eigen::Vector2d> &centre, double radius_m,
+                     const std::string &tool);
 
 /// [m] Highest grain top among grains overlapping the vertical cylinder of `radius_m` about
 /// `centre`, and at least `floor_m`: a tool started above it never appears inside a grain.
