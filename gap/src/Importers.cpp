@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -73,7 +74,32 @@ YAML::Node loadOrNew(const fs::path &file, const std::string &name) {
     return root;
 }
 
-void save(const YAML::Node &root, const fs::path &file, const std::string &header) {
+/// Every number in `node` written with 15 significant digits where that reads back as the same
+/// double: yaml-cpp writes 17 (0.058000000000000003), exact but not as the user wrote it.
+void shortenNumbers(YAML::Node node) {
+    if (node.IsScalar()) {
+        const std::string text = node.Scalar();
+        char *end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (!text.empty() && end == text.c_str() + text.size() && std::isfinite(v) &&
+            text.find_first_of("xX") == std::string::npos) {
+            char shorter[32];
+            std::snprintf(shorter, sizeof shorter, "%.15g", v);
+            if (std::strtod(shorter, nullptr) == v)
+                node = std::string(shorter);
+        }
+        return;
+    }
+    if (node.IsSequence())
+        for (YAML::Node child : node)
+            shortenNumbers(child);
+    else if (node.IsMap())
+        for (auto it = node.begin(); it != node.end(); ++it)
+            shortenNumbers(it->second);
+}
+
+void save(YAML::Node root, const fs::path &file, const std::string &header) {
+    shortenNumbers(root);
     YAML::Emitter e;
     e << root;
     const fs::path tmp = file.string() + ".tmp";

@@ -131,9 +131,19 @@ std::vector<double> conditionValues(const ExperimentSet &set, const std::vector<
     for (const auto &id : ids) {
         const Experiment &e = set.find(id);
         const auto it = e.numbers.find(key);
-        if (it == e.numbers.end())
-            throw std::invalid_argument(e.source + ": experiment '" + id + "' (" +
-                                        typeName(e.type) + ") needs the condition '" + key + "'");
+        if (it == e.numbers.end()) {
+            // A condition it gives that nothing reads is most likely this one misspelt.
+            const std::vector<std::string> read = simulatedConditions(e.type);
+            std::string unread;
+            for (const auto &[k, value] : e.numbers)
+                if (std::find(read.begin(), read.end(), k) == read.end())
+                    unread += (unread.empty() ? "" : ", ") + ("'" + k + "'");
+            throw std::invalid_argument(
+                e.source + ": experiment '" + id + "' (" + typeName(e.type) +
+                ") needs the condition '" + key + "'" +
+                (unread.empty() ? std::string()
+                                : " (it gives " + unread + ", which nothing reads: misspelt?)"));
+        }
         v.push_back(it->second * scale);
     }
     std::sort(v.begin(), v.end());

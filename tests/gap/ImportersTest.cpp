@@ -98,6 +98,12 @@ TEST_CASE("a plain CSV becomes an experiment of a measurements folder", "[gap][i
     CHECK(e.trials[0].curves.at("pressure_Pa").y.back() == Approx(25000.0));
     CHECK(e.trials[0].curves.at("pressure_Pa").x.back() == Approx(0.01));
     CHECK_THROWS_WITH(importCsv(csv, out.string()), Catch::Contains("already in"));
+    // Numbers are written as given, not as yaml-cpp's 17 digits (0.050000000000000003).
+    std::ifstream written(out / "experiments.yaml");
+    const std::string text((std::istreambuf_iterator<char>(written)),
+                           std::istreambuf_iterator<char>());
+    CHECK_THAT(text, Catch::Contains("plate_diameter_m: 0.05}") &&
+                         !Catch::Contains("0.050000000000000003"));
 }
 
 TEST_CASE("import csv reads a file as the diagnosis does, and a failed import leaves the folder "

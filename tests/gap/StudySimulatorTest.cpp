@@ -592,3 +592,23 @@ TEST_CASE("an experiment loaded at another speed than its test is simulated at a
     CHECK(addRateCheckWhereSpeedDiffers(base, setWith(0.003)).empty());
     CHECK(base.checks.at("rate") == 0.25);
 }
+
+TEST_CASE("a condition the test needs, given under another name, is named as likely misspelt",
+          "[gap][simulator]") {
+    // The reading says `plate_diam_m` is not simulated; the error that follows must not leave
+    // the user to connect it with the plate_diameter_m it lacks.
+    const BaseModel base = loadBaseModel(kDir + "/base.yaml");
+    Experiment plate = plateExperiment("p", {}, {});
+    plate.numbers.erase("plate_diameter_m");
+    plate.numbers["plate_diam_m"] = 0.02;
+    ExperimentSet set;
+    set.name = "misspelt";
+    set.experiments = {plate};
+    const StudySimulator sim(base, (freshScratch("grainlink-gap-misspelt") / "sims").string(), {});
+    VariantRequest plain;
+    plain.label = "base";
+    CHECK_THROWS_WITH(sim.plan(set, {plain}),
+                      Catch::Contains("experiment 'p' (plate_sinkage) needs the condition "
+                                      "'plate_diameter_m' (it gives 'plate_diam_m', which nothing "
+                                      "reads: misspelt?)"));
+}
