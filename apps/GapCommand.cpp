@@ -136,6 +136,9 @@ int printPlan(const gap::DiagnosisPlan &plan, const gap::ExperimentSet &set,
     for (const auto &[name, why] : plan.inapplicable)
         std::printf("\n  not applicable: %s: %s", name.c_str(), why.c_str());
     std::printf("\n");
+    for (const auto &[name, why] : plan.probes_refused)
+        std::printf("probe %s (an experiment the diagnosis may propose) cannot run: %s\n",
+                    name.c_str(), why.c_str());
     // Scenarios are checked here, as a study checks its points before it runs one.
     const auto first = sim.plan(set, plan.first);
     auto all = plan.first;

@@ -335,6 +335,26 @@ std::string effectSignatures(const Effect &raw, const YAML::Node &reference,
             requests.clear();
             return "at strength " + fmt(r.strength) + " it is no valid scenario here: " + why;
         }
+    // Edits of keys this base lacks are skipped (a scale of an absent damping, a catalogue
+    // written for other bases): where every variant runs the base's own scenarios, the effect
+    // would be fitted as "no change" everywhere. A measuring-chain effect changes no run.
+    if (resolved.kind != Effect::Kind::Measurement && !requests.empty()) {
+        VariantRequest base{"base", nullptr, 0.0, nullptr, 0.0, "", requests.front().seeds};
+        const std::vector<std::string> base_ids = simulator.runIds(set, base);
+        const bool changes =
+            base_ids.empty() ||
+            std::any_of(requests.begin(), requests.end(), [&](const VariantRequest &r) {
+                return simulator.runIds(set, r) != base_ids;
+            });
+        if (!changes) {
+            std::string keys;
+            for (const EffectEdit &edit : resolved.edits)
+                keys += (keys.empty() ? "" : ", ") + edit.key +
+                        (edit.where.empty() ? "" : " (" + edit.where + ")");
+            requests.clear();
+            return "its edits change nothing in this base's runs (keys it lacks? " + keys + ")";
+        }
+    }
     return "";
 }
 
@@ -361,6 +381,11 @@ DiagnosisPlan planDiagnosis(const ExperimentSet &set, const std::vector<const Ef
                 P.signatures.push_back(std::move(r));
         }
     }
+    for (const ExperimentSet &probe : simulator.probes(set))
+        if (const std::string why = simulator.refusal(
+                probe, {"probe base", nullptr, 0.0, nullptr, 0.0, "", opt.signature_seeds});
+            !why.empty())
+            P.probes_refused.emplace_back(probe.name, why);
     return P;
 }
 
@@ -1132,7 +1157,14 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                             {name, raw ? strengthText(*raw, live[i].result.fit.strength) : "",
                              0.0, 0.0});
                     }
-            const auto rows = simulator.simulate(probe, pd, req);
+            // A probe the base describes badly costs the proposal, never the diagnosis made.
+            std::vector<Eigen::MatrixXd> rows;
+            try {
+                rows = simulator.simulate(probe, pd, req);
+            } catch (const std::exception &e) {
+                log("probe " + probe.name + " not run: " + e.what());
+                continue;
+            }
             for (const auto &r : req)
                 D.simulations += r.seeds;
             const ProbeSeparation ps = probeSeparation(rows);

@@ -852,6 +852,16 @@ std::string StudySimulator::refusal(const ExperimentSet &design,
     return "";
 }
 
+std::vector<std::string> StudySimulator::runIds(const ExperimentSet &design,
+                                                const VariantRequest &request) const {
+    std::vector<Slot> slots;
+    const study::Study st = studyOf(design, groups(design), {request}, slots);
+    std::vector<std::string> ids;
+    for (const study::Point &p : st.points)
+        ids.push_back(p.id);
+    return ids;
+}
+
 StudySimulator::RunCount StudySimulator::plan(const ExperimentSet &design,
                                               const std::vector<VariantRequest> &requests) const {
     std::vector<Slot> slots;

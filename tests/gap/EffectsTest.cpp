@@ -58,6 +58,14 @@ TEST_CASE("effects resolve their off value against the base", "[gap][effects]") 
     // Walls without their own friction use the grains': tan 32 deg.
     CHECK(resolveAgainst(c.find("wall_friction"), base).prior.off ==
           Approx(std::tan(32.0 * M_PI / 180.0)));
+    // A base whose walls and tool have laws of their own: those are the effects' off values,
+    // not the grains' (the base's runs were made with them).
+    YAML::Node own = YAML::Clone(base);
+    own["soil"]["contact_wall"]["tangential"]["stick_angle_deg"] = 20.0;
+    own["soil"]["contact_tool"]["tangential"]["friction_coefficient"] = 0.4;
+    CHECK(resolveAgainst(c.find("wall_friction"), own).prior.off ==
+          Approx(std::tan(20.0 * M_PI / 180.0)));
+    CHECK(resolveAgainst(c.find("tool_friction"), own).prior.off == Approx(0.4));
     CHECK(resolveAgainst(c.find("polydispersity"), base).prior.off == Approx(0.1));
     CHECK(resolveAgainst(c.find("grain_stiffness"), base).prior.off == 1.0);
     CHECK(inapplicable(c.find("grain_shape"), base).find("the base has 'epsd'") !=

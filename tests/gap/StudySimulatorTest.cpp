@@ -612,3 +612,53 @@ TEST_CASE("a condition the test needs, given under another name, is named as lik
                                       "'plate_diameter_m' (it gives 'plate_diam_m', which nothing "
                                       "reads: misspelt?)"));
 }
+
+TEST_CASE("the plan names an effect that changes none of the base's runs and a proposed "
+          "experiment the base cannot run",
+          "[gap][simulator]") {
+    // A user's catalogue entry whose every key is misspelt would be fitted as an effect that
+    // changes nothing; a probe whose condition is misspelt stopped a finished diagnosis at its
+    // very end, when it proposed the next experiment.
+    const fs::path scratch = freshScratch("grainlink-gap-plan-refusals");
+    const std::string cmu = std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml";
+    std::ifstream in(cmu);
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string probe = "{normal_stress_Pa: 10000}";
+    REQUIRE(text.find(probe) != std::string::npos);
+    text.replace(text.find(probe), probe.size(), "{normal_stres_Pa: 10000}");
+    std::ofstream(scratch / "base.yaml") << text;
+    std::ofstream(scratch / "effects.yaml")
+        << "effects:\n"
+           "  - name: wet_density\n"
+           "    description: pore water adds to the bulk weight\n"
+           "    acts_on: grain-grain\n"
+           "    strength: {parameter: f, unit: \"-\", prior: [1, 1.3], off: 1, signature: [1.1, "
+           "1.25]}\n"
+           "    edits:\n"
+           "      - {key: soil.material.density_kg_m, scale: s}\n";
+    const EffectCatalogue c =
+        mergeEffects(loadEffects(std::string(GRAINLINK_SOURCE_DIR) + "/data/effects.yaml"),
+                     loadEffects((scratch / "effects.yaml").string()));
+    const BaseModel base = loadBaseModel((scratch / "base.yaml").string());
+    ExperimentSet set;
+    set.name = "plan";
+    set.experiments = {plateExperiment("a", {}, {{"box", "small"}}),
+                       plateExperiment("b", {}, {{"box", "small"}})};
+    set.experiments[1].numbers["plate_diameter_m"] = 0.08;
+    const StudySimulator sim(base, (scratch / "sims").string(), {});
+    DiagnosisOptions o;
+    const DiagnosisPlan plan =
+        planDiagnosis(set, {&c.find("wet_density"), &c.find("grain_density")}, sim, o);
+    REQUIRE(plan.inapplicable.size() == 1);
+    CHECK(plan.inapplicable[0].first == "wet_density");
+    CHECK_THAT(plan.inapplicable[0].second,
+               Catch::Contains("its edits change nothing in this base's runs") &&
+                   Catch::Contains("soil.material.density_kg_m (") &&
+                   Catch::Contains("effects.yaml:7)"));
+    CHECK(plan.applicable == std::vector<std::string>{"grain_density"});
+    REQUIRE(plan.probes_refused.size() == 1);
+    CHECK_THAT(plan.probes_refused[0].second,
+               Catch::Contains("needs the condition 'normal_stress_Pa' (it gives "
+                               "'normal_stres_Pa'"));
+    fs::remove_all(scratch);
+}

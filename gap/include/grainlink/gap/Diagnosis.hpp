@@ -58,6 +58,14 @@ public:
         (void)request;
         return "";
     }
+    /// The simulations `request` makes on `design`, by their cache ids: two requests with the
+    /// same ids run the same scenarios. Empty where the simulator cannot tell.
+    virtual std::vector<std::string> runIds(const ExperimentSet &design,
+                                            const VariantRequest &request) const {
+        (void)design;
+        (void)request;
+        return {};
+    }
     /// Experiments the simulator runs on the same beds (a seed's one packing) share a group:
     /// held-out evidence is counted per group, since the model's error from its few beds is
     /// shared by every experiment in them. Default: each experiment its own beds.
@@ -211,6 +219,9 @@ struct DiagnosisPlan {
     std::vector<VariantRequest> signatures; ///< every applicable effect's strengths
     std::vector<std::string> applicable;    ///< effect names
     std::vector<std::pair<std::string, std::string>> inapplicable; ///< effect, why not
+    /// Proposed experiments (Simulator::probes) the base cannot run: probe, why not. The
+    /// diagnosis leaves them out of its proposal.
+    std::vector<std::pair<std::string, std::string>> probes_refused;
 };
 DiagnosisPlan planDiagnosis(const ExperimentSet &set, const std::vector<const Effect *> &effects,
                             const Simulator &simulator, const DiagnosisOptions &opt);

@@ -65,6 +65,8 @@ public:
     std::vector<ExperimentSet> probes(const ExperimentSet &design) const override;
     YAML::Node referenceScenario() const override;
     std::string refusal(const ExperimentSet &design, const VariantRequest &request) const override;
+    std::vector<std::string> runIds(const ExperimentSet &design,
+                                    const VariantRequest &request) const override;
     /// One type in one box: its runs at one seed share one cached packing.
     std::string bedGroup(const Experiment &experiment) const override;
 
