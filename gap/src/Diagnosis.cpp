@@ -367,6 +367,9 @@ DiagnosisPlan planDiagnosis(const ExperimentSet &set, const std::vector<const Ef
     P.measured = measure(set, P.design);
     P.held_out = heldOutIds(set, opt);
     P.first = firstRequests(simulator, opt);
+    // The base's own error first: every effect's variants would fail with it too.
+    if (const std::string why = simulator.refusal(set, P.first.front()); !why.empty())
+        throw std::invalid_argument(why);
     const YAML::Node reference = simulator.referenceScenario();
     for (const Effect *raw : effects) {
         Effect resolved;

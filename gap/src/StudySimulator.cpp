@@ -852,6 +852,73 @@ std::string StudySimulator::refusal(const ExperimentSet &design,
     return "";
 }
 
+namespace {
+
+/// Where in the base file `key` (a dotted path a generated scenario's error names, such as
+/// soil.material.youngs_modulus_pa) was written: in its soil, a test's soil or section, a
+/// box's or a condition's soil. "" where it is in none of them (a value the diagnosis made).
+std::string baseLineOf(const std::string &base_path, const std::string &key) {
+    std::vector<std::string> parts;
+    for (std::size_t a = 0, b; a <= key.size(); a = b + 1) {
+        b = std::min(key.find('.', a), key.size());
+        parts.push_back(key.substr(a, b - a));
+    }
+    const auto walk = [&](ConfigNode node, std::size_t from) -> std::optional<int> {
+        for (std::size_t i = from; i < parts.size(); ++i) {
+            const std::string &p = parts[i];
+            const bool index = !p.empty() && p.find_first_not_of("0123456789") == std::string::npos;
+            if (index && node.yaml().IsSequence() && std::stoul(p) < node.yaml().size())
+                node = node.items()[std::stoul(p)];
+            else if (node.yaml().IsMap() && node.has(p))
+                node = node[p];
+            else
+                return std::nullopt;
+        }
+        return node.line();
+    };
+    std::vector<std::pair<ConfigNode, std::size_t>> roots; // where the key may start
+    try {
+        const ConfigNode root = ConfigNode::loadFile(base_path);
+        roots.emplace_back(root, 0);
+        for (const char *overlays : {"tests", "boxes"})
+            if (root.has(overlays))
+                for (const std::string &k : root[overlays].keys())
+                    roots.emplace_back(root[overlays][k], 0);
+        if (root.has("conditions"))
+            for (const std::string &c : root["conditions"].keys())
+                for (const std::string &v : root["conditions"][c].keys())
+                    roots.emplace_back(root["conditions"][c][v], 0);
+        std::string lines;
+        for (const auto &[node, from] : roots)
+            if (const auto line = walk(node, from))
+                lines += (lines.empty() ? "" : ", ") + std::to_string(*line);
+        return lines.empty() ? "" : base_path + ":" + lines;
+    } catch (const std::exception &) {
+        return "";
+    }
+}
+
+} // namespace
+
+void StudySimulator::validated(const study::Study &st) const {
+    try {
+        study::validate(st);
+    } catch (const std::exception &e) {
+        // A generated scenario's error names its key; say where the base wrote it.
+        const std::string what = e.what();
+        const auto at = what.find("key '");
+        if (at != std::string::npos) {
+            const auto end = what.find('\'', at + 5);
+            if (end != std::string::npos)
+                if (const std::string where =
+                        baseLineOf(base_.path, what.substr(at + 5, end - at - 5));
+                    !where.empty())
+                    throw std::invalid_argument(what + " (written in " + where + ")");
+        }
+        throw;
+    }
+}
+
 std::vector<std::string> StudySimulator::runIds(const ExperimentSet &design,
                                                 const VariantRequest &request) const {
     std::vector<Slot> slots;
@@ -866,7 +933,7 @@ StudySimulator::RunCount StudySimulator::plan(const ExperimentSet &design,
                                               const std::vector<VariantRequest> &requests) const {
     std::vector<Slot> slots;
     const study::Study st = studyOf(design, groups(design), requests, slots);
-    study::validate(st);
+    validated(st);
     RunCount count;
     for (const study::PointResult &r : study::collect(st)) {
         ++count.runs;
@@ -882,6 +949,7 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
     const auto gs = groups(design);
     std::vector<Slot> slots;
     const study::Study st = studyOf(design, gs, requests, slots);
+    validated(st);
     const auto results = study::run(st, executor_);
     for (const auto &res : results)
         (res.ran_now ? runs_done_ : runs_reused_)++;

@@ -96,6 +96,8 @@ public:
     RunCount plan(const ExperimentSet &design, const std::vector<VariantRequest> &requests) const;
 
 private:
+    /// study::validate, its error naming where the base file wrote the key it names.
+    void validated(const study::Study &st) const;
     /// Where one (request, seed, test group) runs: a point of the study.
     struct Slot {
         std::size_t request;
