@@ -662,3 +662,31 @@ TEST_CASE("the plan names an effect that changes none of the base's runs and a p
                                "'normal_stres_Pa'"));
     fs::remove_all(scratch);
 }
+
+TEST_CASE("a typo in the base model is named where the base wrote it, not only in the scenario "
+          "generated from it",
+          "[gap][simulator]") {
+    const fs::path scratch = freshScratch("grainlink-gap-base-typo");
+    std::ifstream in(kDir + "/base.yaml");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string key = "youngs_modulus_Pa";
+    const std::size_t at = text.find(key);
+    REQUIRE(at != std::string::npos);
+    const int line = int(std::count(text.begin(), text.begin() + long(at), '\n')) + 1;
+    text.replace(at, key.size(), "youngs_modulus_pa");
+    const std::string path = (scratch / "base.yaml").string();
+    std::ofstream(path) << text;
+    const BaseModel base = loadBaseModel(path);
+    ExperimentSet set;
+    set.name = "typo";
+    set.experiments = {plateExperiment("p", {}, {})};
+    set.experiments[0].numbers["plate_diameter_m"] = 0.02;
+    const StudySimulator sim(base, (scratch / "sims").string(), {});
+    VariantRequest plain;
+    plain.label = "base";
+    CHECK_THROWS_WITH(
+        sim.plan(set, {plain}),
+        Catch::Contains("unknown key 'soil.material.youngs_modulus_pa'") &&
+            Catch::Contains("(written in " + path + ":" + std::to_string(line) + ")"));
+    fs::remove_all(scratch);
+}
