@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <set>
 #include <sstream>
 
 namespace grainlink::config {
@@ -12,6 +13,20 @@ namespace {
 std::string stem(const std::string &key) {
     const auto cut = key.rfind('_');
     return cut == std::string::npos ? key : key.substr(0, cut);
+}
+
+/// Whether `a` and `b` are one quantity in two units: the same stem, and each ending in a
+/// unit (y_sigam beside y_relative is a typo, not a unit).
+bool otherUnit(const std::string &a, const std::string &b) {
+    static const std::set<std::string> units = {
+        "s",  "ms",  "us",  "min", "h", "m",  "mm", "cm",  "um",     "km",
+        "Pa", "kPa", "MPa", "GPa", "N", "kN", "mN", "deg", "rad",    "kg",
+        "g",  "m2",  "m3",  "s2",  "J", "W",  "Hz", "K",   "percent"};
+    const auto suffix = [](const std::string &k) {
+        const auto cut = k.rfind('_');
+        return cut == std::string::npos ? std::string() : k.substr(cut + 1);
+    };
+    return a != b && stem(a) == stem(b) && units.count(suffix(a)) && units.count(suffix(b));
 }
 } // namespace
 
@@ -88,7 +103,7 @@ ConfigNode ConfigNode::operator[](const std::string &key) const {
         // A key with the same stem but another unit suffix is a wrong unit, not a missing key.
         for (const auto &entry : node_) {
             const std::string other = keyText(entry.first);
-            if (other != key && stem(other) == stem(key)) {
+            if (otherUnit(other, key)) {
                 std::ostringstream out;
                 out << *file_ << ":" << entry.first.Mark().line + 1 << ": unknown key '"
                     << (path_.empty() ? other : path_ + "." + other)
@@ -288,7 +303,7 @@ void ConfigNode::finish() const {
             continue;
         std::string hint;
         for (const std::string &known : *used_)
-            if (stem(known) == stem(key))
+            if (otherUnit(known, key))
                 hint = " (wrong unit? this key is '" + known + "')";
         std::ostringstream out;
         out << *file_ << ":" << entry.first.Mark().line + 1 << ": unknown key '"

@@ -217,6 +217,16 @@ void setBedDepth(YAML::Node soil, const Experiment &e) {
     const dem::Vec3 span = spec.region_upper_m - spec.region_lower_m;
     const double grain = 4.0 / 3.0 * M_PI * spec.radius.meanCubedRadius();
     const double depth = it->second;
+    // Deeper than the bin is high: most often a depth in mm. Said here, with the experiment,
+    // rather than as the grain count it would become.
+    for (const YAML::Node &w : soil["walls"])
+        if (w["type"] && w["type"].as<std::string>() == "box" && w["upper_m"] &&
+            spec.region_lower_m.z() + depth > w["upper_m"][2].as<double>())
+            throw std::invalid_argument(e.source + ": experiment '" + e.id + "': bed_depth_m " +
+                                        std::to_string(depth) + " is deeper than the base's bin '" +
+                                        w["name"].as<std::string>("box") + "' is high (" +
+                                        std::to_string(w["upper_m"][2].as<double>()) +
+                                        " m): a depth in mm?");
     const double count = std::ceil(kOverfill * depth * span.x() * span.y() * kDensestPour / grain);
     const double height = std::max(span.z(), span.z() * count / double(spec.count));
     deposition["count"] = static_cast<long long>(count);

@@ -26,6 +26,11 @@ TEST_CASE("a missing key, an unknown key and a wrong unit name the file, key and
     const ConfigNode c = load("sim:\n  time_step_ms: 0.01\n");
     CHECK_THROWS_WITH(c["sim"]["time_step_s"],
                       Contains("s.yaml:2: unknown key 'sim.time_step_ms' (wrong unit?"));
+    // A typo that shares a stem with a known key is no other unit of it.
+    const ConfigNode u = load("u:\n  y_relative: 0.1\n  y_sigam: 2\n")["u"];
+    (void)u["y_relative"].number();
+    CHECK_THROWS_WITH(u.finish(),
+                      Contains("s.yaml:3: unknown key 'u.y_sigam'") && !Contains("wrong unit"));
 }
 
 TEST_CASE("a key given twice is refused with both lines, whichever way it is read",

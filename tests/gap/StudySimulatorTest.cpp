@@ -690,3 +690,20 @@ TEST_CASE("a typo in the base model is named where the base wrote it, not only i
             Catch::Contains("(written in " + path + ":" + std::to_string(line) + ")"));
     fs::remove_all(scratch);
 }
+
+TEST_CASE("a bed deeper than the base's bin is high is named with its experiment",
+          "[gap][simulator]") {
+    // bed_depth_m: 60 (mm meant) became a grain count of 5e7, refused as that count.
+    const BaseModel base = loadBaseModel(kDir + "/base.yaml");
+    ExperimentSet set;
+    set.name = "deep";
+    set.experiments = {plateExperiment("p", {{"bed_depth_m", 60.0}}, {})};
+    set.experiments[0].numbers["plate_diameter_m"] = 0.02;
+    const StudySimulator sim(base, (freshScratch("grainlink-gap-too-deep") / "sims").string(), {});
+    VariantRequest plain;
+    plain.label = "base";
+    CHECK_THROWS_WITH(sim.plan(set, {plain}),
+                      Catch::Contains("experiment 'p': bed_depth_m 60") &&
+                          Catch::Contains("is deeper than the base's bin") &&
+                          Catch::Contains("a depth in mm?"));
+}
