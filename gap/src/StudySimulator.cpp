@@ -61,6 +61,13 @@ void mergeInto(YAML::Node target, const YAML::Node &over) {
     }
 }
 
+/// Whether a `box` label gives this type's test its container: a direct shear test builds its
+/// own box (the lab refuses walls for it), so a box's walls, region and grain count would
+/// only break it.
+bool containerOf(ExperimentType type) {
+    return type != ExperimentType::DirectShear;
+}
+
 std::string boxOf(const Experiment &e) {
     const auto it = e.labels.find("box");
     return it == e.labels.end() ? "" : it->second;
@@ -455,7 +462,9 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
             const std::vector<std::string> used = simulatedConditions(e.type);
             for (const auto &[key, value] : e.conditionText()) {
                 const auto described = base.conditions.find(key);
-                if (described != base.conditions.end() || key == "box") {
+                if (key == "box" && !containerOf(e.type)) {
+                    unused[key].push_back(e.id); // the test builds its own box
+                } else if (described != base.conditions.end() || key == "box") {
                     // A text condition the base gives soils for: this value among them?
                     if (described == base.conditions.end() || !described->second.count(value))
                         undescribed[{key, value}].push_back(e.id);
@@ -677,7 +686,7 @@ std::vector<StudySimulator::Overlay> StudySimulator::overlaysOf(const Experiment
     std::vector<Overlay> out;
     for (const auto &[condition, values] : base_.conditions) {
         const auto label = e.labels.find(condition);
-        if (label == e.labels.end())
+        if (label == e.labels.end() || (condition == "box" && !containerOf(e.type)))
             continue;
         const auto soil = values.find(label->second);
         if (soil != values.end())

@@ -707,3 +707,31 @@ TEST_CASE("a bed deeper than the base's bin is high is named with its experiment
                           Catch::Contains("is deeper than the base's bin") &&
                           Catch::Contains("a depth in mm?"));
 }
+
+TEST_CASE("a direct shear test's box label gives it no container: the test builds its own",
+          "[gap][simulator]") {
+    // The CI base's `narrow` box has walls; merged into a shear test they were refused as
+    // soil.walls, a key the user never wrote for it.
+    const BaseModel base = loadBaseModel(kDir + "/base.yaml");
+    Experiment shear;
+    shear.id = "shear";
+    shear.type = ExperimentType::DirectShear;
+    shear.x_name = "shear_displacement";
+    shear.observables = {"shear_stress_Pa"};
+    shear.numbers = {{"normal_stress_Pa", 4000.0}};
+    shear.labels = {{"box", "narrow"}};
+    shear.trials.push_back(Trial{});
+    shear.trials[0].curves["shear_stress_Pa"] = Curve{{0.0, 0.001, 0.002}, {0.0, 2e3, 3e3}};
+    ExperimentSet set;
+    set.name = "shear-box";
+    set.experiments = {shear};
+    std::vector<std::string> left_out;
+    const ExperimentSet kept = simulable(set, base, left_out);
+    REQUIRE(kept.notes.size() == 1);
+    CHECK_THAT(kept.notes[0], Catch::Contains("condition 'box' is not simulated") &&
+                                  Catch::Contains("in shear (1 experiment"));
+    const StudySimulator sim(base, (freshScratch("grainlink-gap-shear-box") / "sims").string(), {});
+    VariantRequest plain;
+    plain.label = "base";
+    CHECK_NOTHROW(sim.plan(kept, {plain}));
+}
