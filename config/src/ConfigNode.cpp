@@ -1,5 +1,6 @@
 #include "grainlink/config/ConfigNode.hpp"
 
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -19,12 +20,16 @@ std::string stem(const std::string &key) {
 /// unit (y_sigam beside y_relative is a typo, not a unit).
 bool otherUnit(const std::string &a, const std::string &b) {
     static const std::set<std::string> units = {
+        // lower case: youngs_modulus_pa too
         "s",  "ms",  "us",  "min", "h", "m",  "mm", "cm",  "um",     "km",
-        "Pa", "kPa", "MPa", "GPa", "N", "kN", "mN", "deg", "rad",    "kg",
-        "g",  "m2",  "m3",  "s2",  "J", "W",  "Hz", "K",   "percent"};
+        "pa", "kpa", "mpa", "gpa", "n", "kn", "mn", "deg", "rad",    "kg",
+        "g",  "m2",  "m3",  "s2",  "j", "w",  "hz", "k",   "percent"};
     const auto suffix = [](const std::string &k) {
         const auto cut = k.rfind('_');
-        return cut == std::string::npos ? std::string() : k.substr(cut + 1);
+        std::string s = cut == std::string::npos ? std::string() : k.substr(cut + 1);
+        for (char &c : s)
+            c = char(std::tolower(static_cast<unsigned char>(c)));
+        return s;
     };
     return a != b && stem(a) == stem(b) && units.count(suffix(a)) && units.count(suffix(b));
 }
