@@ -10,8 +10,8 @@ using namespace grainlink;
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t *data, std::size_t size) {
     const std::string folder = fz::freshFolder();
     gap::CsvImport csv;
-    csv.file = fz::writeFile(folder, "plate.csv",
-                             std::string_view(reinterpret_cast<const char *>(data), size));
+    csv.files = {fz::writeFile(folder, "plate.csv",
+                               std::string_view(reinterpret_cast<const char *>(data), size))};
     csv.id = "plate";
     csv.type = "plate_sinkage";
     csv.x_column = "z_mm";
