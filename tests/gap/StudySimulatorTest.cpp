@@ -68,7 +68,8 @@ void forEveryVariant(const StudySimulator &sim,
     }
 }
 
-/// A 60 mm plate's sinkage curve to 10 mm with more `numbers` and the text conditions `labels`.
+/// A 60 mm plate's sinkage curve to 10 mm with more `numbers` (a plate_diameter_m among them
+/// replaces the 60 mm) and the text conditions `labels`.
 Experiment plateExperiment(const std::string &id, const std::map<std::string, double> &numbers,
                            const std::map<std::string, std::string> &labels) {
     Experiment e;
@@ -77,12 +78,36 @@ Experiment plateExperiment(const std::string &id, const std::map<std::string, do
     e.x_name = "sinkage";
     e.observables = {"pressure_Pa"};
     e.numbers = {{"plate_diameter_m", 0.06}};
-    e.numbers.insert(numbers.begin(), numbers.end());
+    for (const auto &[key, value] : numbers)
+        e.numbers[key] = value;
     e.labels = labels;
     Trial t;
     t.curves["pressure_Pa"] = Curve{{0.0, 0.005, 0.01}, {0.0, 1e4, 2e4}};
     e.trials.push_back(t);
     return e;
+}
+
+/// A direct shear curve at 4 kPa to 2 mm with more `numbers` and the text conditions `labels`.
+Experiment shearExperiment(const std::string &id, const std::map<std::string, double> &numbers,
+                           const std::map<std::string, std::string> &labels) {
+    Experiment e;
+    e.id = id;
+    e.type = ExperimentType::DirectShear;
+    e.x_name = "shear_displacement";
+    e.observables = {"shear_stress_Pa"};
+    e.numbers = {{"normal_stress_Pa", 4000.0}};
+    for (const auto &[key, value] : numbers)
+        e.numbers[key] = value;
+    e.labels = labels;
+    e.trials.push_back(Trial{});
+    e.trials[0].curves["shear_stress_Pa"] = Curve{{0.0, 0.001, 0.002}, {0.0, 2e3, 3e3}};
+    return e;
+}
+
+/// The CMU base model's text, for a test to edit.
+std::string cmuBaseText() {
+    std::ifstream in(std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml");
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
 }
 
 /// A fresh scratch folder under the temporary directory.
@@ -116,14 +141,16 @@ grainlink::dem::DemScenario labSoilOf(const StudySimulator &sim, const Experimen
 TEST_CASE("every effect and numerical check on the self-tests' designs is a scenario the lab "
           "accepts",
           "[gap][simulator]") {
-    const std::string kDir = GENERATE(std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-ci",
-                                      std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-full");
+    const std::string kDir =
+        GENERATE(std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-ci",
+                 std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-full");
     const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-simulator-test";
     fs::remove_all(scratch);
     fs::create_directories(scratch);
     const StudySimulator sim(loadBaseModel(kDir + "/base.yaml"), (scratch / "sims").string(), {});
     const Design design = loadDesign(kDir + "/design.yaml");
-    forEveryVariant(sim, [&](const VariantRequest &r) { acceptedByTheLab(sim, design, r, scratch); });
+    forEveryVariant(sim,
+                    [&](const VariantRequest &r) { acceptedByTheLab(sim, design, r, scratch); });
     fs::remove_all(scratch);
 }
 
@@ -166,8 +193,11 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
         e.x_name = "slip";
         e.scatter = true;
         e.observables = {"traction_N", "vertical_load_N", "side_force_N"};
-        e.numbers = {{"wheel_radius_m", 0.058}, {"wheel_width_m", 0.05},
-                     {"grouser_height_m", grouser}, {"slip_angle_deg", beta}, {"load_N", 21.5}};
+        e.numbers = {{"wheel_radius_m", 0.058},
+                     {"wheel_width_m", 0.05},
+                     {"grouser_height_m", grouser},
+                     {"slip_angle_deg", beta},
+                     {"load_N", 21.5}};
         for (double s : {-0.5, -0.2, 0.0, 0.2, 0.4, 0.6, 0.8}) {
             Trial t;
             for (const auto &o : e.observables)
@@ -291,7 +321,8 @@ TEST_CASE("a wheel design makes a twin folder the diagnosis reads", "[gap][twin]
     TwinKey key;
     key.seed = 3;
     key.noise = key.level_noise = 0.0;
-    writeTwin(design, curves, key, (scratch / "twin").string(), (scratch / "twin.key.json").string());
+    writeTwin(design, curves, key, (scratch / "twin").string(),
+              (scratch / "twin.key.json").string());
 
     const ExperimentSet read = loadExperiments((scratch / "twin").string());
     const Experiment &w = read.find("wheel");
@@ -397,9 +428,7 @@ TEST_CASE("a text condition the base describes gives its experiments their soil:
     // The CMU base with a dense preparation (more grains in the same box) besides its own bed:
     // plates prepared dense, loose (which the base leaves to its own soil) and unsaid.
     const fs::path scratch = freshScratch("grainlink-gap-preparation-test");
-    const std::string cmu = std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml";
-    std::ifstream in(cmu);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string text = cmuBaseText();
     text += "conditions:\n  preparation:\n    dense: {soil: {deposition: {count: 5000}}}\n";
     std::ofstream(scratch / "base.yaml") << text;
     const BaseModel base = loadBaseModel((scratch / "base.yaml").string());
@@ -445,23 +474,16 @@ TEST_CASE("an experiment's bed depth makes its bed: poured deeper and struck off
     // The CI self-test's base (a 50 mm box, grains of 1.8-2 mm poured about 25 mm deep): plates
     // on beds of 30 and 15 mm and one without the condition, and a shear box given a depth.
     const BaseModel base = loadBaseModel(kDir + "/base.yaml");
-    Experiment shear;
-    shear.id = "shear";
-    shear.type = ExperimentType::DirectShear;
-    shear.x_name = "shear_displacement";
-    shear.observables = {"shear_stress_Pa"};
-    shear.numbers = {{"normal_stress_Pa", 4000.0}, {"bed_depth_m", 0.03}};
-    shear.trials.push_back(Trial{});
-    shear.trials[0].curves["shear_stress_Pa"] = Curve{{0.0, 0.001, 0.002}, {0.0, 2e3, 3e3}};
+    const Experiment shear = shearExperiment("shear", {{"bed_depth_m", 0.03}}, {});
     ExperimentSet set;
     set.name = "depths";
-    set.experiments = {plateExperiment("deep", {{"bed_depth_m", 0.03}}, {}),
-                       plateExperiment("shallow", {{"bed_depth_m", 0.015}}, {}),
-                       plateExperiment("as_base", {}, {}),
-                       plateExperiment("no_depth", {{"bed_depth_m", -0.01}}, {}), shear};
-    for (Experiment &e : set.experiments)
-        if (e.type == ExperimentType::PlateSinkage)
-            e.numbers["plate_diameter_m"] = 0.04; // in the 50 mm box
+    const auto plate = [](const std::string &id, std::map<std::string, double> numbers) {
+        numbers["plate_diameter_m"] = 0.04; // in the 50 mm box
+        return plateExperiment(id, numbers, {});
+    };
+    set.experiments = {plate("deep", {{"bed_depth_m", 0.03}}),
+                       plate("shallow", {{"bed_depth_m", 0.015}}), plate("as_base", {}),
+                       plate("no_depth", {{"bed_depth_m", -0.01}}), shear};
     std::vector<std::string> left_out;
     const ExperimentSet kept = simulable(set, base, left_out);
     REQUIRE(left_out.size() == 1);
@@ -598,9 +620,8 @@ TEST_CASE("a condition the test needs, given under another name, is named as lik
     // The reading says `plate_diam_m` is not simulated; the error that follows must not leave
     // the user to connect it with the plate_diameter_m it lacks.
     const BaseModel base = loadBaseModel(kDir + "/base.yaml");
-    Experiment plate = plateExperiment("p", {}, {});
+    Experiment plate = plateExperiment("p", {{"plate_diam_m", 0.02}}, {});
     plate.numbers.erase("plate_diameter_m");
-    plate.numbers["plate_diam_m"] = 0.02;
     ExperimentSet set;
     set.name = "misspelt";
     set.experiments = {plate};
@@ -620,9 +641,7 @@ TEST_CASE("the plan names an effect that changes none of the base's runs and a p
     // changes nothing; a probe whose condition is misspelt stopped a finished diagnosis at its
     // very end, when it proposed the next experiment.
     const fs::path scratch = freshScratch("grainlink-gap-plan-refusals");
-    const std::string cmu = std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/cmu/base.yaml";
-    std::ifstream in(cmu);
-    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::string text = cmuBaseText();
     const std::string probe = "{normal_stress_Pa: 10000}";
     REQUIRE(text.find(probe) != std::string::npos);
     text.replace(text.find(probe), probe.size(), "{normal_stres_Pa: 10000}");
@@ -643,8 +662,7 @@ TEST_CASE("the plan names an effect that changes none of the base's runs and a p
     ExperimentSet set;
     set.name = "plan";
     set.experiments = {plateExperiment("a", {}, {{"box", "small"}}),
-                       plateExperiment("b", {}, {{"box", "small"}})};
-    set.experiments[1].numbers["plate_diameter_m"] = 0.08;
+                       plateExperiment("b", {{"plate_diameter_m", 0.08}}, {{"box", "small"}})};
     const StudySimulator sim(base, (scratch / "sims").string(), {});
     DiagnosisOptions o;
     const DiagnosisPlan plan =
@@ -679,8 +697,7 @@ TEST_CASE("a typo in the base model is named where the base wrote it, not only i
     const BaseModel base = loadBaseModel(path);
     ExperimentSet set;
     set.name = "typo";
-    set.experiments = {plateExperiment("p", {}, {})};
-    set.experiments[0].numbers["plate_diameter_m"] = 0.02;
+    set.experiments = {plateExperiment("p", {{"plate_diameter_m", 0.02}}, {})};
     const StudySimulator sim(base, (scratch / "sims").string(), {});
     VariantRequest plain;
     plain.label = "base";
@@ -697,8 +714,8 @@ TEST_CASE("a bed deeper than the base's bin is high is named with its experiment
     const BaseModel base = loadBaseModel(kDir + "/base.yaml");
     ExperimentSet set;
     set.name = "deep";
-    set.experiments = {plateExperiment("p", {{"bed_depth_m", 60.0}}, {})};
-    set.experiments[0].numbers["plate_diameter_m"] = 0.02;
+    set.experiments = {
+        plateExperiment("p", {{"bed_depth_m", 60.0}, {"plate_diameter_m", 0.02}}, {})};
     const StudySimulator sim(base, (freshScratch("grainlink-gap-too-deep") / "sims").string(), {});
     VariantRequest plain;
     plain.label = "base";
@@ -713,18 +730,9 @@ TEST_CASE("a direct shear test's box label gives it no container: the test build
     // The CI base's `narrow` box has walls; merged into a shear test they were refused as
     // soil.walls, a key the user never wrote for it.
     const BaseModel base = loadBaseModel(kDir + "/base.yaml");
-    Experiment shear;
-    shear.id = "shear";
-    shear.type = ExperimentType::DirectShear;
-    shear.x_name = "shear_displacement";
-    shear.observables = {"shear_stress_Pa"};
-    shear.numbers = {{"normal_stress_Pa", 4000.0}};
-    shear.labels = {{"box", "narrow"}};
-    shear.trials.push_back(Trial{});
-    shear.trials[0].curves["shear_stress_Pa"] = Curve{{0.0, 0.001, 0.002}, {0.0, 2e3, 3e3}};
     ExperimentSet set;
     set.name = "shear-box";
-    set.experiments = {shear};
+    set.experiments = {shearExperiment("shear", {}, {{"box", "narrow"}})};
     std::vector<std::string> left_out;
     const ExperimentSet kept = simulable(set, base, left_out);
     REQUIRE(kept.notes.size() == 1);
