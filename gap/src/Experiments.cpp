@@ -608,12 +608,14 @@ ExperimentSet loadExperiments(const std::string &directory) {
                                    std::to_string(curve.x.size()) + " sample(s) with " + e.x_name +
                                    " and a value; a curve needs two or more");
                     // Every sample at one x: the wrong column, or the x of a constant.
-                    for (const auto &[o, curve] : whole.curves)
+                    for (const auto &[o, curve] : whole.curves) {
+                        const double first = curve.x.front();
                         if (std::all_of(curve.x.begin(), curve.x.end(),
-                                        [&](double x) { return x == curve.x.front(); }))
+                                        [first](double x) { return x == first; }))
                             data["x"].fail(path.string() + ": every sample of '" + o + "' is at " +
-                                           e.x_name + " = " + std::to_string(curve.x.front()) +
+                                           e.x_name + " = " + std::to_string(first) +
                                            ": the x column does not vary (is it the right one?)");
+                    }
                     // A plate or shear curve recorded in time order that runs back after its
                     // largest x (unloaded, reversed) keeps its loading branch: binned with it,
                     // the other branch would read low against a loading-only simulation.
