@@ -353,11 +353,11 @@ void importCsv(const CsvImport &csv, const std::string &out) {
             throw std::invalid_argument(option + ": " + e.what());
         }
     };
-    if (!scalar)
+    if (!scalar) {
         checkUnit("--x " + csv.x_column + ":" + csv.x_unit, csv.x_unit, xNameOf(type));
-    for (const auto &[obs, col] : csv.y)
-        if (!scalar)
+        for (const auto &[obs, col] : csv.y)
             checkUnit("--y " + obs + "=" + col.first + ":" + col.second, col.second, obs);
+    }
 
     // Read and checked before anything is written: an error names the user's file and line.
     TableFormat format;

@@ -882,9 +882,8 @@ std::string baseLineOf(const std::string &base_path, const std::string &key) {
         b = std::min(key.find('.', a), key.size());
         parts.push_back(key.substr(a, b - a));
     }
-    const auto walk = [&](ConfigNode node, std::size_t from) -> std::optional<int> {
-        for (std::size_t i = from; i < parts.size(); ++i) {
-            const std::string &p = parts[i];
+    const auto walk = [&](ConfigNode node) -> std::optional<int> {
+        for (const std::string &p : parts) {
             const bool index = !p.empty() && p.find_first_not_of("0123456789") == std::string::npos;
             if (index && node.yaml().IsSequence() && std::stoul(p) < node.yaml().size())
                 node = node.items()[std::stoul(p)];
@@ -895,21 +894,21 @@ std::string baseLineOf(const std::string &base_path, const std::string &key) {
         }
         return node.line();
     };
-    std::vector<std::pair<ConfigNode, std::size_t>> roots; // where the key may start
+    std::vector<ConfigNode> roots; // where the key may start
     try {
         const ConfigNode root = ConfigNode::loadFile(base_path);
-        roots.emplace_back(root, 0);
+        roots.push_back(root);
         for (const char *overlays : {"tests", "boxes"})
             if (root.has(overlays))
                 for (const std::string &k : root[overlays].keys())
-                    roots.emplace_back(root[overlays][k], 0);
+                    roots.push_back(root[overlays][k]);
         if (root.has("conditions"))
             for (const std::string &c : root["conditions"].keys())
                 for (const std::string &v : root["conditions"][c].keys())
-                    roots.emplace_back(root["conditions"][c][v], 0);
+                    roots.push_back(root["conditions"][c][v]);
         std::string lines;
-        for (const auto &[node, from] : roots)
-            if (const auto line = walk(node, from))
+        for (const ConfigNode &node : roots)
+            if (const auto line = walk(node))
                 lines += (lines.empty() ? "" : ", ") + std::to_string(*line);
         return lines.empty() ? "" : base_path + ":" + lines;
     } catch (const std::exception &) {
@@ -919,23 +918,14 @@ std::string baseLineOf(const std::string &base_path, const std::string &key) {
 
 } // namespace
 
-void StudySimulator::validated(const study::Study &st) const {
-    try {
-        study::validate(st);
-    } catch (const std::exception &e) {
-        // A generated scenario's error names its key; say where the base wrote it.
-        const std::string what = e.what();
-        const auto at = what.find("key '");
-        if (at != std::string::npos) {
-            const auto end = what.find('\'', at + 5);
-            if (end != std::string::npos)
-                if (const std::string where =
-                        baseLineOf(base_.path, what.substr(at + 5, end - at - 5));
-                    !where.empty())
-                    throw std::invalid_argument(what + " (written in " + where + ")");
-        }
-        throw;
-    }
+std::string StudySimulator::withBaseLine(const std::string &what) const {
+    // A generated scenario's error names its key; say where the base wrote it.
+    const auto at = what.find("key '");
+    const auto end = at == std::string::npos ? at : what.find('\'', at + 5);
+    if (end == std::string::npos)
+        return what;
+    const std::string where = baseLineOf(base_.path, what.substr(at + 5, end - at - 5));
+    return where.empty() ? what : what + " (written in " + where + ")";
 }
 
 std::vector<std::string> StudySimulator::runIds(const ExperimentSet &design,
@@ -952,7 +942,11 @@ StudySimulator::RunCount StudySimulator::plan(const ExperimentSet &design,
                                               const std::vector<VariantRequest> &requests) const {
     std::vector<Slot> slots;
     const study::Study st = studyOf(design, groups(design), requests, slots);
-    validated(st);
+    try {
+        study::validate(st);
+    } catch (const std::exception &e) {
+        throw std::invalid_argument(withBaseLine(e.what()));
+    }
     RunCount count;
     for (const study::PointResult &r : study::collect(st)) {
         ++count.runs;
@@ -968,8 +962,13 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
     const auto gs = groups(design);
     std::vector<Slot> slots;
     const study::Study st = studyOf(design, gs, requests, slots);
-    validated(st);
-    const auto results = study::run(st, executor_);
+    const auto results = [&] { // study::run validates every point before it runs one
+        try {
+            return study::run(st, executor_);
+        } catch (const std::exception &e) {
+            throw std::runtime_error(withBaseLine(e.what()));
+        }
+    }();
     for (const auto &res : results)
         (res.ran_now ? runs_done_ : runs_reused_)++;
 

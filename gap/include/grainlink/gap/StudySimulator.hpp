@@ -96,8 +96,8 @@ public:
     RunCount plan(const ExperimentSet &design, const std::vector<VariantRequest> &requests) const;
 
 private:
-    /// study::validate, its error naming where the base file wrote the key it names.
-    void validated(const study::Study &st) const;
+    /// A study's error `what` with where the base file wrote the key it names, if it does.
+    std::string withBaseLine(const std::string &what) const;
     /// Where one (request, seed, test group) runs: a point of the study.
     struct Slot {
         std::size_t request;
