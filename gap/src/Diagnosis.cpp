@@ -885,13 +885,22 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     if (best_no_gap && best_no_gap->explains)
         winner = best_no_gap;
 
-    // Pairs, where no single effect explains the gap and a claim is possible at all (a
-    // resolved base; two or more held-out groups of beds, or one group of two or more
-    // experiments simulated on two or more beds: `compareDensities`).
+    // Pairs, where no single effect explains the gap, none within its prior leaves the design
+    // without a gap, and a claim is possible at all (a resolved base; two or more held-out
+    // groups of beds, or one group of two or more experiments simulated on two or more beds:
+    // `compareDensities`). A single that leaves no gap but misses the level lacks power, not a
+    // second effect: a pair then adds one nothing asks for, and on a design with five seeds a
+    // hidden grain stiffness (p = 0.066 alone) was claimed with wall friction, another sand's
+    // friction as grain stiffness + domain size.
     const bool claim_possible =
         canCarryClaim(D.held_out, bed_keys, meas.keys,
                       std::size_t(std::min<Eigen::Index>(base_rows.rows(), opt.seeds)));
-    if (!any_explains && resolved && claim_possible) {
+    const bool single_leaves_no_gap =
+        std::any_of(D.candidates.begin(), D.candidates.end(), [](const CandidateResult &R) {
+            return R.confirmed && !R.after.gap && !R.fit.at_prior_edge &&
+                   std::isfinite(R.held_out.log_density);
+        });
+    if (!any_explains && !single_leaves_no_gap && resolved && claim_possible) {
         std::vector<std::size_t> pool;
         for (std::size_t i : applicable)
             if (int(pool.size()) < opt.pair_pool && live[i].result.calibration_gain > 0.0)
@@ -1048,6 +1057,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                          "one experiment, or one group the model simulates on a single bed "
                          "(a claim needs two or more held-out experiments and two or more bed "
                          "realisations, numerics.seeds)";
+            else if (single_leaves_no_gap)
+                claim << "unexplained: no catalogued effect predicts the held-out experiments "
+                         "better than the null model and leaves no gap (one leaves no gap "
+                         "alone: no pair is tried)";
             else
                 claim << "unexplained: no catalogued effect, alone or in a pair, predicts the "
                          "held-out experiments better than the null model and leaves no gap";

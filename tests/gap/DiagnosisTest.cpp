@@ -1147,3 +1147,27 @@ TEST_CASE("the separating experiment: a probe's features scored by how far the c
     const ProbeSeparation one = probeSeparation({base.topRows(1), a.topRows(1), b.topRows(1)});
     CHECK(one.chi2.sum() == 0.0);
 }
+
+TEST_CASE("diagnosis: no pair is tried where a single effect within its prior leaves no gap "
+          "without beating the null",
+          "[gap][diagnosis]") {
+    // The hidden cohesion's confirming beds scatter so much that it misses the level while its
+    // mean leaves no gap: the held-out plates lack the power, not the single effect the
+    // explanation. A pair would add an effect that nothing asks for (on the full self-test's
+    // powered design a hidden grain stiffness, p = 0.066, was claimed as stiffness + wall
+    // friction); the outcome is unexplained, the single named closest.
+    const EffectCatalogue c = shippedEffects();
+    AnalyticSimulator sim;
+    sim.confirm_scatter_of["cohesion"] = 0.125;
+    const Diagnosis d =
+        diagnose(measuredSet({"cohesion", 4.0e4}, 7), c.diagnosable(), sim, analyticOptions());
+    INFO(d.claim);
+    const CandidateResult &single = candidate(d, "cohesion");
+    REQUIRE(single.confirmed);
+    REQUIRE_FALSE(single.beats_null);
+    REQUIRE_FALSE(single.after.gap);
+    REQUIRE_FALSE(single.fit.at_prior_edge);
+    CHECK(d.pairs.empty());
+    CHECK(d.outcome == Diagnosis::Outcome::Unexplained);
+    CHECK(d.best_model == "cohesion");
+}
