@@ -193,6 +193,8 @@ GapCommand::GapCommand(CLI::App &app) {
     twin_->add_option("--seed", seed_, "seed of the beds and the draws");
     twin_->add_option("--noise", noise_, "relative sd of every sample");
     twin_->add_option("--level-noise", level_noise_, "relative sd of each trial's level");
+    twin_->add_flag("--own-beds", own_beds_,
+                    "every experiment on beds of its own (a test bed rebuilt for every trial)");
 
     selftest_ = command_->add_subcommand(
         "selftest", "the diagnosis run blind on twins of every catalogue effect, null twins and "
@@ -314,6 +316,7 @@ int GapCommand::twin() const {
     o.seed = seed_;
     o.noise = noise_;
     o.level_noise = level_noise_;
+    o.own_beds = own_beds_;
     o.strength = strength_;
     if (random_) {
         const auto list = catalogue.diagnosable();

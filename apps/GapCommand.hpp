@@ -38,6 +38,7 @@ private:
     bool random_ = false, null_ = false;
     unsigned seed_ = 1;
     double noise_ = 0.01, level_noise_ = 0.02;
+    bool own_beds_ = false;
     // selftest
     std::string scale_ = "ci", plan_;
     // import

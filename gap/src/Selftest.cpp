@@ -30,6 +30,7 @@ struct Plan {
     std::vector<std::pair<std::string, double>> out_of_catalogue; ///< effect, strength
     double noise = 0.01, level_noise = 0.02;
     StrengthDraw strengths = StrengthDraw::Prior; ///< `strengths: prior | far_half`
+    bool own_beds = false;                        ///< `beds: shared | own`
 };
 
 Plan loadPlan(const std::string &path) {
@@ -58,6 +59,8 @@ Plan loadPlan(const std::string &path) {
             d->fail("must be prior (uniform over each prior) or far_half (over the half of each "
                     "side of off that lies farther from it)");
     }
+    if (const auto b = root.optional("beds"))
+        p.own_beds = b->choice({"shared", "own"}) == "own";
     p.noise = root.number("noise", p.noise);
     p.level_noise = root.number("level_noise", p.level_noise);
     root.finish();
@@ -181,6 +184,7 @@ SelftestResult runSelftest(const SelftestOptions &o) {
         to.seed = o.seed * 100 + k;
         to.noise = plan.noise;
         to.level_noise = plan.level_noise;
+        to.own_beds = plan.own_beds;
         if (p.strength)
             to.strength = *p.strength;
         else if (!p.effect.empty())
@@ -230,6 +234,7 @@ SelftestResult runSelftest(const SelftestOptions &o) {
                 design.repeats.begin(), design.repeats.end(),
                 [](const auto &a, const auto &b) { return a.second < b.second; })->second;
             truth.seed_offset = 1000 + 37 * int(key.seed % 1000);
+            truth.own_beds = key.own_beds;
             const Eigen::MatrixXd rows = sim.simulate(set, d.design, {truth})[0];
             const ColumnStats s = columnStats(rows);
             // The same standardisation as the diagnosis' own gap test: the normal deviate of

@@ -696,7 +696,16 @@ std::vector<StudySimulator::Overlay> StudySimulator::overlaysOf(const Experiment
     return out;
 }
 
-std::vector<std::vector<std::string>> StudySimulator::groups(const ExperimentSet &design) const {
+std::vector<std::vector<std::string>>
+StudySimulator::groups(const ExperimentSet &design,
+                       const std::vector<VariantRequest> &requests) const {
+    if (std::any_of(requests.begin(), requests.end(),
+                    [](const VariantRequest &r) { return r.own_beds; })) {
+        std::vector<std::vector<std::string>> alone;
+        for (const Experiment &e : design.experiments)
+            alone.push_back({e.id});
+        return alone;
+    }
     // Experiments of one type in one box share a bed: one lab test runs them all (wheels: those
     // of one wheel under one load).
     std::map<std::tuple<ExperimentType, std::string, std::string>, std::vector<std::string>> g;
@@ -846,8 +855,10 @@ study::Study StudySimulator::studyOf(const ExperimentSet &design,
                 study::Kind kind = e.type == ExperimentType::Mole
                                        ? study::standardKind("run", "")
                                        : study::standardKind("lab", testSectionOf(e.type));
-                const YAML::Node scenario =
-                    scenarioNode(design, gs[g], requests[r], requests[r].seed_offset + s);
+                // Beds of its own: another packing seed for every experiment.
+                const int seed =
+                    requests[r].seed_offset + s + (requests[r].own_beds ? 1009 * int(g + 1) : 0);
+                const YAML::Node scenario = scenarioNode(design, gs[g], requests[r], seed);
                 if (kind.summary_file_of)
                     kind.summary_file = kind.summary_file_of(scenario);
                 const study::Point p = study::makePoint(
@@ -931,7 +942,7 @@ std::string StudySimulator::withBaseLine(const std::string &what) const {
 std::vector<std::string> StudySimulator::runIds(const ExperimentSet &design,
                                                 const VariantRequest &request) const {
     std::vector<Slot> slots;
-    const study::Study st = studyOf(design, groups(design), {request}, slots);
+    const study::Study st = studyOf(design, groups(design, {request}), {request}, slots);
     std::vector<std::string> ids;
     for (const study::Point &p : st.points)
         ids.push_back(p.id);
@@ -941,7 +952,7 @@ std::vector<std::string> StudySimulator::runIds(const ExperimentSet &design,
 StudySimulator::RunCount StudySimulator::plan(const ExperimentSet &design,
                                               const std::vector<VariantRequest> &requests) const {
     std::vector<Slot> slots;
-    const study::Study st = studyOf(design, groups(design), requests, slots);
+    const study::Study st = studyOf(design, groups(design, requests), requests, slots);
     try {
         study::validate(st);
     } catch (const std::exception &e) {
@@ -959,7 +970,7 @@ StudySimulator::RunCount StudySimulator::plan(const ExperimentSet &design,
 std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
                                                     const std::vector<VariantRequest> &requests,
                                                     std::vector<int> &seeds_of) {
-    const auto gs = groups(design);
+    const auto gs = groups(design, requests);
     std::vector<Slot> slots;
     const study::Study st = studyOf(design, gs, requests, slots);
     const auto results = [&] { // study::run validates every point before it runs one

@@ -122,6 +122,7 @@ TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySi
     key.seed = options.seed;
     key.noise = options.noise;
     key.level_noise = options.level_noise;
+    key.own_beds = options.own_beds;
     const Effect *effect = nullptr;
     if (!options.effect.empty()) {
         effect = &catalogue.find(options.effect);
@@ -143,6 +144,7 @@ TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySi
     truth.seeds = most;
     // The twin's beds are other realisations than the ones the diagnosis simulates.
     truth.seed_offset = 1000 + 37 * int(options.seed % 1000);
+    truth.own_beds = options.own_beds;
     std::vector<int> seeds;
     writeTwin(design, simulator.curves(design.set, {truth}, seeds), key, out, key_path);
     return key;
@@ -254,6 +256,8 @@ void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves,
         YAML::Node u;
         u["y_relative"] = key.level_noise;
         u["repeats"] = "rebuilt_bed";
+        if (key.own_beds)
+            u["beds"] = "own";
         n["uncertainty"] = u;
         list.push_back(n);
     }
@@ -272,6 +276,7 @@ void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves,
                              {"seed", key.seed},
                              {"noise", key.noise},
                              {"level_noise", key.level_noise},
+                             {"own_beds", key.own_beds},
                              {"twin", out}};
     fs::create_directories(fs::absolute(key_path).parent_path());
     std::ofstream(key_path) << j.dump(2) << '\n';

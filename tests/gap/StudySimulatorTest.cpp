@@ -743,3 +743,27 @@ TEST_CASE("a direct shear test's box label gives it no container: the test build
     plain.label = "base";
     CHECK_NOTHROW(sim.plan(kept, {plain}));
 }
+
+TEST_CASE("a twin's experiments on beds of their own are run alone, each on another packing",
+          "[gap][simulator]") {
+    // A test bed rebuilt for every trial: two plates of one box, even two alike, are two beds per
+    // trial, not one bed pressed twice (the default, as grainlink's packing cache does).
+    const StudySimulator sim(loadBaseModel(kDir + "/base.yaml"),
+                             (fs::temp_directory_path() / "grainlink-gap-own-beds").string(), {});
+    ExperimentSet set = loadDesign(kDir + "/design.yaml").set;
+    Experiment again = set.find("wide_d20");
+    again.id = "wide_d20_again";
+    set.experiments = {set.find("wide_d20"), set.find("wide_d30"), again};
+    VariantRequest twin;
+    twin.label = "twin";
+    twin.seeds = 2;
+    twin.seed_offset = 1000;
+    const auto distinct = [](std::vector<std::string> ids) {
+        std::sort(ids.begin(), ids.end());
+        return std::size_t(std::unique(ids.begin(), ids.end()) - ids.begin());
+    };
+    CHECK(distinct(sim.runIds(set, twin)) == 2); // one run of the box per trial
+    twin.own_beds = true;
+    CHECK(distinct(sim.runIds(set, twin)) == 6); // the alike plates too: another seed each
+    CHECK(sim.groups(set, {twin}).size() == 3);
+}

@@ -31,6 +31,9 @@ struct VariantRequest {
     std::string check; ///< "", "resolution", "time_step", "domain", "rate"
     int seeds = 1;
     int seed_offset = 0; ///< the first seed: a twin's "measured" beds are not the model's own
+    /// Each experiment on beds of its own (a twin of a test bed rebuilt for every trial), not
+    /// every experiment of a group on the same bed per seed.
+    bool own_beds = false;
 };
 
 /// Runs variants of the base model on a design: one matrix per request, seeds x features.

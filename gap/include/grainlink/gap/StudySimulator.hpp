@@ -82,8 +82,9 @@ public:
                              const VariantRequest &request, int seed) const;
 
     /// The experiments that run as one lab test: one type in one box (wheels: one wheel under
-    /// one load).
-    std::vector<std::vector<std::string>> groups(const ExperimentSet &design) const;
+    /// one load); each experiment alone where any request asks for beds of its own.
+    std::vector<std::vector<std::string>>
+    groups(const ExperimentSet &design, const std::vector<VariantRequest> &requests = {}) const;
 
     int runsDone() const { return runs_done_; }
     int runsReused() const { return runs_reused_; }

@@ -28,6 +28,7 @@ struct TwinKey {
     bool in_catalogue = true;
     unsigned seed = 0;
     double noise = 0.0, level_noise = 0.0;
+    bool own_beds = false; ///< every experiment on beds of its own (`beds: own` in the folder)
 };
 
 struct TwinOptions {
@@ -36,6 +37,9 @@ struct TwinOptions {
     unsigned seed = 1;               ///< the beds' seeds and the draws
     double noise = 0.01;             ///< relative sd of every sample
     double level_noise = 0.02;       ///< relative sd of a trial's level (its calibration)
+    /// Every experiment's repeats on beds of its own, as a test bed rebuilt for every trial;
+    /// otherwise trial t of every experiment of a group is made on bed t.
+    bool own_beds = false;
 };
 
 /// Which part of an effect's prior a twin's strength is drawn from.
