@@ -31,9 +31,10 @@ struct Plan {
     double noise = 0.01, level_noise = 0.02;
     StrengthDraw strengths = StrengthDraw::Prior; ///< `strengths: prior | far_half`
     bool own_beds = false;                        ///< `beds: shared | own`
+    std::vector<std::string> hold_out; ///< the diagnosis' held-out ids; empty: its default split
 };
 
-Plan loadPlan(const std::string &path) {
+Plan loadPlan(const std::string &path, const Design &design) {
     Plan p;
     if (!fs::exists(path))
         return p;
@@ -59,6 +60,12 @@ Plan loadPlan(const std::string &path) {
             d->fail("must be prior (uniform over each prior) or far_half (over the half of each "
                     "side of off that lies farther from it)");
     }
+    if (const auto h = root.optional("hold_out"))
+        for (const ConfigNode &id : h->items()) {
+            if (!design.repeats.count(id.text()))
+                id.fail("names no experiment of the design");
+            p.hold_out.push_back(id.text());
+        }
     if (const auto b = root.optional("beds"))
         p.own_beds = b->choice({"shared", "own"}) == "own";
     p.noise = root.number("noise", p.noise);
@@ -139,8 +146,9 @@ SelftestResult runSelftest(const SelftestOptions &o) {
     const Design design = loadDesign(o.design);
     if (!o.plan.empty() && !fs::exists(o.plan))
         throw std::runtime_error(o.plan + ": no such self-test plan");
-    const Plan plan = loadPlan(o.plan.empty() ? (fs::path(o.design).parent_path() / "selftest.yaml").string()
-                                              : o.plan);
+    const Plan plan = loadPlan(
+        o.plan.empty() ? (fs::path(o.design).parent_path() / "selftest.yaml").string() : o.plan,
+        design);
     const std::string sims = o.sims.empty() ? o.out + "/sims" : o.sims;
     StudySimulator sim(base, sims, o.executor);
     fs::create_directories(o.out);
@@ -208,6 +216,7 @@ SelftestResult runSelftest(const SelftestOptions &o) {
         dopt.seeds = base.seeds;
         dopt.signature_seeds = base.signature_seeds;
         dopt.check_seeds = base.check_seeds;
+        dopt.held_out = plan.hold_out;
         dopt.log = [&](const std::string &line) {
             std::fprintf(stderr, "[selftest %s] %s\n", p.name.c_str(), line.c_str());
         };

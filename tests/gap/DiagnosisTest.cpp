@@ -1098,13 +1098,18 @@ TEST_CASE("the self-test scores each twin against its key: claims, weak twins, n
 
 namespace fs = std::filesystem;
 
-TEST_CASE("selftest: a plan with an unknown strength draw is refused, naming the file, the key "
-          "and the line, before anything runs",
+TEST_CASE("selftest: a plan with an unknown strength draw or a held-out id the design lacks is "
+          "refused, naming the file, the key and the line, before anything runs",
           "[gap][selftest]") {
+    // {plan text, its key, what the message suggests}
+    const auto [text, key, hint] = GENERATE(table<std::string, std::string, std::string>(
+        {{"nulls: 1\nstrengths: wide\n", "strengths", "far_half"},
+         {"nulls: 1\nhold_out: [wide_d20, wide_d25]\n", "hold_out",
+          "no experiment of the design"}}));
     const fs::path dir = fs::temp_directory_path() / ("grainlink-plan-" + std::to_string(getpid()));
     fs::create_directories(dir);
     const fs::path plan = dir / "selftest.yaml";
-    std::ofstream(plan) << "nulls: 1\nstrengths: wide\n";
+    std::ofstream(plan) << text;
     SelftestOptions o;
     const std::string ci = GRAINLINK_SOURCE_DIR "/scenarios/gap/selftest-ci";
     o.base_model = ci + "/base.yaml";
@@ -1114,14 +1119,14 @@ TEST_CASE("selftest: a plan with an unknown strength draw is refused, naming the
     o.catalogue = shippedEffects();
     try {
         runSelftest(o);
-        FAIL("a plan with strengths: wide was accepted");
+        FAIL("the plan was accepted: " << text);
     } catch (const std::exception &e) {
         const std::string what = e.what();
         INFO(what);
         CHECK(what.find(plan.string()) != std::string::npos);
-        CHECK(what.find("strengths") != std::string::npos);
+        CHECK(what.find(key) != std::string::npos);
         CHECK(what.find(plan.string() + ":2:") != std::string::npos); // file:line
-        CHECK(what.find("far_half") != std::string::npos);
+        CHECK(what.find(hint) != std::string::npos);
     }
     CHECK_FALSE(fs::exists(dir / "out" / "twins"));
     fs::remove_all(dir);
