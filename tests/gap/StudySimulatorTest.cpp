@@ -141,14 +141,17 @@ grainlink::dem::DemScenario labSoilOf(const StudySimulator &sim, const Experimen
 TEST_CASE("every effect and numerical check on the self-tests' designs is a scenario the lab "
           "accepts",
           "[gap][simulator]") {
-    const std::string kDir =
-        GENERATE(std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-ci",
-                 std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-full");
+    const std::string kGap = std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap";
+    const std::string kDesign =
+        GENERATE_COPY(kGap + "/selftest-ci/design.yaml", kGap + "/selftest-full/design.yaml",
+                      kGap + "/selftest-full/three_boxes.yaml");
     const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-simulator-test";
     fs::remove_all(scratch);
     fs::create_directories(scratch);
-    const StudySimulator sim(loadBaseModel(kDir + "/base.yaml"), (scratch / "sims").string(), {});
-    const Design design = loadDesign(kDir + "/design.yaml");
+    const StudySimulator sim(
+        loadBaseModel((fs::path(kDesign).parent_path() / "base.yaml").string()),
+        (scratch / "sims").string(), {});
+    const Design design = loadDesign(kDesign);
     forEveryVariant(sim,
                     [&](const VariantRequest &r) { acceptedByTheLab(sim, design, r, scratch); });
     fs::remove_all(scratch);
