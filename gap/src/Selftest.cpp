@@ -235,15 +235,7 @@ SelftestResult runSelftest(const SelftestOptions &o) {
         // Weak: the hidden effect, simulated on the twin's own beds without noise, stays within
         // the diagnosis' validation uncertainty of the base.
         if (!key.effect.empty()) {
-            VariantRequest truth;
-            truth.label = "twin " + key.effect + " seed " + std::to_string(key.seed);
-            truth.effect = &o.catalogue.find(key.effect);
-            truth.strength = key.strength;
-            truth.seeds = std::max_element(
-                design.repeats.begin(), design.repeats.end(),
-                [](const auto &a, const auto &b) { return a.second < b.second; })->second;
-            truth.seed_offset = 1000 + 37 * int(key.seed % 1000);
-            truth.own_beds = key.own_beds;
+            const VariantRequest truth = twinRequest(design, key, &o.catalogue.find(key.effect));
             const Eigen::MatrixXd rows = sim.simulate(set, d.design, {truth})[0];
             const ColumnStats s = columnStats(rows);
             // The same standardisation as the diagnosis' own gap test: the normal deviate of

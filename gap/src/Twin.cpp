@@ -133,21 +133,26 @@ TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySi
             std::fprintf(stderr, "[twin] %s = %g lies outside its prior [%g, %g]\n",
                          effect->name.c_str(), key.strength, effect->prior.lo, effect->prior.hi);
     }
+    std::vector<int> seeds;
+    writeTwin(design, simulator.curves(design.set, {twinRequest(design, key, effect)}, seeds), key,
+              out, key_path);
+    return key;
+}
+
+VariantRequest twinRequest(const Design &design, const TwinKey &key, const Effect *effect) {
     int most = 1;
     for (const auto &[id, r] : design.repeats)
         most = std::max(most, r);
     VariantRequest truth;
     truth.label = "twin " + (key.effect.empty() ? std::string("null") : key.effect) + " seed " +
-                  std::to_string(options.seed);
+                  std::to_string(key.seed);
     truth.effect = effect;
     truth.strength = key.strength;
     truth.seeds = most;
     // The twin's beds are other realisations than the ones the diagnosis simulates.
-    truth.seed_offset = 1000 + 37 * int(options.seed % 1000);
-    truth.own_beds = options.own_beds;
-    std::vector<int> seeds;
-    writeTwin(design, simulator.curves(design.set, {truth}, seeds), key, out, key_path);
-    return key;
+    truth.seed_offset = 1000 + 37 * int(key.seed % 1000);
+    truth.own_beds = key.own_beds;
+    return truth;
 }
 
 void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves, const TwinKey &key,

@@ -59,6 +59,10 @@ double drawStrength(const Effect &effect, unsigned seed, StrengthDraw draw = Str
 void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves, const TwinKey &key,
                const std::string &out, const std::string &key_path);
 
+/// The simulation a twin's data come from (`effect` the key's, null for a null twin): every
+/// repeat of the design on the twin's own beds, not the ones the diagnosis simulates.
+VariantRequest twinRequest(const Design &design, const TwinKey &key, const Effect *effect);
+
 /// Simulates the twin into `out` (writeTwin) and returns its key.
 TwinKey makeTwin(const Design &design, const EffectCatalogue &catalogue, StudySimulator &simulator,
                  const TwinOptions &options, const std::string &out, const std::string &key_path);
