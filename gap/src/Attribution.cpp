@@ -234,12 +234,44 @@ StrengthFit fitStrength(const Response &response, const Prior &prior,
     fit.strength = prior.fromScale(p.t_best);
     fit.lo = prior.fromScale(p.t_lo);
     fit.hi = prior.fromScale(p.t_hi);
+    fit.spread_lo = fit.lo, fit.spread_hi = fit.hi;
     fit.chi2 = p.chi2;
     fit.at_bound = p.at_bound;
     fit.beyond_prior = beyondPrior(chi2, p, t0, t1, prior.toScale(prior.off));
     fit.at_prior_edge = atPriorEdge(p, t0, t1, prior.toScale(prior.off));
     fit.chi2_off = chi2(prior.toScale(prior.off));
     return fit;
+}
+
+Eigen::VectorXd bedLuckSd(const std::function<Eigen::VectorXd(const Eigen::VectorXd &)> &refit,
+                          const Eigen::VectorXd &t_fit, const Eigen::VectorXd &at_fit,
+                          const Eigen::MatrixXd &rows) {
+    Eigen::VectorXd sum2 = Eigen::VectorXd::Zero(t_fit.size());
+    if (rows.rows() < 2)
+        return sum2;
+    const Eigen::VectorXd mean = columnStats(rows).mean;
+    for (Eigen::Index j = 0; j < rows.rows(); ++j) {
+        // A bin this seed lacks is no measurement of it (NaN: left out of chi^2).
+        const Eigen::VectorXd pseudo = at_fit + (rows.row(j).transpose() - mean);
+        sum2 += (refit(pseudo) - t_fit).array().square().matrix();
+    }
+    return (sum2 / double(rows.rows() - 1)).cwiseSqrt();
+}
+
+void widenInterval(StrengthFit &fit, const Prior &prior, double sd, double dof) {
+    fit.spread_lo = fit.lo, fit.spread_hi = fit.hi;
+    if (!(sd > 0.0) || !std::isfinite(sd) || !(dof >= 1.0))
+        return;
+    const double t = prior.toScale(fit.strength);
+    const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi);
+    const double below = t - prior.toScale(fit.lo), above = prior.toScale(fit.hi) - t;
+    const auto widened = [&](double half, double &lo, double &hi) {
+        lo = prior.fromScale(std::max(t - std::hypot(below, half), std::min(t0, t)));
+        hi = prior.fromScale(std::min(t + std::hypot(above, half), std::max(t1, t)));
+    };
+    widened(boost::math::quantile(boost::math::students_t(dof), 0.975) * sd, fit.lo, fit.hi);
+    widened(1.959963984540054 * sd, fit.spread_lo, fit.spread_hi);
+    fit.luck_sd = sd;
 }
 
 Eigen::VectorXd PairResponse::mean(double sa, double sb) const {
@@ -294,6 +326,7 @@ PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Pri
         f.strength = p.fromScale(q.t_best);
         f.lo = p.fromScale(q.t_lo);
         f.hi = p.fromScale(q.t_hi);
+        f.spread_lo = f.lo, f.spread_hi = f.hi;
         f.chi2 = q.chi2;
         f.at_bound = q.at_bound;
         f.beyond_prior = beyondPrior(profile, q, p.toScale(p.lo), p.toScale(p.hi), p.toScale(p.off));

@@ -151,6 +151,10 @@ Measured measure(const ExperimentSet &set, const FeatureDesign &design) {
     m.u_repeats = Eigen::VectorXd::Zero(n);
     m.trials = Eigen::VectorXi::Zero(n);
     m.from_repeats.assign(std::size_t(n), false);
+    std::size_t most_trials = 0;
+    for (const Experiment &e : set.experiments)
+        most_trials = std::max(most_trials, e.trials.size());
+    m.trial_values = Eigen::MatrixXd::Constant(Eigen::Index(most_trials), n, kNaN);
     for (const auto &[id, idx] : design.by_experiment) {
         const Experiment &e = set.find(id);
         const MeasurementUncertainty &u = e.uncertainty;
@@ -158,16 +162,21 @@ Measured measure(const ExperimentSet &set, const FeatureDesign &design) {
             const FeatureKey &key = design.keys[std::size_t(k)];
             std::vector<double> values;
             if (e.x_name.empty()) {
-                for (const Trial &t : e.trials)
-                    values.push_back(t.curves.at(key.observable).y[0]);
-            } else if (e.scatter) {
+                for (std::size_t r = 0; r < e.trials.size(); ++r) {
+                    values.push_back(e.trials[r].curves.at(key.observable).y[0]);
+                    m.trial_values(Eigen::Index(r), k) = values.back();
+                }
+            } else if (e.scatter) { // points, not trials: no trial's own value
                 for (const auto &[x, y] : scatterPoints(e, key.observable))
                     if (inScatterBin(design, key, x))
                         values.push_back(y);
             } else {
-                for (const Curve &c : zeroedTrials(e, key.observable))
-                    if (const auto v = binMean(c, key.x_lo, key.x_hi))
+                const std::vector<Curve> curves = zeroedTrials(e, key.observable);
+                for (std::size_t r = 0; r < curves.size(); ++r)
+                    if (const auto v = binMean(curves[r], key.x_lo, key.x_hi)) {
                         values.push_back(*v);
+                        m.trial_values(Eigen::Index(r), k) = *v;
+                    }
             }
             const int count = int(values.size());
             m.trials[k] = count;

@@ -49,10 +49,17 @@ Json verdict(const GapVerdict &g) {
 }
 
 Json strength(const Effect &e, const StrengthFit &f) {
-    return {{"parameter", e.parameter}, {"unit", e.unit},          {"value", number(f.strength)},
-            {"ci95", {number(f.lo), number(f.hi)}}, {"base_value", number(e.prior.off)},
-            {"prior", {e.prior.lo, e.prior.hi}}, {"at_prior_bound", f.at_bound},
-            {"beyond_prior", f.beyond_prior}, {"at_prior_edge", f.at_prior_edge}};
+    return {{"parameter", e.parameter},
+            {"unit", e.unit},
+            {"value", number(f.strength)},
+            {"ci95", {number(f.lo), number(f.hi)}},
+            {"base_value", number(e.prior.off)},
+            {"prior", {e.prior.lo, e.prior.hi}},
+            {"at_prior_bound", f.at_bound},
+            {"beyond_prior", f.beyond_prior},
+            {"at_prior_edge", f.at_prior_edge},
+            {"bed_luck_sd", number(f.luck_sd)},
+            {"bed_luck_sd_scale", e.prior.log_scale ? "log" : "linear"}};
 }
 
 void writeAtomically(const fs::path &path, const std::string &text) {

@@ -61,6 +61,56 @@ TEST_CASE("the fitted strength's 95 % interval covers the true strength about 95
     CHECK(double(covered) / draws < 0.995);
 }
 
+TEST_CASE("a bed's luck shared by every feature widens the strength's interval to its 95 % "
+          "coverage (bedLuckSd): the chi^2 profile alone misses it",
+          "[gap][attribution]") {
+    // One bed shifts all five features alike (a sinkage zero that the surface moves for every
+    // plate pressed into it); the chi^2 sees each feature's scatter, luck and noise, as
+    // independent. The luck's sd comes from 6 simulated beds, as bedLuckSd is used.
+    const Prior prior{0.0, 1.0, 0.0, false};
+    const Eigen::VectorXd base = Eigen::VectorXd::Constant(5, 10.0);
+    Eigen::VectorXd J(5);
+    J << 1, 1.2, 1.4, 1.6, 1.8; // mostly a level: the luck's own shape
+    const auto r = linear(prior, base, J, {0.0, 0.5, 1.0});
+    const double luck = 0.15, u = 0.03, truth = 0.4;
+    const Eigen::VectorXd u2 = Eigen::VectorXd::Constant(5, luck * luck + u * u);
+    std::mt19937 rng(7);
+    std::normal_distribution<double> normal(0.0, 1.0);
+    const auto bed = [&] {
+        Eigen::VectorXd y = Eigen::VectorXd::Constant(5, luck * normal(rng));
+        for (int k = 0; k < 5; ++k)
+            y[k] += u * normal(rng);
+        return y;
+    };
+    const auto refit = [&](const Eigen::VectorXd &y) {
+        return Eigen::VectorXd::Constant(1, fitStrength(r, prior, y, u2, all(5)).strength);
+    };
+    const int draws = 400, seeds = 6;
+    int profile_covers = 0, widened_covers = 0;
+    for (int d = 0; d < draws; ++d) {
+        const Eigen::VectorXd y = base + truth * J + bed();
+        auto fit = fitStrength(r, prior, y, u2, all(5));
+        profile_covers += fit.lo <= truth && truth <= fit.hi;
+        Eigen::MatrixXd rows(seeds, 5);
+        for (int j = 0; j < seeds; ++j)
+            rows.row(j) = (base + bed()).transpose();
+        const Eigen::VectorXd sd = bedLuckSd(refit, Eigen::VectorXd::Constant(1, fit.strength),
+                                             r.mean(fit.strength), rows);
+        // The measurement is one bed; the table has no luck of its own here.
+        widenInterval(fit, prior, sd[0], seeds - 1);
+        widened_covers += fit.lo <= truth && truth <= fit.hi;
+        if (d == 0) {
+            // One bed's luck moves s by luck / mean(J) (a level shift read as strength).
+            CHECK(fit.luck_sd == Approx(luck / J.mean()).epsilon(0.6));
+            CHECK(fit.lo < fit.strength);
+            CHECK(fit.hi > fit.strength);
+        }
+    }
+    CHECK(double(profile_covers) / draws < 0.8);
+    CHECK(double(widened_covers) / draws > 0.92);
+    CHECK(double(widened_covers) / draws < 0.999);
+}
+
 TEST_CASE("a logarithmic strength is found on its own scale", "[gap][attribution]") {
     // m(s) = 10 s^0.5, tabulated at 0.3, 1, 3 (linear in log s only piecewise): data at s = 2.
     const Prior prior{0.2, 5.0, 1.0, true};

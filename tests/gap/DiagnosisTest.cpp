@@ -713,7 +713,7 @@ TEST_CASE("diagnosis: held-out plates that the model presses into the same beds 
 
 namespace {
 /// The analytic cohesion twin diagnosed with a second catalogue entry of cohesion's physics
-/// whose prior ends at `cap`, below the hidden 4e4 (fitted at 4.00e4 [3.97e4, 4.03e4]).
+/// whose prior ends at `cap`, below the hidden 4e4 (fitted at 4.02e4 [3.88e4, 4.16e4]).
 Diagnosis withCappedCohesion(double cap) {
     EffectCatalogue c = shippedEffects();
     Effect capped = c.find("cohesion");
@@ -757,8 +757,10 @@ TEST_CASE("diagnosis: a claim names the rivals that its held-out experiments can
     // Pinned at its edge the capped entry predicts the held-out plates about as well: never
     // claimed (the edge), it is still a rival the claim must name (on the CMU plates softer
     // grains at the softest allowed predicted the small box as well as grain shape).
-    int claimed = 0, blocked = 0; // 3.88e4 predicts a little worse than the truth, 3.99e4 better
-    for (double cap : {3.88e4, 3.99e4}) {
+    // 3.87e4 predicts a little worse than the truth, 3.99e4 better (the truth's interval, with
+    // the beds' luck, spreads its prediction: 3.88e4 predicted better than it too).
+    int claimed = 0, blocked = 0;
+    for (double cap : {3.87e4, 3.99e4}) {
         const Diagnosis d = withCappedCohesion(cap);
         INFO("cap " << cap << ": " << d.claim);
         const CandidateResult &truth = candidate(d, "cohesion");

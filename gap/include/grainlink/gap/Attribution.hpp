@@ -95,10 +95,34 @@ struct StrengthFit {
     /// The best strength is an end of the prior that is not "off": the prior cuts its interval,
     /// so the data may want more of the effect than is plausible, and it is never claimed.
     bool at_prior_edge = false;
+    /// The beds' luck in the interval: the strength's standard deviation on the prior's scale
+    /// from the measured and the simulated beds' luck (`bedLuckSd`), added to the profile's
+    /// half-widths in quadrature (`widenInterval`); 0 where it was not estimated.
+    double luck_sd = 0.0;
+    /// What a prediction at the fitted strength spreads over: the interval with the luck at
+    /// the normal quantile, not Student's (a plug-in spread; the t quantile says how little
+    /// a few beds tell of it, not how far the strength is off). The interval where unwidened.
+    double spread_lo = 0.0, spread_hi = 0.0;
 };
 StrengthFit fitStrength(const Response &response, const Prior &prior,
                         const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
                         const FeatureSet &use, const BlockCorrelation &correlation = {});
+
+/// How far one bed's luck moves fitted strengths: their standard deviations on the prior's
+/// scale. The strengths are refitted (`refit`, returning them on the prior's scale) to the
+/// fitted model's mean `at_fit` plus each seed's departure from the seeds' mean in `rows` (a
+/// real bed's luck, with its shape and its reach over every experiment that bed serves, which
+/// a chi^2 of independent or within-experiment errors does not see: a sinkage zero that a
+/// bed's surface moves for every plate pressed into it), summed in squares over S - 1 seeds.
+/// Zeros with fewer than two seeds.
+Eigen::VectorXd bedLuckSd(const std::function<Eigen::VectorXd(const Eigen::VectorXd &)> &refit,
+                          const Eigen::VectorXd &t_fit, const Eigen::VectorXd &at_fit,
+                          const Eigen::MatrixXd &rows);
+
+/// Widens a fit's 95 % interval by a standard deviation `sd` on the prior's scale, estimated
+/// with `dof` degrees of freedom (its half-width Student's t quantile times sd, added to each
+/// half-width in quadrature), within the prior; records it in `luck_sd`.
+void widenInterval(StrengthFit &fit, const Prior &prior, double sd, double dof);
 
 /// Two effects together, their changes added to the base (the confirming simulation runs them
 /// together for real).

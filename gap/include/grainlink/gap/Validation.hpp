@@ -20,6 +20,9 @@ struct Measured {
     Eigen::VectorXd u_D;   ///< standard uncertainty of that mean: repeats, stated sigma, zero
     Eigen::VectorXd u_repeats; ///< the part of u_D estimated from the repeats' scatter
     Eigen::VectorXi trials;
+    /// Each trial's own value (rows: the experiments' trials in order; NaN where a trial has
+    /// no value in the bin, and for scatter data, whose points are no trials).
+    Eigen::MatrixXd trial_values;
     /// True where u_D comes from repeats on re-prepared beds (and so holds the bed-to-bed
     /// scatter); where false the simulation's single-bed scatter is added (one real bed is one
     /// realisation too).
