@@ -194,10 +194,13 @@ struct BedLuck {
         for (std::size_t i = 0; i < fits.size(); ++i) {
             const Eigen::Index k = Eigen::Index(i);
             const double vs = sim[k] * sim[k] / signature_seeds, vm = real[k] * real[k] / real_beds;
-            // The same estimate counted twice (no measured repeats) is one, not two, dof.
-            const double dof = measured.rows() >= 2 ? (vs + vm) * (vs + vm) /
-                                                          (vs * vs / sim_dof + vm * vm / real_dof)
-                                                    : sim_dof;
+            // The same estimate counted twice (no measured repeats) is one, not two, dof; a
+            // side of one bed tells nothing of its luck (0, and no term).
+            const double dof =
+                measured.rows() >= 2
+                    ? (vs + vm) * (vs + vm) /
+                          ((sim_dof > 0.0 ? vs * vs / sim_dof : 0.0) + vm * vm / real_dof)
+                    : sim_dof;
             if (vs + vm > 0.0)
                 widenInterval(*fits[i].first, *fits[i].second, std::sqrt(vs + vm), dof);
         }
