@@ -1178,3 +1178,44 @@ TEST_CASE("diagnosis: no pair is tried where a single effect within its prior le
     CHECK(d.outcome == Diagnosis::Outcome::Unexplained);
     CHECK(d.best_model == "cohesion");
 }
+
+TEST_CASE("diagnosis: a fitted strength's interval carries the measured trials' luck and holds "
+          "the hidden strength",
+          "[gap][diagnosis]") {
+    // Every measured trial is a bed of its own (level and tilt); the simulated side's seeds are
+    // beds too. The luck both carry is in the interval, and it grows with the trials' scatter.
+    const EffectCatalogue c = shippedEffects();
+    const auto fitOf = [&](const std::string &effect, const ExperimentSet &set) {
+        AnalyticSimulator sim;
+        const std::vector<const Effect *> only{&c.find(effect)};
+        return candidate(diagnose(set, only, sim, analyticOptions()), effect).fit;
+    };
+    ExperimentSet set = measuredSet({"cohesion", 4.0e4}, 7);
+    const StrengthFit fit = fitOf("cohesion", set);
+    CHECK(fit.luck_sd > 0.0);
+    // The same trials three times as far from their mean, bin by bin: more luck.
+    for (Experiment &e : set.experiments) {
+        std::vector<double> mean(e.trials.front().curves.at("pressure_Pa").y.size(), 0.0);
+        for (const Trial &t : e.trials)
+            for (std::size_t i = 0; i < mean.size(); ++i)
+                mean[i] += t.curves.at("pressure_Pa").y[i] / double(e.trials.size());
+        for (Trial &t : e.trials)
+            for (std::size_t i = 0; i < mean.size(); ++i) {
+                double &y = t.curves.at("pressure_Pa").y[i];
+                y = mean[i] + 3.0 * (y - mean[i]);
+            }
+    }
+    const StrengthFit wider = fitOf("cohesion", set);
+    CHECK(wider.luck_sd > 1.5 * fit.luck_sd);
+    CHECK(wider.hi - wider.lo > fit.hi - fit.lo);
+    // Over 30 measured draws of each (the simulated beds fixed: their luck is one draw), the
+    // interval holds the hidden strength (measured 25/30 and 30/30).
+    int held = 0;
+    for (const auto &[effect, s] :
+         {std::pair<std::string, double>{"cohesion", 4.0e4}, {"grain_stiffness", 3.0}})
+        for (unsigned seed = 1; seed <= 30; ++seed) {
+            const StrengthFit f = fitOf(effect, measuredSet({effect, s}, seed));
+            held += f.lo <= s && s <= f.hi;
+        }
+    CHECK(held >= 50);
+}
