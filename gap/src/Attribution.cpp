@@ -251,8 +251,13 @@ Eigen::VectorXd bedLuckSd(const std::function<Eigen::VectorXd(const Eigen::Vecto
         return sum2;
     const Eigen::VectorXd mean = columnStats(rows).mean;
     for (Eigen::Index j = 0; j < rows.rows(); ++j) {
-        // A bin this seed lacks is no measurement of it (NaN: left out of chi^2).
-        const Eigen::VectorXd pseudo = at_fit + (rows.row(j).transpose() - mean);
+        // A bin this bed lacks tells nothing of its luck there: no departure. (Left out of the
+        // refit instead, it would move the strength by the features it lost, not by luck.)
+        Eigen::VectorXd departure = rows.row(j).transpose() - mean;
+        for (Eigen::Index k = 0; k < departure.size(); ++k)
+            if (!std::isfinite(departure[k]))
+                departure[k] = 0.0;
+        const Eigen::VectorXd pseudo = at_fit + departure;
         sum2 += (refit(pseudo) - t_fit).array().square().matrix();
     }
     return (sum2 / double(rows.rows() - 1)).cwiseSqrt();

@@ -176,7 +176,9 @@ Eigen::MatrixXd firstRows(const Eigen::MatrixXd &rows, int n) {
 struct BedLuck {
     Eigen::MatrixXd simulated; ///< the base's seeds: one simulated bed each
     int signature_seeds = 1;   ///< the seeds a signature's mean is over
-    Eigen::MatrixXd measured;  ///< the measured trials on rebuilt beds (none: fewer than two)
+    /// The measured trials on rebuilt beds, where every calibration feature has a value of
+    /// each (none: fewer than two, or scatter points instead of trials)
+    Eigen::MatrixXd measured;
 
     using Refit = std::function<Eigen::VectorXd(const Eigen::VectorXd &)>;
     /// Widens each fit's interval (on its prior's scale) by the luck of its strength.
@@ -216,12 +218,19 @@ BedLuck bedLuck(const Measured &meas, const FeatureSet &calibration,
     int trials = std::numeric_limits<int>::max();
     for (Eigen::Index k : calibration)
         trials = meas.from_repeats[std::size_t(k)] ? std::min(trials, int(meas.trials[k])) : 0;
-    if (trials >= 2 && trials != std::numeric_limits<int>::max()) {
-        luck.measured = Eigen::MatrixXd::Constant(trials, meas.trial_values.cols(), kNaN);
-        for (Eigen::Index k : calibration)
-            for (Eigen::Index r = 0, row = 0; r < meas.trial_values.rows() && row < trials; ++r)
-                if (std::isfinite(meas.trial_values(r, k)))
-                    luck.measured(row++, k) = meas.trial_values(r, k);
+    if (trials < 2 || trials == std::numeric_limits<int>::max())
+        return luck;
+    luck.measured = Eigen::MatrixXd::Constant(trials, meas.trial_values.cols(), kNaN);
+    for (Eigen::Index k : calibration) {
+        Eigen::Index row = 0;
+        for (Eigen::Index r = 0; r < meas.trial_values.rows() && row < trials; ++r)
+            if (std::isfinite(meas.trial_values(r, k)))
+                luck.measured(row++, k) = meas.trial_values(r, k);
+        // Points, not trials (a wheel's scatter of slips): no trial's own luck to read.
+        if (row < trials) {
+            luck.measured.resize(0, 0);
+            return luck;
+        }
     }
     return luck;
 }

@@ -5,6 +5,7 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <limits>
 #include <random>
 
 using namespace grainlink::gap;
@@ -109,6 +110,30 @@ TEST_CASE("a bed's luck shared by every feature widens the strength's interval t
     CHECK(double(profile_covers) / draws < 0.8);
     CHECK(double(widened_covers) / draws > 0.92);
     CHECK(double(widened_covers) / draws < 0.999);
+}
+
+TEST_CASE("bedLuckSd: a bin a bed lacks adds no luck (left out, the refit would lose the only "
+          "feature that carries the strength)",
+          "[gap][attribution]") {
+    const Prior prior{0.0, 1.0, 0.0, false};
+    const Eigen::VectorXd base = Eigen::VectorXd::Constant(3, 10.0);
+    Eigen::VectorXd J(3);
+    J << 1, 0, 0; // only the first feature moves with the strength
+    const auto r = linear(prior, base, J, {0.0, 0.5, 1.0});
+    const Eigen::VectorXd u2 = Eigen::VectorXd::Constant(3, 0.01);
+    const auto refit = [&](const Eigen::VectorXd &y) {
+        return Eigen::VectorXd::Constant(1, fitStrength(r, prior, y, u2, all(3)).strength);
+    };
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    Eigen::MatrixXd rows(3, 3);
+    rows << 10.02, 10.1, 9.9, //
+        nan, 9.9, 10.1,       // this bed lacks the first bin
+        9.98, 10.0, 10.0;
+    const Eigen::VectorXd sd =
+        bedLuckSd(refit, Eigen::VectorXd::Constant(1, 0.4), r.mean(0.4), rows);
+    // Beds 1 and 3 move the strength by +-0.02 (their departures from the first bin's mean);
+    // bed 2 tells nothing: sqrt((0.02^2 + 0.02^2) / 2) = 0.02.
+    CHECK(sd[0] == Approx(0.02).epsilon(0.05));
 }
 
 TEST_CASE("a logarithmic strength is found on its own scale", "[gap][attribution]") {
