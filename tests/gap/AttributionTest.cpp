@@ -30,6 +30,15 @@ FeatureSet all(int n) {
     return f;
 }
 
+/// bedLuckSd's refit: the strength fitted to pseudo-data y over every feature (a linear
+/// prior: its scale is the strength itself).
+auto refitOf(const TabulatedResponse &r, const Prior &prior, const Eigen::VectorXd &u2) {
+    return [&r, &prior, &u2](const Eigen::VectorXd &y) {
+        return Eigen::VectorXd::Constant(
+            1, fitStrength(r, prior, y, u2, all(int(u2.size()))).strength);
+    };
+}
+
 } // namespace
 
 TEST_CASE("the fitted strength's 95 % interval covers the true strength about 95 % of the time",
@@ -83,9 +92,7 @@ TEST_CASE("a bed's luck shared by every feature widens the strength's interval t
             y[k] += u * normal(rng);
         return y;
     };
-    const auto refit = [&](const Eigen::VectorXd &y) {
-        return Eigen::VectorXd::Constant(1, fitStrength(r, prior, y, u2, all(5)).strength);
-    };
+    const auto refit = refitOf(r, prior, u2);
     const int draws = 400, seeds = 6;
     int profile_covers = 0, widened_covers = 0;
     for (int d = 0; d < draws; ++d) {
@@ -121,9 +128,7 @@ TEST_CASE("bedLuckSd: a bin a bed lacks adds no luck (left out, the refit would 
     J << 1, 0, 0; // only the first feature moves with the strength
     const auto r = linear(prior, base, J, {0.0, 0.5, 1.0});
     const Eigen::VectorXd u2 = Eigen::VectorXd::Constant(3, 0.01);
-    const auto refit = [&](const Eigen::VectorXd &y) {
-        return Eigen::VectorXd::Constant(1, fitStrength(r, prior, y, u2, all(3)).strength);
-    };
+    const auto refit = refitOf(r, prior, u2);
     const double nan = std::numeric_limits<double>::quiet_NaN();
     Eigen::MatrixXd rows(3, 3);
     rows << 10.02, 10.1, 9.9, //
