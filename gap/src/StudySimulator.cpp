@@ -1044,8 +1044,11 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
                         for (const auto &fit : sum.fits)
                             if (fit.law == "repose")
                                 curve = Curve{{0.0}, {sum.fitted("repose", "angle").value}};
+                        // The grains spread flat: no heap, a slope of zero. A missing value
+                        // would drop the bed, and a model whose beds mostly spread would be
+                        // judged by the one that kept a heap.
                         if (curve.empty())
-                            curve = Curve{{0.0}, {kNaN}}; // the grains spread: no heap
+                            curve = Curve{{0.0}, {0.0}};
                         break;
                     default:
                         break;

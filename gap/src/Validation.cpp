@@ -331,8 +331,15 @@ std::vector<RegimeFinding> localise(const std::vector<FeatureKey> &keys,
                 f.ratio_min = rmin;
                 f.ratio_max = rmax;
                 const bool high = f.sign > 0;
-                // Ratios far from 1 read best as "2-3x"; near 1 as a percentage.
-                if (high && rmin >= 1.5)
+                // Ratios far from 1 read best as "2-3x"; near 1 as a percentage; a simulated
+                // value of the other sign, or zero, as its ratio (a heap that spread flat
+                // against a measured 22 deg is not "21x too low").
+                if (rmin <= 0.0) {
+                    const std::string lo = format(rmin, 2), hi = format(rmax, 2);
+                    t << " too " << (high ? "high" : "low") << ", simulated "
+                      << (lo == hi ? lo : lo + " to " + hi) << "x the measured"
+                      << (rmax <= 0.0 ? " (the other sign, or zero)" : "");
+                } else if (high && rmin >= 1.5)
                     t << ' ' << range(rmin, rmax) << "x too high";
                 else if (!high && rmax <= 1.0 / 1.5)
                     t << ' ' << range(1.0 / rmax, 1.0 / rmin) << "x too low";

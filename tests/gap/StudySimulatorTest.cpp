@@ -770,3 +770,35 @@ TEST_CASE("a twin's experiments on beds of their own are run alone, each on anot
     CHECK(distinct(sim.runIds(set, twin)) == 6); // the alike plates too: another seed each
     CHECK(sim.groups(set, {twin}).size() == 3);
 }
+
+TEST_CASE("a heap that spreads flat is an angle of repose of zero, not a missing value",
+          "[gap][simulator]") {
+    // The full self-test's repose fill on a frictionless floor: the grains run out of the lifted
+    // tube and leave no flank to fit (the lab's "no heap"). A missing value would drop that bed,
+    // and a model whose beds mostly spread would be judged by the one that kept a heap (wall
+    // friction 0.07 on the full self-test: two beds spread, one kept a heap of -1.06 deg).
+    const std::string dir = std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-full";
+    std::ifstream in(dir + "/base.yaml");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::string floor = "normal: [0, 0, 1], friction_coefficient: 0.6}";
+    REQUIRE(text.find(floor) != std::string::npos);
+    text.replace(text.find(floor), floor.size(), "normal: [0, 0, 1], friction_coefficient: 0.0}");
+    const fs::path scratch = freshScratch("grainlink-gap-no-heap");
+    std::ofstream(scratch / "base.yaml") << text;
+
+    grainlink::study::ExecutorOptions run;
+    run.grainlink = GRAINLINK_EXECUTABLE;
+    run.progress_interval_s = 1e9;
+    StudySimulator sim(loadBaseModel((scratch / "base.yaml").string()), (scratch / "sims").string(),
+                       run);
+    ExperimentSet set = loadDesign(dir + "/design.yaml").set;
+    set.experiments = {set.find("repose")};
+    VariantRequest plain;
+    plain.label = "base";
+    std::vector<int> seeds_of;
+    const auto curves = sim.curves(set, {plain}, seeds_of);
+    REQUIRE(curves.size() == 1);
+    const Curve &angle = curves[0].at("repose").at("angle_deg");
+    REQUIRE(angle.scalar());
+    CHECK(angle.y[0] == 0.0);
+}

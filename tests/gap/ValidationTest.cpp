@@ -288,6 +288,24 @@ TEST_CASE("localise names an observable in words, without its unit", "[gap][vali
     }
 }
 
+TEST_CASE("localise gives a simulated value of the other sign as its ratio, not as 'Nx too low'",
+          "[gap][validation]") {
+    // A heap that spread flat (-1.06 deg) against a measured 22.6 deg: the ratio -0.047
+    // once read "-21x too low". A side force of the other sign than the measured -0.54 N
+    // (+1.0 N, ratio -1.85) once read "-0.54x too low".
+    const std::vector<FeatureKey> keys{{"repose", "angle_deg", "angle_of_repose/angle_deg", 0, 0},
+                                       {"w", "side_force_N", "wheel/side_force_N", 0.35, 0.6}};
+    ValidationResult v;
+    v.standardised = Eigen::Vector2d(3.1, -2.7);
+    v.ratio = Eigen::Vector2d(-1.06 / 22.6, 1.0 / -0.54);
+    const auto findings = localise(keys, v, {{"repose", {}}, {"w", {}}}, {});
+    REQUIRE(findings.size() == 2);
+    CHECK(findings[0].text == "angle too low, simulated -0.047x the measured (the other sign, or "
+                              "zero) on every experiment (1)");
+    CHECK(findings[1].text == "side force too high, simulated -1.9x the measured (the other "
+                              "sign, or zero) at x 0.35-0.6 on every experiment (1)");
+}
+
 TEST_CASE("a check that moves the base by over half its value makes the base unresolved",
           "[gap][validation]") {
     // Seeds 1.0 1.2 0.8 1.0 (mean 1). A time-step check at 10 on the first two seeds (the
