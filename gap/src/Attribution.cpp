@@ -99,6 +99,26 @@ bool beyondPrior(F chi2, const Profile &p, double t0, double t1, double t_off) {
     return std::isfinite(c) && c < p.chi2 - std::max(kDeltaChi2_95, 0.1 * p.chi2);
 }
 
+/// A strength fit from the profile `q` of `chi2` over `prior` (on its scale): the best
+/// strength, its interval (the spread's too, until the beds' luck widens it) and where it lies
+/// against the prior's ends.
+template <class F>
+StrengthFit fitOfProfile(const Profile &q, const Prior &prior, F chi2, int features, double birge) {
+    const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi),
+                 t_off = prior.toScale(prior.off);
+    StrengthFit f;
+    f.strength = prior.fromScale(q.t_best);
+    f.lo = f.spread_lo = prior.fromScale(q.t_lo);
+    f.hi = f.spread_hi = prior.fromScale(q.t_hi);
+    f.chi2 = q.chi2;
+    f.at_bound = q.at_bound;
+    f.beyond_prior = beyondPrior(chi2, q, t0, t1, t_off);
+    f.at_prior_edge = atPriorEdge(q, t0, t1, t_off);
+    f.features = features;
+    f.birge = birge;
+    return f;
+}
+
 /// `mean` with every feature a response lacks somewhere taken at the base (`off`): one missing
 /// at some strengths (a bin a softer soil never reaches) would drop out of chi^2 only there and
 /// make those strengths look better; dropped everywhere, the effect's chi^2 would be summed over
@@ -224,21 +244,12 @@ StrengthFit fitStrength(const Response &response, const Prior &prior,
                          atBaseWhereMissing(response.variance(s), has, off_var), u2_fixed, use,
                          correlation);
     };
-    StrengthFit fit;
-    fit.features = int(use.size());
     // A first pass gives the Birge ratio that widens the interval of a poor best fit.
     const Profile first = minimiseProfile(chi2, t0, t1, 1.0);
-    const int dof = std::max(1, fit.features - 1);
-    fit.birge = std::max(1.0, first.chi2 / dof);
-    const Profile p = fit.birge > 1.0 ? minimiseProfile(chi2, t0, t1, fit.birge) : first;
-    fit.strength = prior.fromScale(p.t_best);
-    fit.lo = prior.fromScale(p.t_lo);
-    fit.hi = prior.fromScale(p.t_hi);
-    fit.spread_lo = fit.lo, fit.spread_hi = fit.hi;
-    fit.chi2 = p.chi2;
-    fit.at_bound = p.at_bound;
-    fit.beyond_prior = beyondPrior(chi2, p, t0, t1, prior.toScale(prior.off));
-    fit.at_prior_edge = atPriorEdge(p, t0, t1, prior.toScale(prior.off));
+    const int features = int(use.size());
+    const double birge = std::max(1.0, first.chi2 / std::max(1, features - 1));
+    const Profile p = birge > 1.0 ? minimiseProfile(chi2, t0, t1, birge) : first;
+    StrengthFit fit = fitOfProfile(p, prior, chi2, features, birge);
     fit.chi2_off = chi2(prior.toScale(prior.off));
     return fit;
 }
@@ -264,7 +275,6 @@ Eigen::VectorXd bedLuckSd(const std::function<Eigen::VectorXd(const Eigen::Vecto
 }
 
 void widenInterval(StrengthFit &fit, const Prior &prior, double sd, double dof) {
-    fit.spread_lo = fit.lo, fit.spread_hi = fit.hi;
     if (!(sd > 0.0) || !std::isfinite(sd) || !(dof >= 1.0))
         return;
     const double t = prior.toScale(fit.strength);
@@ -327,20 +337,11 @@ PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Pri
     const double birge = std::max(1.0, fit.chi2 / dof);
     const Profile qa = minimiseProfile([&](double t) { return chi2(t, tb); }, a0, a1, birge);
     const Profile qb = minimiseProfile([&](double t) { return chi2(ta, t); }, b0, b1, birge);
-    const auto fill = [&](StrengthFit &f, const Profile &q, const Prior &p, auto profile) {
-        f.strength = p.fromScale(q.t_best);
-        f.lo = p.fromScale(q.t_lo);
-        f.hi = p.fromScale(q.t_hi);
-        f.spread_lo = f.lo, f.spread_hi = f.hi;
-        f.chi2 = q.chi2;
-        f.at_bound = q.at_bound;
-        f.beyond_prior = beyondPrior(profile, q, p.toScale(p.lo), p.toScale(p.hi), p.toScale(p.off));
-        f.at_prior_edge = atPriorEdge(q, p.toScale(p.lo), p.toScale(p.hi), p.toScale(p.off));
-        f.features = int(use.size());
-        f.birge = birge;
-    };
-    fill(fit.a, qa, pa, [&](double t) { return chi2(t, tb); });
-    fill(fit.b, qb, pb, [&](double t) { return chi2(ta, t); });
+    const int features = int(use.size());
+    fit.a = fitOfProfile(
+        qa, pa, [&](double t) { return chi2(t, tb); }, features, birge);
+    fit.b = fitOfProfile(
+        qb, pb, [&](double t) { return chi2(ta, t); }, features, birge);
     fit.chi2 = std::min({fit.chi2, qa.chi2, qb.chi2});
     fit.a.chi2_off = fit.b.chi2_off = chi2(pa.toScale(pa.off), pb.toScale(pb.off));
     return fit;
