@@ -1,4 +1,5 @@
 #include "grainlink/gap/Diagnosis.hpp"
+#include "grainlink/config/Number.hpp"
 
 #include "NotANumber.hpp"
 
@@ -16,10 +17,7 @@ namespace grainlink::gap {
 namespace {
 
 std::string fmt(double v, int digits = 3) {
-    std::ostringstream s;
-    s.precision(digits);
-    s << v;
-    return s.str();
+    return config::significant(v, digits);
 }
 
 /// The spread a fitted strength's 95 % interval gives its prediction, ((m(hi) - m(lo))/3.92)^2

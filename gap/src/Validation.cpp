@@ -1,4 +1,5 @@
 #include "grainlink/gap/Validation.hpp"
+#include "grainlink/config/Number.hpp"
 
 #include "NotANumber.hpp"
 
@@ -31,9 +32,7 @@ std::string observableName(const std::string &observable) {
 }
 
 std::string format(double v, int digits = 2) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-    return buf;
+    return config::significant(v, digits);
 }
 
 /// "2.1-2.9", or "2.5" when both ends print the same.

@@ -1,4 +1,5 @@
 #include "grainlink/lab/Bevameter.hpp"
+#include "grainlink/config/Number.hpp"
 
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
@@ -29,12 +30,6 @@ dem::TriangleMesh plateMesh(double radius_m, double thickness_m, int segments) {
     for (Vec3 &v : mesh.vertices_m)
         v = Vec3(v.x(), -v.z(), v.y() + 0.5 * thickness_m); // cylinder axis y -> z
     return mesh;
-}
-
-std::string mm(double m) {
-    std::ostringstream out;
-    out << std::setprecision(4) << m * 1e3 << " mm";
-    return out.str();
 }
 
 } // namespace
@@ -143,7 +138,7 @@ PlateRun BevameterExperiment::run(const LabBed &bed, double radius,
     std::fprintf(stderr,
                  "[bevameter] R = %s: bed surface %.5f m, highest grain under the plate "
                  "%.5f m, plate starts at %.5f m\n",
-                 mm(radius).c_str(), surface, highest, initial.position_m.z());
+                 config::millimetres(radius).c_str(), surface, highest, initial.position_m.z());
     dem::MeshBody plate("plate", plateMesh(radius, thickness, t.plate_segments), initial);
     plate.friction_coefficient = t.plate_friction_coefficient;
     const double z0 = initial.position_m.z(), v = t.speed_m_s;
@@ -155,7 +150,7 @@ PlateRun BevameterExperiment::run(const LabBed &bed, double radius,
     const auto steps_per_sample =
         std::max<std::uint64_t>(1, std::llround(t.sample_interval_s / dt));
     const double area = M_PI * radius * radius;
-    dem::Progress progress("bevameter R=" + mm(radius), progress_interval_s);
+    dem::Progress progress("bevameter R=" + config::millimetres(radius), progress_interval_s);
     std::uint64_t done = 0;
     while (done < total_steps) {
         const std::uint64_t n = std::min(steps_per_sample, total_steps - done);
@@ -167,15 +162,17 @@ PlateRun BevameterExperiment::run(const LabBed &bed, double radius,
         s.force_N = load.force_N.z();
         s.pressure_Pa = s.force_N / area;
         run.samples.push_back(s);
-        progress.update(
-            sys.time(), double(done) / double(total_steps), done * sys.particles().size(),
-            "sinkage " + mm(s.sinkage_m) + ", p " + std::to_string(s.pressure_Pa) + " Pa");
+        progress.update(sys.time(), double(done) / double(total_steps),
+                        done * sys.particles().size(),
+                        "sinkage " + config::millimetres(s.sinkage_m) + ", p " +
+                            std::to_string(s.pressure_Pa) + " Pa");
     }
     run.steps = done;
     run.wall_s = secondsSince(plate_start);
     std::fprintf(stderr, "[bevameter] R = %s: %llu steps in %.1f s, p(%s) = %.4g Pa\n",
-                 mm(radius).c_str(), static_cast<unsigned long long>(done), run.wall_s,
-                 mm(run.samples.back().sinkage_m).c_str(), run.samples.back().pressure_Pa);
+                 config::millimetres(radius).c_str(), static_cast<unsigned long long>(done),
+                 run.wall_s, config::millimetres(run.samples.back().sinkage_m).c_str(),
+                 run.samples.back().pressure_Pa);
     return run;
 }
 
@@ -191,13 +188,13 @@ std::string BevameterResult::report() const {
     out << "Virtual bevameter (pressure-sinkage)\n";
     writeBedLine(out, bed);
     for (const auto &p : runs) {
-        out << "  plate R = " << mm(p.plate_radius_m) << ": Gamma = R/r_max = " << p.resolution
-            << ", rim to region side " << mm(p.wall_gap_m) << " ("
-            << p.wall_gap_m / (2 * p.plate_radius_m)
-            << " diameters), bed under the plate at the end " << mm(p.depth_below_m) << "; "
-            << p.steps << " steps, " << p.wall_s
+        out << "  plate R = " << config::millimetres(p.plate_radius_m)
+            << ": Gamma = R/r_max = " << p.resolution << ", rim to region side "
+            << config::millimetres(p.wall_gap_m) << " (" << p.wall_gap_m / (2 * p.plate_radius_m)
+            << " diameters), bed under the plate at the end "
+            << config::millimetres(p.depth_below_m) << "; " << p.steps << " steps, " << p.wall_s
             << " s wall; final p = " << p.samples.back().pressure_Pa
-            << " Pa at z = " << mm(p.samples.back().sinkage_m) << "\n";
+            << " Pa at z = " << config::millimetres(p.samples.back().sinkage_m) << "\n";
     }
     if (fit)
         out << fit->describe();

@@ -1,4 +1,5 @@
 #include "grainlink/lab/DirectShear.hpp"
+#include "grainlink/config/Number.hpp"
 
 #include "grainlink/dem/Progress.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
@@ -57,9 +58,7 @@ dem::TriangleMesh frameMesh(double L, double W, double h, double lip_x0, double 
 }
 
 std::string kPa(double pa) {
-    std::ostringstream out;
-    out << std::setprecision(4) << pa * 1e-3 << " kPa";
-    return out.str();
+    return config::significant(pa * 1e-3, 4) + " kPa";
 }
 
 /// Top plate's vertical motion, set by the servo between control intervals, and the shear

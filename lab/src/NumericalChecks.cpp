@@ -1,4 +1,5 @@
 #include "grainlink/lab/NumericalChecks.hpp"
+#include "grainlink/config/Number.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -23,13 +24,7 @@ std::size_t scaledCount(std::size_t count, double scale) {
 }
 
 std::string number(double x, int digits = 4) {
-    std::ostringstream out;
-    out << std::setprecision(digits) << x;
-    return out.str();
-}
-
-std::string mm(double m) {
-    return number(m * 1e3) + " mm";
+    return config::significant(x, digits);
 }
 
 /// Linear interpolation of y(x) in samples sorted by x; clamped to the ends.
@@ -239,8 +234,9 @@ Quantities bevameterQuantities(const BevameterResult &result, double max_sinkage
         const PressureSinkageCurve c = p.curve();
         for (double fraction : {0.25, 0.5, 0.75, 1.0}) {
             const double z = fraction * max_sinkage_m;
-            q.push_back({"p(" + mm(z) + "), R = " + mm(p.plate_radius_m), "Pa",
-                         interpolate(c.sinkage_m, c.pressure_Pa, z)});
+            q.push_back(
+                {"p(" + config::millimetres(z) + "), R = " + config::millimetres(p.plate_radius_m),
+                 "Pa", interpolate(c.sinkage_m, c.pressure_Pa, z)});
         }
     }
     if (result.fit) {

@@ -1,0 +1,20 @@
+#pragma once
+// A number as a message or a report prints it: `digits` significant digits, as "%g" does
+// (2.1, 0.047, 3.9e+04), the one way every part of grainlink words a figure.
+#include <cstdio>
+#include <string>
+
+namespace grainlink::config {
+
+inline std::string significant(double v, int digits) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+    return buf;
+}
+
+/// A length in metres as millimetres, to four significant digits: "12.35 mm".
+inline std::string millimetres(double metres) {
+    return significant(metres * 1e3, 4) + " mm";
+}
+
+} // namespace grainlink::config
