@@ -2,6 +2,7 @@
 
 #include "NotANumber.hpp"
 
+#include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
 #include <algorithm>
@@ -287,6 +288,53 @@ void widenInterval(StrengthFit &fit, const Prior &prior, double sd, double dof) 
     widened(boost::math::quantile(boost::math::students_t(dof), 0.975) * sd, fit.lo, fit.hi);
     widened(1.959963984540054 * sd, fit.spread_lo, fit.spread_hi);
     fit.luck_sd = sd;
+}
+
+StrengthAgreement strengthAgreement(const std::vector<StrengthFit> &parts, const Prior &prior) {
+    const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi), span = t1 - t0;
+    struct Part {
+        double t, below, above; // strength and half-widths on the prior's scale
+    };
+    std::vector<Part> used;
+    for (const StrengthFit &f : parts) {
+        const double t = prior.toScale(f.strength), lo = prior.toScale(f.lo),
+                     hi = prior.toScale(f.hi);
+        if (std::isfinite(t) && std::isfinite(lo) && std::isfinite(hi) && hi - lo < 0.9 * span)
+            used.push_back({t, t - lo, hi - t});
+    }
+    StrengthAgreement a;
+    a.mean = kNaN;
+    if (used.empty())
+        return a;
+    // A half-width of nothing (a profile as sharp as the grid) would weigh without end: a
+    // two-hundredth of the prior at least.
+    const double floor = 0.005 * span, z95 = 1.959963984540054;
+    const auto sd = [&](const Part &p, double towards) {
+        return std::max(towards >= p.t ? p.above : p.below, floor) / z95;
+    };
+    // The mean with the symmetric widths, then once more with the sides that face it.
+    double mean = 0.0, weights = 0.0;
+    for (const Part &p : used) {
+        const double s = std::max(0.5 * (p.below + p.above), floor) / z95;
+        mean += p.t / (s * s), weights += 1.0 / (s * s);
+    }
+    mean /= weights;
+    double again = 0.0;
+    weights = 0.0;
+    for (const Part &p : used) {
+        const double s = sd(p, mean);
+        again += p.t / (s * s), weights += 1.0 / (s * s);
+    }
+    a.mean = prior.fromScale(again / weights);
+    for (const Part &p : used) {
+        const double s = sd(p, again / weights);
+        a.chi2 += (p.t - again / weights) * (p.t - again / weights) / (s * s);
+    }
+    a.dof = int(used.size()) - 1;
+    if (a.dof > 0)
+        a.p_value =
+            boost::math::cdf(boost::math::complement(boost::math::chi_squared(a.dof), a.chi2));
+    return a;
 }
 
 Eigen::VectorXd PairResponse::mean(double sa, double sb) const {

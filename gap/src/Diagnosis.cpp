@@ -233,6 +233,16 @@ BedLuck bedLuck(const Measured &meas, const FeatureSet &calibration,
     return luck;
 }
 
+/// The first confirmed candidate that would explain the gap but for its kinds of observable
+/// asking for different strengths of it; null if none.
+const CandidateResult *disagreeing(const std::vector<CandidateResult> &candidates) {
+    for (const CandidateResult &R : candidates)
+        if (R.confirmed && R.beats_null && !R.after.gap && !R.fit.at_prior_edge &&
+            !R.strengths_agree)
+            return &R;
+    return nullptr;
+}
+
 } // namespace
 
 ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidates,
@@ -761,6 +771,28 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         luck.widen(refit, L.response->mean(fit.strength), {{&fit, &p}});
         return fit;
     };
+    // The same fit on one kind of observable at a time, over every compared experiment (a
+    // check of the claim, not a fit of it: the held-out experiments may veto, never choose).
+    std::map<std::string, FeatureSet> kinds;
+    for (const FeatureSet *part : {&D.calibration, &D.held_out})
+        for (Eigen::Index k : *part)
+            kinds[meas.keys[std::size_t(k)].kind].push_back(k);
+    const auto fitByKind = [&](CandidateResult &R, const Response &response) {
+        const Prior &p = R.effect.prior;
+        std::vector<StrengthFit> parts;
+        for (const auto &[kind, use] : kinds) {
+            StrengthFit fit = fitStrength(response, p, meas.value, u2_fixed, use, correlation);
+            const auto refit = [&](const Eigen::VectorXd &pseudo) {
+                const StrengthFit f = fitStrength(response, p, pseudo, u2_fixed, use, correlation);
+                return Eigen::VectorXd::Constant(1, p.toScale(f.strength));
+            };
+            bedLuck(meas, use, base_rows, opt.signature_seeds)
+                .widen(refit, response.mean(fit.strength), {{&fit, &p}});
+            R.by_kind.emplace_back(kind, fit);
+            parts.push_back(fit);
+        }
+        R.agreement = strengthAgreement(parts, p);
+    };
     for (Live &L : live) {
         if (!L.response)
             continue;
@@ -951,7 +983,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // A strength at its prior's edge may stand in for something the catalogue lacks (LIGGGHTS'
         // 5x softer soil fitted by the softest grains allowed): it may beat the null, it is
         // still not claimed as the cause.
-        R.explains = R.beats_null && !R.after.gap && !R.fit.at_prior_edge && resolved;
+        fitByKind(R, *L.response);
+        R.strengths_agree = R.agreement.p_value >= opt.agreement_level;
+        R.explains =
+            R.beats_null && !R.after.gap && !R.fit.at_prior_edge && resolved && R.strengths_agree;
     }
     for (Live &L : live)
         D.candidates.push_back(L.result);
@@ -1152,6 +1187,18 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                               : "p = " + fmt(best_no_gap->versus_null.p_value, 2) +
                                     " against the null")
                       << "): these experiments do not tell them apart";
+            } else if (const CandidateResult *torn = disagreeing(D.candidates)) {
+                claim << "unexplained: " << torn->name << " ("
+                      << strengthText(torn->effect, torn->fit.strength) << ", held-out gap "
+                      << fmt(100.0 * torn->held_out.gap, 2)
+                      << " %, p = " << fmt(torn->versus_null.p_value, 2)
+                      << ") beats the null model and leaves no gap, but the kinds of observable "
+                         "ask for different strengths of it (";
+                for (const auto &[kind, fit] : torn->by_kind)
+                    claim << kind << ' ' << fmt(fit.strength) << " [" << fmt(fit.lo) << ", "
+                          << fmt(fit.hi) << "]; ";
+                claim << "p = " << fmt(torn->agreement.p_value, 2)
+                      << "): it absorbs a difference of model form rather than explaining it";
             } else if (!claim_possible)
                 claim << "unexplained: the held-out experiments are one piece of evidence: "
                          "one experiment, or one group the model simulates on a single bed "

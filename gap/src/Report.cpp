@@ -132,6 +132,14 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
                 cj["held_out_gain"] = gain(c.versus_null);
                 cj["beats_null"] = c.beats_null;
                 cj["gap_test_with_effect"] = verdict(c.after);
+                cj["strength_by_kind"] = Json::array();
+                for (const auto &[kind, fit] : c.by_kind)
+                    cj["strength_by_kind"].push_back(
+                        {{"kind", kind}, {"strength", strength(c.effect, fit)}});
+                cj["strength_agreement"] = {{"chi2", number(c.agreement.chi2)},
+                                            {"dof", c.agreement.dof},
+                                            {"p_value", number(c.agreement.p_value)},
+                                            {"weighted_mean", number(c.agreement.mean)}};
                 cj["explains"] = c.explains;
             }
         }
@@ -235,8 +243,18 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
               << (c.explains ? ", EXPLAINS"
                   : c.beats_null && c.fit.at_prior_edge
                       ? ", beats the null but only at its prior's edge"
-                  : c.beats_null ? ", beats the null but leaves a gap"
+                  : c.beats_null && c.after.gap ? ", beats the null but leaves a gap"
+                  : c.beats_null && !c.strengths_agree
+                      ? ", beats the null but its kinds of observable ask for different strengths"
+                  : c.beats_null ? ", beats the null but is not claimable"
                                  : ", does not beat the null");
+        if (c.confirmed && c.agreement.dof > 0) {
+            r << "\n      by kind:";
+            for (const auto &[kind, fit] : c.by_kind)
+                r << ' ' << kind << ' ' << fit.strength << " [" << fit.lo << ", " << fit.hi << "];";
+            r << " agreement chi^2 " << c.agreement.chi2 << " (" << c.agreement.dof
+              << " dof), p = " << c.agreement.p_value;
+        }
         if (c.fit.beyond_prior)
             r << "; pinned at its prior's edge (the data ask for more than " << c.effect.prior.lo
               << "-" << c.effect.prior.hi << " allows)";

@@ -633,3 +633,44 @@ TEST_CASE("a fit pinned at its prior's edge is flagged only when the data ask fo
     CHECK_FALSE(below.beyond_prior);
     CHECK_FALSE(below.at_prior_edge);
 }
+
+TEST_CASE("strengthAgreement: parts that ask for one strength agree, parts that ask for two do "
+          "not, by a two-sample z test",
+          "[gap][attribution]") {
+    const Prior linear{0.0, 1.0, 0.0, false};
+    const double z = 1.959963984540054; // the normal's 97.5 % quantile
+    const auto part = [](double s, double below, double above) {
+        StrengthFit f;
+        f.strength = s, f.lo = s - below, f.hi = s + above;
+        return f;
+    };
+    // 0.2 +- 0.05 and 0.5 +- 0.1 (sd): z = 0.3 / sqrt(0.05^2 + 0.1^2) = 2.683, two-sided
+    // p = 0.0073 (normal table), the weighted mean (0.2 / 0.05^2 + 0.5 / 0.1^2) / 500 = 0.26.
+    const StrengthAgreement two =
+        strengthAgreement({part(0.2, z * 0.05, z * 0.05), part(0.5, z * 0.1, z * 0.1)}, linear);
+    CHECK(two.dof == 1);
+    CHECK(two.chi2 == Approx(7.2).epsilon(1e-9));
+    CHECK(two.p_value == Approx(0.0073).margin(0.0001));
+    CHECK(two.mean == Approx(0.26).epsilon(1e-9));
+    // Each part's side facing the mean counts: 0.2 (-0.02, +0.196) and 0.5 (+-0.196) meet at
+    // 0.35, 0.15 = 1.5 sd from each: chi^2 = 2 x 1.5^2 = 4.5.
+    const StrengthAgreement sides =
+        strengthAgreement({part(0.2, 0.02, z * 0.1), part(0.5, z * 0.1, z * 0.1)}, linear);
+    CHECK(sides.chi2 == Approx(4.5).epsilon(1e-9));
+    CHECK(sides.mean == Approx(0.35).epsilon(1e-9));
+    // A part whose interval spans nine tenths of the prior tells nothing: one part left, no
+    // comparison.
+    const StrengthAgreement one =
+        strengthAgreement({part(0.2, 0.1, 0.1), part(0.5, 0.5, 0.45)}, linear);
+    CHECK(one.dof == 0);
+    CHECK(one.p_value == 1.0);
+    CHECK(one.mean == Approx(0.2));
+    // On a log prior the comparison is on log strength: x 2 and x 8, each with a standard
+    // deviation of ln 2: chi^2 = (ln 4)^2 / (2 (ln 2)^2) = 2.
+    const Prior log_prior{0.1, 10.0, 1.0, true};
+    const double f95 = std::exp(z * std::log(2.0));
+    StrengthFit a, b;
+    a.strength = 2.0, a.lo = 2.0 / f95, a.hi = 2.0 * f95;
+    b.strength = 8.0, b.lo = 8.0 / f95, b.hi = 8.0 * f95;
+    CHECK(strengthAgreement({a, b}, log_prior).chi2 == Approx(2.0).epsilon(1e-9));
+}

@@ -31,7 +31,16 @@ struct Truth {
     /// DEM code, another contact law): the exponent of z, and a trend with plate size.
     double exponent_shift = 0.0;
     double size_trend = 0.0;
+    /// The measuring world's heap (an angle of repose experiment, where the set has one): by
+    /// default the model's own law (`angle`), else this angle.
+    double heap_deg = 0.0;
 };
+
+/// The analytic heap's angle: 30 deg, which denser grains steepen in proportion (the model's
+/// law; a world may differ).
+double angle(const Truth &t) {
+    return 30.0 * (t.effect == "grain_density" ? t.strength : 1.0);
+}
 
 double pressure(double z, double d, const std::string &box, const Truth &t) {
     const double confinement = box == "small" ? 1.25 : 1.0;
@@ -144,12 +153,17 @@ public:
                         else
                             t = {alias.count(eff->name) ? alias.at(eff->name) : eff->name, str};
                     }
-                    const double d = e.numbers.at("plate_diameter_m");
                     const bool confirming = r.label.rfind("confirm ", 0) == 0;
                     const double bed = !r.effect ? 0.03
                                        : confirming && confirm_scatter_of.count(r.effect->name)
                                            ? confirm_scatter_of.at(r.effect->name)
                                            : effect_bed_scatter;
+                    if (e.type == ExperimentType::AngleOfRepose) {
+                        curves[e.id]["angle_deg"] = Curve{
+                            {0.0}, {angle(t) * (1.0 + bed * std::normal_distribution<>()(rng))}};
+                        continue;
+                    }
+                    const double d = e.numbers.at("plate_diameter_m");
                     // Plates on the same beds draw the same bed (its level and tilt).
                     std::mt19937 same_bed(2000 + 31 * s + (e.labels.at("box") == "small"));
                     Curve c = plateCurve(d, e.labels.at("box"), t,
@@ -1218,4 +1232,91 @@ TEST_CASE("diagnosis: a fitted strength's interval carries the measured trials' 
             held += f.lo <= s && s <= f.hi;
         }
     CHECK(held >= 50);
+}
+
+namespace {
+
+/// The analytic plates and a heap, measured three times (2 % scatter from heap to heap).
+ExperimentSet withHeap(const Truth &t, unsigned seed) {
+    ExperimentSet set = measuredSet(t, seed);
+    std::mt19937 rng(seed + 100);
+    std::normal_distribution<double> z01;
+    Experiment e;
+    e.id = "repose";
+    e.type = ExperimentType::AngleOfRepose;
+    e.x_name = ""; // a scalar
+    e.observables = {"angle_deg"};
+    e.labels["box"] = "large";
+    for (int r = 0; r < 3; ++r) {
+        Trial tr;
+        tr.curves["angle_deg"] =
+            Curve{{0.0}, {(t.heap_deg > 0.0 ? t.heap_deg : angle(t)) * (1.0 + 0.02 * z01(rng))}};
+        e.trials.push_back(tr);
+    }
+    set.experiments.push_back(e);
+    return set;
+}
+
+} // namespace
+
+TEST_CASE("diagnosis: an effect whose kinds of observable ask for different strengths of it is "
+          "not claimed",
+          "[gap][diagnosis][mismatch]") {
+    // Denser grains (x 1.5) raise the analytic plates' pressure 1.5 times and, in the model, the
+    // heap's angle from 30 to 45 deg. Where the measuring world's heap follows that law the plates
+    // and the heap ask for one density (the hidden 1.5) and it is claimed. Where its heap stands
+    // at 41 deg (another code's law: 41 / 30 = x 1.37 by the model's), the fit on plates and heap
+    // together still beats the null and leaves no gap (|z| of the heap below the bound), so
+    // without the agreement test it is claimed; the plates (x 1.5) and the heap (x 1.37) disagree
+    // at p < 0.01, and the density absorbs a difference of model form: not claimed.
+    const EffectCatalogue c = shippedEffects();
+    const auto diagnoseWith = [&](double heap_deg, double level) {
+        AnalyticSimulator sim;
+        DiagnosisOptions o = analyticOptions();
+        o.agreement_level = level;
+        Truth t{"grain_density", 1.5};
+        t.heap_deg = heap_deg;
+        return diagnose(withHeap(t, 7), c.diagnosable(), sim, o);
+    };
+    const auto density = [](const Diagnosis &d) {
+        for (const CandidateResult &r : d.candidates)
+            if (r.name == "grain_density")
+                return r;
+        FAIL("grain_density was not a candidate");
+        return CandidateResult{};
+    };
+    const auto kindStrength = [](const CandidateResult &r, const std::string &kind) {
+        for (const auto &[k, fit] : r.by_kind)
+            if (k == kind)
+                return fit.strength;
+        FAIL("no strength for " << kind);
+        return 0.0;
+    };
+
+    const Diagnosis agree = diagnoseWith(0.0, 0.01);
+    INFO(agree.claim);
+    CHECK(agree.outcome == Diagnosis::Outcome::Explained);
+    CHECK(agree.explained_by == "grain_density");
+    const CandidateResult one = density(agree);
+    CHECK(one.agreement.dof == 1);
+    CHECK(one.agreement.p_value >= 0.01);
+    CHECK(kindStrength(one, "plate_sinkage/pressure_Pa") == Approx(1.5).epsilon(0.05));
+    CHECK(kindStrength(one, "angle_of_repose/angle_deg") == Approx(1.5).epsilon(0.05));
+
+    const Diagnosis unchecked = diagnoseWith(41.0, 0.0);
+    INFO(unchecked.claim);
+    CHECK(unchecked.outcome == Diagnosis::Outcome::Explained);
+
+    const Diagnosis torn = diagnoseWith(41.0, 0.01);
+    INFO(torn.claim);
+    CHECK(torn.outcome == Diagnosis::Outcome::Unexplained);
+    CHECK_THAT(torn.claim, Catch::Contains("grain_density") &&
+                               Catch::Contains("the kinds of observable ask for different "
+                                               "strengths of it") &&
+                               Catch::Contains("absorbs a difference of model form"));
+    const CandidateResult two = density(torn);
+    CHECK_FALSE(two.strengths_agree);
+    CHECK(two.agreement.p_value < 0.01);
+    CHECK(kindStrength(two, "plate_sinkage/pressure_Pa") == Approx(1.5).epsilon(0.05));
+    CHECK(kindStrength(two, "angle_of_repose/angle_deg") == Approx(41.0 / 30.0).epsilon(0.05));
 }

@@ -124,6 +124,22 @@ Eigen::VectorXd bedLuckSd(const std::function<Eigen::VectorXd(const Eigen::Vecto
 /// half-width in quadrature), within the prior; records it in `luck_sd`.
 void widenInterval(StrengthFit &fit, const Prior &prior, double sd, double dof);
 
+/// Whether the strengths that parts of the data ask for alone (one kind of observable each:
+/// the plates' pressure, the shear box's stress, the heap's angle) agree, as one cause's
+/// would: chi^2 of their spread about their precision-weighted mean on the prior's scale, each
+/// with the standard deviation its 95 % interval gives on the side facing that mean
+/// (half-width / 1.96), against chi^2 of (informative parts - 1) degrees of freedom. A part
+/// whose interval spans nine tenths of the prior or more tells nothing and is left out. An
+/// effect fitted at a strength no single part asks for absorbs a difference of model form, as
+/// a tuned parameter does, instead of explaining it (docs/gap.md, step 7).
+struct StrengthAgreement {
+    double chi2 = 0.0;
+    int dof = 0;          ///< informative parts - 1; 0: nothing to compare
+    double p_value = 1.0; ///< 1 when dof is 0
+    double mean = 0.0;    ///< the weighted mean strength (NaN when no part is informative)
+};
+StrengthAgreement strengthAgreement(const std::vector<StrengthFit> &parts, const Prior &prior);
+
 /// Two effects together, their changes added to the base (the confirming simulation runs them
 /// together for real).
 class PairResponse final : public Response {

@@ -84,6 +84,9 @@ struct DiagnosisOptions {
     int measurement_grid = 17; ///< strengths tabulated for a measuring-chain effect (no simulation)
     int max_confirmed = 3;    ///< candidates re-simulated at their fitted strength
     int pair_pool = 4;        ///< singles combined into pairs when none explains the gap
+    /// A confirmed effect whose kinds of observable ask for strengths that disagree at this
+    /// level (`strengthAgreement`) absorbs a difference of model form: never claimed.
+    double agreement_level = 0.01;
     /// Held-out experiments by id; empty: the split rule of docs/gap.md ("Calibration and
     /// held-out experiments").
     std::vector<std::string> held_out;
@@ -106,6 +109,12 @@ struct CandidateResult {
     bool beats_null = false;
     bool explains = false;     ///< beats the null and leaves no gap on any feature
     GapVerdict after;          ///< the gap test with the effect added (confirmed)
+    /// The strength each kind of observable asks for alone, over every compared experiment,
+    /// with the beds' luck (confirmed candidates; "plate_sinkage/pressure_Pa" -> its fit), and
+    /// whether they agree.
+    std::vector<std::pair<std::string, StrengthFit>> by_kind;
+    StrengthAgreement agreement;
+    bool strengths_agree = true;    ///< the agreement's p is at the options' level or above
     Eigen::VectorXd confirmed_mean; ///< features of the confirming runs
     Eigen::VectorXd confirmed_z;    ///< their normal-equivalent residuals, as `after` judged them
 };
