@@ -780,7 +780,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     const auto fitByKind = [&](CandidateResult &R, const Response &response) {
         const Prior &p = R.effect.prior;
         std::vector<StrengthFit> parts;
-        for (const auto &[kind, use] : kinds) {
+        for (const auto &kind_features : kinds) {
+            const FeatureSet &use = kind_features.second; // a lambda cannot capture a binding
             StrengthFit fit = fitStrength(response, p, meas.value, u2_fixed, use, correlation);
             const auto refit = [&](const Eigen::VectorXd &pseudo) {
                 const StrengthFit f = fitStrength(response, p, pseudo, u2_fixed, use, correlation);
@@ -788,7 +789,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             };
             bedLuck(meas, use, base_rows, opt.signature_seeds)
                 .widen(refit, response.mean(fit.strength), {{&fit, &p}});
-            R.by_kind.emplace_back(kind, fit);
+            R.by_kind.emplace_back(kind_features.first, fit);
             parts.push_back(fit);
         }
         R.agreement = strengthAgreement(parts, p);
