@@ -904,11 +904,33 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         return VariantRequest{"confirm " + live[i].result.name, raw, live[i].result.fit.strength,
                               nullptr, 0.0, "", opt.seeds};
     };
+    // A fitted strength need not be a scenario the simulator can run where the signatures'
+    // strengths were (the full self-test's narrow box at width x 0.71, narrower than a plate
+    // pressed into it): its runs are refused, taken as failed, and never stop the diagnosis.
+    const auto simulateValid = [&](const std::vector<VariantRequest> &requests) {
+        std::vector<Eigen::MatrixXd> rows(requests.size());
+        std::vector<VariantRequest> valid;
+        std::vector<std::size_t> at;
+        for (std::size_t i = 0; i < requests.size(); ++i) {
+            if (const std::string why = simulator.refusal(set, requests[i]); !why.empty()) {
+                log(requests[i].label + " at " + fmt(requests[i].strength) +
+                    " is no valid scenario here, taken as failed runs: " + why);
+                rows[i] = Eigen::MatrixXd::Constant(requests[i].seeds, n, kNaN);
+            } else {
+                valid.push_back(requests[i]);
+                at.push_back(i);
+            }
+        }
+        const auto simulated = simulator.simulate(set, design, valid);
+        for (std::size_t k = 0; k < at.size(); ++k)
+            rows[at[k]] = simulated[k];
+        return rows;
+    };
     std::vector<VariantRequest> confirm;
     for (std::size_t i : to_confirm)
         confirm.push_back(confirmRequest(i));
     log("confirming " + std::to_string(confirm.size()) + " candidates");
-    auto confirm_rows = simulator.simulate(set, design, confirm);
+    auto confirm_rows = simulateValid(confirm);
     for (const auto &r : confirm)
         D.simulations += r.seeds;
     // A candidate whose confirming runs failed predicts nothing: the next one by calibration
@@ -928,7 +950,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         if (!more.empty()) {
             log("confirming runs failed: confirming " + std::to_string(more.size()) +
                 " more candidates in their place");
-            const auto more_rows = simulator.simulate(set, design, more);
+            const auto more_rows = simulateValid(more);
             for (std::size_t k = 0; k < more.size(); ++k) {
                 confirm.push_back(more[k]);
                 confirm_rows.push_back(more_rows[k]);
@@ -964,7 +986,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 again_of.push_back(c);
             }
         }
-        const auto again_rows = simulator.simulate(set, design, again);
+        const auto again_rows = simulateValid(again);
         for (std::size_t i = 0; i < again.size(); ++i) {
             D.simulations += again[i].seeds;
             final_rows[again_of[i]] = again_rows[i];
@@ -1077,7 +1099,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         }
         if (!pr.empty())
             log("no single effect explains the gap: confirming " + std::to_string(pr.size()) + " pairs");
-        const auto pair_rows = simulator.simulate(set, design, pr);
+        const auto pair_rows = simulateValid(pr);
         for (const auto &r : pr)
             D.simulations += r.seeds;
         const double pair_level = opt.alpha / std::max<std::size_t>(1, confirm.size() + pr.size());
