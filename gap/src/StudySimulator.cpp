@@ -610,7 +610,7 @@ BaseModel loadBaseModel(const std::string &path) {
     if (const auto n = root.optional("numerics")) {
         b.seeds = int(n->integer("seeds", 2, 64, 3));
         b.signature_seeds = int(n->integer("signature_seeds", 1, 64, 2));
-        b.check_seeds = int(n->integer("check_seeds", 1, 64, 2));
+        b.check_seeds = int(n->integer("check_seeds", 1, 64, 3));
         b.threads = int(n->integer("threads", 1, dem::kMaxThreads, 1));
         if (const auto checks = n->optional("checks"))
             for (const std::string &c : checks->keys()) {

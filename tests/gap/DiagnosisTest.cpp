@@ -293,7 +293,7 @@ TEST_CASE("a dry run plans the runs the diagnosis then asks for, and names what 
     REQUIRE(sim.calls.size() >= 2);
     CHECK(labels(plan.first) == sim.calls[0]);
     CHECK(labels(plan.signatures) == sim.calls[1]);
-    CHECK(labels(plan.first) == std::vector<std::string>{"base x4", "check resolution x2"});
+    CHECK(labels(plan.first) == std::vector<std::string>{"base x4", "check resolution x3"});
     CHECK(plan.design.size() == d.design.size());
     CHECK(plan.held_out == analyticOptions().held_out);
     // Every diagnosable effect is either planned or named with why not, as in the diagnosis.

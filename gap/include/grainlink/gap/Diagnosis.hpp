@@ -80,7 +80,7 @@ struct DiagnosisOptions {
     double flag_at = 2.0;  ///< a feature beyond this many u_val is flagged
     int seeds = 3;         ///< base and confirming runs
     int signature_seeds = 2;
-    int check_seeds = 2;
+    int check_seeds = 3; ///< two pairs give a one-feature experiment one dof (docs/gap.md, step 2)
     int measurement_grid = 17; ///< strengths tabulated for a measuring-chain effect (no simulation)
     int max_confirmed = 3;    ///< candidates re-simulated at their fitted strength
     int pair_pool = 4;        ///< singles combined into pairs when none explains the gap

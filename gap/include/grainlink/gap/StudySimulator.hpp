@@ -27,7 +27,7 @@ struct BaseModel {
     /// text condition -> its value -> the soil merged over the base's for experiments with it
     /// (`boxes:` gives the `box` condition's, `conditions:` any other's: a bed preparation)
     std::map<std::string, std::map<std::string, YAML::Node>> conditions;
-    int seeds = 3, signature_seeds = 2, check_seeds = 2, threads = 1;
+    int seeds = 3, signature_seeds = 2, check_seeds = 3, threads = 1;
     std::map<std::string, double> checks;      ///< numerical check -> its factor
 };
 
