@@ -896,17 +896,44 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 (to_confirm.empty() || live[i].result.fit.chi2 <= tie))
                 to_confirm.push_back(i);
     }
+    // A fitted strength need not be a scenario the simulator can run where the signatures'
+    // strengths were (the full self-test's narrow box at width x 0.713, narrower than the 25 mm
+    // plate pressed into it): the strength nearest the fit that runs, found by bisection towards
+    // the nearest signature strength, is confirmed in its place and becomes the fit.
+    const auto runnable = [&](CandidateResult &R, VariantRequest r) {
+        if (simulator.refusal(set, r).empty())
+            return r;
+        const Prior &p = R.effect.prior;
+        double good = p.off;
+        for (double s : R.effect.signature)
+            if (std::abs(p.toScale(s) - p.toScale(r.strength)) <
+                std::abs(p.toScale(good) - p.toScale(r.strength)))
+                good = s;
+        VariantRequest probe = r;
+        probe.strength = good;
+        if (!simulator.refusal(set, probe).empty())
+            return r; // refused as it is: taken as failed runs
+        double t_bad = p.toScale(r.strength), t_good = p.toScale(good);
+        for (int k = 0; k < 20; ++k) {
+            probe.strength = p.fromScale(0.5 * (t_bad + t_good));
+            (simulator.refusal(set, probe).empty() ? t_good : t_bad) = p.toScale(probe.strength);
+        }
+        log(R.name + " at " + fmt(r.strength) + " is no valid scenario here; confirmed at " +
+            fmt(p.fromScale(t_good)) + ", the nearest that is");
+        r.strength = R.fit.strength = p.fromScale(t_good);
+        return r;
+    };
     const auto confirmRequest = [&](std::size_t i) {
         const Effect *raw = nullptr;
         for (const Effect *e : effects)
             if (e->name == live[i].result.name)
                 raw = e;
-        return VariantRequest{"confirm " + live[i].result.name, raw, live[i].result.fit.strength,
-                              nullptr, 0.0, "", opt.seeds};
+        return runnable(live[i].result,
+                        VariantRequest{"confirm " + live[i].result.name, raw,
+                                       live[i].result.fit.strength, nullptr, 0.0, "", opt.seeds});
     };
-    // A fitted strength need not be a scenario the simulator can run where the signatures'
-    // strengths were (the full self-test's narrow box at width x 0.71, narrower than a plate
-    // pressed into it): its runs are refused, taken as failed, and never stop the diagnosis.
+    // A request the simulator refuses all the same (no strength near the fit runs): taken as
+    // failed runs, never an error that stops the diagnosis.
     const auto simulateValid = [&](const std::vector<VariantRequest> &requests) {
         std::vector<Eigen::MatrixXd> rows(requests.size());
         std::vector<VariantRequest> valid;
@@ -974,15 +1001,24 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 meanAndVariance(firstRows(confirm_rows[c], opt.signature_seeds), bed_sd);
             if (!coversBase(mv.first, V.simulated, meas.keys))
                 continue; // failed runs: nothing to add, nothing to refit
-            L.response->add(L.result.fit.strength, mv.first, mv.second);
+            L.response->add(confirm[c].strength, mv.first, mv.second);
             const StrengthFit refit = fitEffect(L);
             const Prior &p = L.result.effect.prior;
             const double span = p.toScale(p.hi) - p.toScale(p.lo);
-            if (std::abs(p.toScale(refit.strength) - p.toScale(L.result.fit.strength)) > 0.01 * span) {
+            if (std::abs(p.toScale(refit.strength) - p.toScale(confirm[c].strength)) >
+                0.01 * span) {
+                const StrengthFit before = L.result.fit;
                 L.result.fit = refit;
+                VariantRequest next = confirm[c];
+                next.strength = refit.strength;
+                next = runnable(L.result, next);
+                if (std::abs(p.toScale(next.strength) - p.toScale(confirm[c].strength)) <=
+                    0.01 * span) {
+                    L.result.fit = before; // the refit runs only where it was confirmed
+                    continue;
+                }
                 L.result.calibration_gain = refit.chi2_off - refit.chi2;
-                again.push_back(confirm[c]);
-                again.back().strength = refit.strength;
+                again.push_back(next);
                 again_of.push_back(c);
             }
         }
