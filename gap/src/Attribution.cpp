@@ -312,24 +312,21 @@ StrengthAgreement strengthAgreement(const std::vector<StrengthFit> &parts, const
     const auto sd = [&](const Part &p, double towards) {
         return std::max(towards >= p.t ? p.above : p.below, floor) / z95;
     };
+    const auto weightedMean = [&](auto sdOf) {
+        double sum = 0.0, weights = 0.0;
+        for (const Part &p : used) {
+            const double s = sdOf(p);
+            sum += p.t / (s * s), weights += 1.0 / (s * s);
+        }
+        return sum / weights;
+    };
     // The mean with the symmetric widths, then once more with the sides that face it.
-    double mean = 0.0, weights = 0.0;
-    for (const Part &p : used) {
-        const double s = std::max(0.5 * (p.below + p.above), floor) / z95;
-        mean += p.t / (s * s), weights += 1.0 / (s * s);
-    }
-    mean /= weights;
-    double again = 0.0;
-    weights = 0.0;
-    for (const Part &p : used) {
-        const double s = sd(p, mean);
-        again += p.t / (s * s), weights += 1.0 / (s * s);
-    }
-    a.mean = prior.fromScale(again / weights);
-    for (const Part &p : used) {
-        const double s = sd(p, again / weights);
-        a.chi2 += (p.t - again / weights) * (p.t - again / weights) / (s * s);
-    }
+    const double first = weightedMean(
+        [&](const Part &p) { return std::max(0.5 * (p.below + p.above), floor) / z95; });
+    const double mean = weightedMean([&](const Part &p) { return sd(p, first); });
+    a.mean = prior.fromScale(mean);
+    for (const Part &p : used)
+        a.chi2 += (p.t - mean) * (p.t - mean) / (sd(p, mean) * sd(p, mean));
     a.dof = int(used.size()) - 1;
     if (a.dof > 0)
         a.p_value =

@@ -759,17 +759,18 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // held the hidden strength in 11 of 34 fits. The fitted strength carries the luck of the
     // measured beds (rebuilt for each repeat, or one) and of the signatures' seeds.
     const BedLuck luck = bedLuck(meas, D.calibration, base_rows, opt.signature_seeds);
-    const auto fitEffect = [&](const Live &L) {
-        const Prior &p = L.result.effect.prior;
-        StrengthFit fit =
-            fitStrength(*L.response, p, meas.value, u2_fixed, D.calibration, correlation);
+    const auto fitOn = [&](const Response &response, const Prior &p, const FeatureSet &use,
+                           const BedLuck &beds) {
+        StrengthFit fit = fitStrength(response, p, meas.value, u2_fixed, use, correlation);
         const auto refit = [&](const Eigen::VectorXd &pseudo) {
-            const StrengthFit f =
-                fitStrength(*L.response, p, pseudo, u2_fixed, D.calibration, correlation);
+            const StrengthFit f = fitStrength(response, p, pseudo, u2_fixed, use, correlation);
             return Eigen::VectorXd::Constant(1, p.toScale(f.strength));
         };
-        luck.widen(refit, L.response->mean(fit.strength), {{&fit, &p}});
+        beds.widen(refit, response.mean(fit.strength), {{&fit, &p}});
         return fit;
+    };
+    const auto fitEffect = [&](const Live &L) {
+        return fitOn(*L.response, L.result.effect.prior, D.calibration, luck);
     };
     // The same fit on one kind of observable at a time, over every compared experiment (a
     // check of the claim, not a fit of it: the held-out experiments may veto, never choose).
@@ -780,17 +781,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     const auto fitByKind = [&](CandidateResult &R, const Response &response) {
         const Prior &p = R.effect.prior;
         std::vector<StrengthFit> parts;
-        for (const auto &kind_features : kinds) {
-            const FeatureSet &use = kind_features.second; // a lambda cannot capture a binding
-            StrengthFit fit = fitStrength(response, p, meas.value, u2_fixed, use, correlation);
-            const auto refit = [&](const Eigen::VectorXd &pseudo) {
-                const StrengthFit f = fitStrength(response, p, pseudo, u2_fixed, use, correlation);
-                return Eigen::VectorXd::Constant(1, p.toScale(f.strength));
-            };
-            bedLuck(meas, use, base_rows, opt.signature_seeds)
-                .widen(refit, response.mean(fit.strength), {{&fit, &p}});
-            R.by_kind.emplace_back(kind_features.first, fit);
-            parts.push_back(fit);
+        for (const auto &[kind, use] : kinds) {
+            parts.push_back(
+                fitOn(response, p, use, bedLuck(meas, use, base_rows, opt.signature_seeds)));
+            R.by_kind.emplace_back(kind, parts.back());
         }
         R.agreement = strengthAgreement(parts, p);
     };

@@ -907,6 +907,16 @@ TEST_CASE("diagnosis: an effect whose variants are no valid scenario on this des
     CHECK(d.explained_by == "cohesion");
 }
 
+namespace {
+/// How many candidates a diagnosis re-simulated at their fitted strength.
+int confirmedCount(const Diagnosis &d) {
+    int n = 0;
+    for (const auto &cand : d.candidates)
+        n += cand.confirmed;
+    return n;
+}
+} // namespace
+
 TEST_CASE("diagnosis: a candidate whose confirming runs failed is replaced by the next one",
           "[gap][diagnosis]") {
     // The hidden cohesion leads; its confirming runs fail on a held-out plate. It is not
@@ -914,19 +924,13 @@ TEST_CASE("diagnosis: a candidate whose confirming runs failed is replaced by th
     const EffectCatalogue c = shippedEffects();
     const DiagnosisOptions o = analyticOptions();
     const ExperimentSet set = measuredSet({"cohesion", 4.0e4}, 7);
-    const auto confirmed = [](const Diagnosis &d) {
-        int n = 0;
-        for (const auto &cand : d.candidates)
-            n += cand.confirmed;
-        return n;
-    };
     AnalyticSimulator fine;
     const Diagnosis before = diagnose(set, c.diagnosable(), fine, o);
     FailingEffectSimulator failing("cohesion", {"large_90"}, true);
     const Diagnosis d = diagnose(set, c.diagnosable(), failing, o);
     INFO(d.claim);
     CHECK(d.explained_by != "cohesion");
-    CHECK(confirmed(d) == confirmed(before) + 1);
+    CHECK(confirmedCount(d) == confirmedCount(before) + 1);
 }
 
 TEST_CASE("diagnosis: a candidate whose fitted strength is no valid scenario is taken as failed, "
@@ -945,13 +949,7 @@ TEST_CASE("diagnosis: a candidate whose fitted strength is no valid scenario is 
     CHECK(d.explained_by != "cohesion");
     AnalyticSimulator fine;
     const Diagnosis before = diagnose(set, c.diagnosable(), fine, analyticOptions());
-    const auto confirmed = [](const Diagnosis &x) {
-        int k = 0;
-        for (const auto &cand : x.candidates)
-            k += cand.confirmed;
-        return k;
-    };
-    CHECK(confirmed(d) == confirmed(before) + 1);
+    CHECK(confirmedCount(d) == confirmedCount(before) + 1);
 }
 
 TEST_CASE("diagnosis: a fitted strength the design cannot run is confirmed at the nearest that it "
