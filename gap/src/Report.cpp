@@ -40,7 +40,8 @@ Json verdict(const GapVerdict &g) {
     return {{"gap", g.gap},
             {"flagged_features", g.flagged},
             {"features", g.features},
-            {"largest_abs_z", number(g.max_abs)},
+            {"largest_abs_z", number(g.max_abs)}, // nearest its kind's bound
+            {"largest_abs_z_kind", g.worst_kind},
             {"feature_bound", number(g.feature_bound)},
             {"worst_experiment", g.worst_experiment},
             {"worst_experiment_rms_z", number(g.worst_rms)},

@@ -180,14 +180,15 @@ GapVerdict testGap(const std::vector<FeatureKey> &keys, const Eigen::VectorXd &s
                    double alpha, double flag_at) {
     GapVerdict g;
     std::map<std::string, std::pair<double, int>> per_experiment; // sum e^2, count
+    std::map<std::string, int> per_kind;                          // compared features
     for (std::size_t k = 0; k < keys.size(); ++k) {
         const double e = standardised[Eigen::Index(k)];
         if (!std::isfinite(e))
             continue;
         ++g.features;
+        ++per_kind[keys[k].kind];
         if (std::abs(e) > flag_at)
             ++g.flagged;
-        g.max_abs = std::max(g.max_abs, std::abs(e));
         auto &acc = per_experiment[keys[k].experiment];
         acc.first += e * e;
         ++acc.second;
@@ -197,7 +198,24 @@ GapVerdict testGap(const std::vector<FeatureKey> &keys, const Eigen::VectorXd &s
         return g;
     }
     const double share = alpha / 3.0;
-    g.feature_bound = std::max(flag_at, normalBound(share / g.features));
+    // (a) Each kind of observable gets an equal part of the level, shared among its features
+    // (a weighted Bonferroni bound, as valid as the plain one): the one heap angle beside 87
+    // plate and shear bins was held to the 88 features' bound, 3.73, and a model that left the
+    // heap 13 degrees (z = -3.0) off was claimed as explaining the design.
+    double worst_ratio = -1.0;
+    for (std::size_t k = 0; k < keys.size(); ++k) {
+        const double e = standardised[Eigen::Index(k)];
+        if (!std::isfinite(e))
+            continue;
+        const double bound = std::max(
+            flag_at, normalBound(share / double(per_kind.size() * per_kind[keys[k].kind])));
+        if (std::abs(e) / bound > worst_ratio) {
+            worst_ratio = std::abs(e) / bound;
+            g.max_abs = std::abs(e);
+            g.feature_bound = bound;
+            g.worst_kind = keys[k].kind;
+        }
+    }
     g.experiment_bound = std::max(flag_at, normalBound(share / double(per_experiment.size())));
     for (const auto &[id, acc] : per_experiment) {
         const double rms = std::sqrt(acc.first / acc.second);
@@ -218,9 +236,10 @@ GapVerdict testGap(const std::vector<FeatureKey> &keys, const Eigen::VectorXd &s
     else
         s << "no gap: ";
     s << g.flagged << " of " << g.features << " features beyond " << format(flag_at)
-      << " u_val; largest |e| " << format(g.max_abs, 3) << " (bound " << format(g.feature_bound, 3)
-      << "), largest experiment rms " << format(g.worst_rms, 3) << " in " << g.worst_experiment
-      << " (bound " << format(g.experiment_bound, 3) << ")";
+      << " u_val; largest |e| " << format(g.max_abs, 3) << " (" << g.worst_kind
+      << ", its kind's bound " << format(g.feature_bound, 3) << "), largest experiment rms "
+      << format(g.worst_rms, 3) << " in " << g.worst_experiment << " (bound "
+      << format(g.experiment_bound, 3) << ")";
     s << ", sum of experiments' mean z^2 " << format(g.sum_mean_square, 3) << " (bound "
       << format(g.sum_bound, 3) << ")";
     g.summary = s.str();

@@ -231,6 +231,42 @@ TEST_CASE("the gap test holds its false-alarm rate with independent or fully cor
     CHECK_FALSE(testGap(keys, Eigen::VectorXd::Constant(30, 1.5)).gap);
 }
 
+TEST_CASE("the gap test gives each kind of observable its share of the level: one heap angle is "
+          "not held to the bound of 88 features",
+          "[gap][validation]") {
+    // 87 plate bins over 6 plates and one heap angle: two kinds.
+    std::vector<FeatureKey> keys;
+    for (int k = 0; k < 87; ++k)
+        keys.push_back(
+            {"plate" + std::to_string(k % 6), "p", "plate/p", 0.001 * k, 0.001 * (k + 1)});
+    keys.push_back({"repose", "angle_deg", "repose/angle_deg", 0.0, 0.0});
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(88);
+    e[87] = -3.0; // the heap 3 u_val off, everything else agreeing
+    const GapVerdict g = testGap(keys, e);
+    // Hand values: the heap's kind holds 0.05 / 3 / 2 kinds, two-sided, of one feature:
+    // Phi^-1(1 - 0.05/12) = 2.638 (tables); the plates' bound Phi^-1(1 - 0.05/(12 * 87)) = 3.90.
+    CHECK(g.feature_bound == Approx(2.638).margin(0.002));
+    CHECK(g.worst_kind == "repose/angle_deg");
+    CHECK(g.gap); // one bound over all 88 features, Phi^-1(1 - 0.05/(6 * 88)) = 3.73, let it pass
+    e[87] = 0.0;
+    e[5] = 3.8; // a plate bin under its kind's 3.90
+    const GapVerdict plates = testGap(keys, e);
+    CHECK(plates.feature_bound == Approx(3.90).margin(0.01));
+    CHECK_FALSE(plates.gap);
+
+    // The level holds over both kinds together (3000 draws of unit normal features).
+    std::mt19937 rng(12);
+    std::normal_distribution<double> z;
+    int alarms = 0;
+    const int draws = 3000;
+    for (int d = 0; d < draws; ++d) {
+        for (Eigen::Index k = 0; k < 88; ++k)
+            e[k] = z(rng);
+        alarms += testGap(keys, e).gap;
+    }
+    CHECK(double(alarms) / draws < 0.06);
+}
+
 TEST_CASE("localise says where the simulation is too high, on which experiments, and where it "
           "agrees",
           "[gap][validation]") {

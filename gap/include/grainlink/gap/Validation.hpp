@@ -96,7 +96,10 @@ std::string numericalWarning(const ValidationResult &validation);
 /// z^2). A feature beyond `flag_at` (2 u_val) is flagged either way.
 struct GapVerdict {
     bool gap = false;
+    /// (a) the feature nearest its kind's bound (each kind of observable holds alpha/3 over the
+    /// number of kinds, shared among its features): its |e|, that bound and its kind
     double max_abs = 0.0, feature_bound = 0.0;
+    std::string worst_kind;
     std::string worst_experiment;
     double worst_rms = 0.0, experiment_bound = 0.0;
     double sum_mean_square = 0.0, sum_bound = 0.0; ///< (c)
