@@ -102,12 +102,28 @@ int printPlan(const gap::DiagnosisPlan &plan, const gap::ExperimentSet &set,
                           keys[std::size_t(it->second.back())].x_hi);
             range = text;
         }
+        // Reading refuses an experiment with no bin of its own; on its kind's shared bins a
+        // curve shorter than the others' may still have none: said with where they start.
+        std::string none;
+        if (bins == 0 && !e.x_name.empty()) {
+            const std::string slot = e.id + "/" + e.observables.front();
+            const auto edges = plan.design.edges.find(slot);
+            const auto reach = plan.design.x_reach.find(slot);
+            char text[200];
+            std::snprintf(
+                text, sizeof text,
+                "  (no measured bin, not compared: its curves reach %s %.4g, the first "
+                "bin of its kind ends at %.4g; give it bins: of its own)",
+                e.x_name.c_str(), reach == plan.design.x_reach.end() ? NAN : reach->second,
+                edges == plan.design.edges.end() || edges->second.size() < 2 ? NAN
+                                                                             : edges->second[1]);
+            none = text;
+        }
         const bool held =
             std::find(plan.held_out.begin(), plan.held_out.end(), e.id) != plan.held_out.end();
         std::printf("  %-20s %-16s %zu feature(s)%s, %zu trial(s); %s%s\n", e.id.c_str(),
                     gap::typeName(e.type), bins, range.c_str(), e.trials.size(),
-                    held ? "held out" : "calibration",
-                    bins == 0 ? "  (no measured bin: not compared)" : "");
+                    held ? "held out" : "calibration", none.c_str());
         // The values as read, in SI: a unit mistaken (kPa for Pa, m for mm) shows here.
         std::string measured;
         for (const std::string &o : e.observables) {

@@ -45,6 +45,32 @@ bool missingCell(const std::string &cell) {
            low == "#n/a" || low == "null" || low == "none" || low == "-" || low == "--";
 }
 
+/// A delimiter as experiments.yaml writes it.
+std::string delimiterName(char c) {
+    return c == '\t' ? "tab" : c == ' ' ? "whitespace" : "\"" + std::string(1, c) + "\"";
+}
+
+/// The delimiter a header read as one cell holds in its place (';' or a tab); 0: none.
+char otherDelimiter(const DataTable &t) {
+    if (t.header_given || t.header.size() != 1)
+        return 0;
+    for (char c : {';', '\t', ','})
+        if (c != t.delimiter && t.header[0].find(c) != std::string::npos)
+            return c;
+    return 0;
+}
+
+/// Whether a header's cells all read as numbers: the first row of a file whose names stand on
+/// a comment line.
+bool numericHeader(const DataTable &t) {
+    return !t.header_given &&
+           std::all_of(t.header.begin(), t.header.end(), [&](const std::string &h) {
+               char *end = nullptr;
+               std::strtod(h.c_str(), &end);
+               return !h.empty() && end == h.c_str() + h.size();
+           });
+}
+
 } // namespace
 
 std::vector<std::string> splitCells(const std::string &line, const TableFormat &format) {
@@ -100,6 +126,28 @@ std::string DataTable::names() const {
     return have;
 }
 
+std::string DataTable::missingColumn(const std::string &name) const {
+    std::string why = "column '" + name + "' is not in " + file + " (its columns: " + names() + ")";
+    if (const char other = otherDelimiter(*this))
+        return why + "; its header reads as one column holding " + delimiterName(other) +
+               ": give data.delimiter: " + delimiterName(other);
+    if (!header_given && header.size() == 1 && header[0].find(' ') != std::string::npos)
+        return why + "; its cells may be separated by blanks: give data.delimiter: whitespace";
+    if (numericHeader(*this)) {
+        // The names stand on a comment line ("# TimeStep v_z v_f"): said as a list to copy.
+        std::string list;
+        TableFormat words;
+        words.delimitedBy("whitespace");
+        const std::size_t mark = names_comment.find_first_not_of("#%;/ \t");
+        if (mark != std::string::npos)
+            for (const std::string &w : splitCells(names_comment.substr(mark), words))
+                list += (list.empty() ? "" : ", ") + w;
+        return why + "; its first line read holds numbers: a file whose column names stand on a " +
+               "comment line? give data.columns" + (list.empty() ? "" : ": [" + list + "]");
+    }
+    return why;
+}
+
 bool DataTable::missing(std::size_t row, std::size_t col) const {
     return col >= rows[row].size() || missingCell(rows[row][col]);
 }
@@ -137,6 +185,7 @@ DataTable readDataTable(const std::string &path, const TableFormat &format) {
     DataTable t;
     t.file = path;
     t.decimal = format.decimal;
+    t.delimiter = format.blanks ? ' ' : format.delimiter;
     t.header = format.columns;
     t.header_given = !format.columns.empty();
     bool units_row = format.units_row && !t.header_given;
@@ -145,8 +194,14 @@ DataTable readDataTable(const std::string &path, const TableFormat &format) {
     while (std::getline(in, line)) {
         if (++number == 1 && line.rfind("\xEF\xBB\xBF", 0) == 0)
             line.erase(0, 3); // a spreadsheet's byte-order mark
-        if (trimmed(line).empty() ||
-            (!format.comment.empty() && line.rfind(format.comment, 0) == 0))
+        if (number <= format.skip_lines)
+            continue;
+        if (!format.comment.empty() && line.rfind(format.comment, 0) == 0) {
+            if (t.header.empty())
+                t.names_comment = line.substr(format.comment.size());
+            continue;
+        }
+        if (trimmed(line).empty())
             continue;
         std::vector<std::string> cells = splitCells(line, format);
         if (std::all_of(cells.begin(), cells.end(), [](const std::string &c) { return c.empty(); }))
@@ -160,27 +215,45 @@ DataTable readDataTable(const std::string &path, const TableFormat &format) {
             continue;
         }
         // More cells than columns: a delimiter inside a number (0,5 in a comma-separated
-        // file), or data.columns naming too few. Cells would be read under the wrong names.
-        // Trailing empty cells (a trailing delimiter) are no cells.
+        // file), a title line read as the header, or data.columns naming too few. Cells would
+        // be read under the wrong names. Trailing empty cells (a trailing delimiter) are no cells.
         while (cells.size() > t.header.size() && cells.back().empty())
             cells.pop_back();
-        if (cells.size() > t.header.size() || (t.header_given && cells.size() < t.header.size()))
+        if (cells.size() > t.header.size() || (t.header_given && cells.size() < t.header.size())) {
+            std::string why;
+            if (t.header_given)
+                why = "name every column of the file, in order";
+            else if (const char other = otherDelimiter(t))
+                why = "the header reads as one column holding " + delimiterName(other) +
+                      ": give data.delimiter: " + delimiterName(other);
+            else if (t.header.size() == 1)
+                why = "a title above the header? give data.skip_lines (the lines before the "
+                      "header) or start it with data.comment";
+            else if (format.decimal == format.delimiter && !format.blanks)
+                why = "with a decimal comma in a comma-separated file, quote each number (\"0,5\")";
+            else if (format.delimiter == ',' && !format.blanks)
+                why = "a decimal comma in a comma-separated file? give data.delimiter and "
+                      "data.decimal";
+            else
+                why = "a stray cell, or a header naming too few columns";
             throw config::ConfigError(
                 path + ":" + std::to_string(number) + ": " + std::to_string(cells.size()) +
                 " cells where " +
                 (t.header_given ? "data.columns names " : "the header line names ") +
-                std::to_string(t.header.size()) + " (" + t.names() + ")" +
-                (format.decimal == format.delimiter && !format.blanks
-                     ? ": with a decimal comma in a comma-separated file, quote each number "
-                       "(\"0,5\")"
-                 : t.header_given ? ": name every column of the file, in order"
-                                  : ": a decimal comma in a comma-separated file? give "
-                                    "data.delimiter and data.decimal"));
+                std::to_string(t.header.size()) + " (" + t.names() + "): " + why);
+        }
         t.rows.push_back(std::move(cells));
         t.lines.push_back(number);
     }
+    if (number == 0)
+        throw config::ConfigError("data file " + path + " is empty");
+    if (number <= format.skip_lines)
+        throw config::ConfigError("data file " + path + " has " + std::to_string(number) +
+                                  " line(s), none after the " + std::to_string(format.skip_lines) +
+                                  " of data.skip_lines");
     if (t.header.empty())
-        throw config::ConfigError("data file " + path + " has no header line");
+        throw config::ConfigError("data file " + path + " has no header line (its " +
+                                  std::to_string(number) + " line(s) are comments or blank)");
     if (t.rows.empty())
         throw config::ConfigError("data file " + path + " has no data rows");
     return t;

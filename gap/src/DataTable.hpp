@@ -18,6 +18,8 @@ struct TableFormat {
     std::vector<std::string> columns;
     /// The line under the header holds units (a spreadsheet's "mm;kPa"): skipped.
     bool units_row = false;
+    /// Lines before the header (an instrument's title and preamble), skipped whatever they hold.
+    int skip_lines = 0;
 
     /// Cells separated by ",", ";", "tab" or "whitespace" (runs of blanks).
     void delimitedBy(const std::string &name) {
@@ -33,12 +35,18 @@ struct DataTable {
     std::vector<std::vector<std::string>> rows;
     std::vector<int> lines;
     char decimal = '.';
+    char delimiter = ',';
     bool header_given = false; ///< the names came from data.columns, not from the file
+    /// The last comment line above the header: another code's column names (LIGGGHTS').
+    std::string names_comment;
 
     /// The column of that name; none when it is missing. Throws when two columns share it.
     std::optional<std::size_t> find(const std::string &name) const;
     /// The header's names, comma-separated, for a message.
     std::string names() const;
+    /// Why no column is named `name`: the file, its columns, and the likely cause (another
+    /// delimiter, names on a comment line).
+    std::string missingColumn(const std::string &name) const;
     /// Whether row r holds no value in column c (empty, NaN, NA, N/A, #N/A, null, none, "-",
     /// "--"; or no such cell).
     bool missing(std::size_t row, std::size_t col) const;
@@ -51,8 +59,8 @@ struct DataTable {
 /// doubled quote; blanks around a cell are dropped.
 std::vector<std::string> splitCells(const std::string &line, const TableFormat &format);
 
-/// Reads `path`; throws config::ConfigError naming the file when it cannot be read, has no
-/// header or no data rows.
+/// Reads `path`; throws config::ConfigError naming the file when it cannot be read, is empty,
+/// has no header or no data rows.
 DataTable readDataTable(const std::string &path, const TableFormat &format);
 
 } // namespace grainlink::gap

@@ -2,6 +2,8 @@
 
 #include "DataTable.hpp"
 
+#include "grainlink/gap/Comparison.hpp"
+
 #include "grainlink/config/ConfigNode.hpp"
 
 #include <algorithm>
@@ -125,6 +127,17 @@ const std::vector<Unit> &units() {
     return u;
 }
 
+/// The largest size a tool or a bed may have (a plate's or wheel's diameter, a grouser's
+/// height, a bed's depth): a lab's soil bin is a metre or two. Above it, the size was given in
+/// mm or cm. A travel or a bin's length may be longer (a field test, a long test bed).
+constexpr double kLongestLabSize_m = 2.0;
+bool isToolOrBedSize(const std::string &key) {
+    for (const char *size : {"diameter", "radius", "width", "height", "depth"})
+        if (key.find(size) != std::string::npos)
+            return true;
+    return false;
+}
+
 /// Conditions under another size's name: (that name, grainlink's, the factor to it).
 constexpr std::tuple<const char *, const char *, double> kOtherSizeNames[] = {
     {"plate_radius_m", "plate_diameter_m", 2.0},
@@ -150,15 +163,24 @@ bool endsWith(const std::string &s, const std::string &tail) {
 TableFormat parseTableFormat(const ConfigNode &data) {
     TableFormat f;
     f.comment = data.text("comment", "#");
-    if (data.has("delimiter"))
-        f.delimitedBy(data["delimiter"].text() == "\t"
-                          ? "tab"
-                          : data["delimiter"].choice({",", ";", "tab", "whitespace"}));
+    if (data.has("delimiter")) {
+        // A tab also as the character itself ("\t").
+        const std::string d = data["delimiter"].text() == "\t" ? "tab" : data["delimiter"].text();
+        if (d != "," && d != ";" && d != "tab" && d != "whitespace")
+            data["delimiter"].fail("'" + d +
+                                   "' is no delimiter: give \",\", \";\", tab or whitespace");
+        f.delimitedBy(d);
+    }
     // A decimal comma beside the comma delimiter reads only quoted numbers ("0,5"); an
     // unquoted one splits its row into too many cells, which the reader refuses.
-    if (data.has("decimal"))
-        f.decimal = data["decimal"].choice({".", ","})[0];
+    if (data.has("decimal")) {
+        const std::string d = data["decimal"].text();
+        if (d != "." && d != ",")
+            data["decimal"].fail("'" + d + "' is no decimal mark: give \".\" or \",\"");
+        f.decimal = d[0];
+    }
     f.units_row = data.boolean("units_row", false);
+    f.skip_lines = int(data.integer("skip_lines", 0, 1000000, 0));
     if (data.has("columns")) {
         for (const ConfigNode &c : data["columns"].items())
             f.columns.push_back(c.text());
@@ -176,15 +198,8 @@ std::size_t columnOf(const DataTable &table, const std::string &name, const Conf
     } catch (const config::ConfigError &e) {
         where.fail(e.what());
     }
-    if (!c) {
-        const bool one =
-            table.header.size() == 1 && table.header[0].find_first_of(";\t ") != std::string::npos;
-        where.fail("column '" + name + "' is not in " + table.file +
-                   " (its columns: " + table.names() + ")" +
-                   (one ? "; its cells may be separated otherwise: give data.delimiter "
-                          "(; tab whitespace)"
-                        : ""));
-    }
+    if (!c)
+        where.fail(table.missingColumn(name));
     return *c;
 }
 
@@ -207,6 +222,20 @@ std::pair<std::size_t, double> axisColumn(const ConfigNode &node, const DataTabl
     return {col, factor * scale};
 }
 
+/// How grainlink takes a type's signs, and the fix for another code's (z up, a box pulled the
+/// other way): said alike wherever a column reads with the other sign.
+std::string signFix(ExperimentType type) {
+    const char *convention =
+        type == ExperimentType::PlateSinkage
+            ? "a plate's pressure as positive and its sinkage as growing into the soil"
+        : type == ExperimentType::WheelSteadyState ? "a wheel's sinkage as positive into the soil"
+        : type == ExperimentType::Mole             ? "a mole's depth as positive below the surface"
+                                       : "the shear stress as positive and the shear displacement "
+                                         "as growing";
+    return std::string("; grainlink takes ") + convention +
+           " (add `scale: -1` to a column whose axis points the other way, as z up does)";
+}
+
 /// Refuses a curve that reads with another code's signs: grainlink takes a plate's pressure and
 /// a shear box's stress as positive, and their sinkage or displacement as growing, and a curve
 /// with z up (or the box pulled the other way) would otherwise read as an enormous gap. Judged
@@ -222,19 +251,14 @@ void checkSigns(ExperimentType type, const Curve &curve, const ConfigNode &data,
     for (std::size_t i = 1; i < curve.y.size(); ++i)
         if (std::abs(curve.y[i]) > std::abs(curve.y[peak]))
             peak = i;
-    const std::string fix =
-        plate ? "; grainlink takes a plate's pressure as positive and its sinkage as growing into "
-                "the soil (add `scale: -1` where this code's axis points up)"
-              : "; grainlink takes the shear stress as positive and the shear displacement as "
-                "growing (add `scale: -1` to a column of the opposite sign)";
     if (curve.y[peak] < 0.0)
         data["y"].fail(file + ": the largest " + (plate ? "pressure" : "shear stress") +
-                       " is negative" + fix);
+                       " is negative" + signFix(type));
     if (curve.x[peak] < curve.x.front())
         data["x"].fail(file +
                        (plate ? ": the sinkage falls as the plate is loaded"
                               : ": the shear displacement falls as the stress builds") +
-                       fix);
+                       signFix(type));
 }
 
 /// Refuses a wheel's sinkage given z up: every run's sinkage at or below zero, one below.
@@ -245,9 +269,38 @@ void checkWheelSinkage(const Experiment &e, const ConfigNode &data) {
             for (double y : c->second.y)
                 below = below || y < 0.0, above = above || y > 0.0;
     if (below && !above)
-        data["y"]["sinkage_m"].fail("every run's sinkage is negative; grainlink takes a wheel's "
-                                    "sinkage as positive into the soil (add `scale: -1` where "
-                                    "this code's axis points up)");
+        data["y"]["sinkage_m"].fail("every run's sinkage is negative" + signFix(e.type));
+}
+
+/// Refuses an experiment that gives no feature of its own (the diagnosis' bins on it alone):
+/// its curves all on the wrong side of their zero (z up without `scale: -1`), or its own bins
+/// beyond its data. Said here, with its file, rather than as "not compared" after the
+/// simulations have run.
+void refuseUncomparable(const Experiment &e, const ConfigNode &node) {
+    if (e.x_name.empty())
+        return;
+    ExperimentSet alone;
+    alone.experiments = {e};
+    if (designFeatures(alone).by_experiment.count(e.id))
+        return;
+    double lo = INFINITY, hi = -INFINITY;
+    for (const Trial &t : e.trials)
+        for (const auto &[o, curve] : t.curves)
+            for (double x : applyZero(curve, e.zero).x)
+                lo = std::min(lo, x), hi = std::max(hi, x);
+    std::ostringstream m;
+    m << "experiment '" << e.id << "' has no bin to compare: its " << e.x_name;
+    if (!e.scatter)
+        m << " (zeroed by its zero method)";
+    m << " runs from " << lo << " to " << hi + 0.0; // + 0.0: -0 reads as 0
+    if (!e.bin_edges.empty()) {
+        m << ", its bins from " << e.bin_edges.front() << " to " << e.bin_edges.back()
+          << (e.scatter ? " (SI), and none holds a run"
+                        : " (SI), and none up to its curves' reach holds a measured sample");
+        node["bins"]["edges"].fail(m.str() + (hi <= 0.0 && lo < 0.0 ? signFix(e.type) : ""));
+    }
+    m << " (SI), and its bins start at 0";
+    node["data"]["x"].fail(m.str() + (hi <= 0.0 && lo < 0.0 ? signFix(e.type) : ""));
 }
 
 double siValue(const ConfigNode &parent, const std::string &value_key, const std::string &unit_key,
@@ -264,6 +317,13 @@ double siValue(const ConfigNode &parent, const std::string &value_key, const std
 } // namespace
 
 const char *typeName(ExperimentType type) { return info(type).name; }
+
+std::vector<ExperimentType> experimentTypes() {
+    std::vector<ExperimentType> all;
+    for (const auto &t : types())
+        all.push_back(t.type);
+    return all;
+}
 
 const std::vector<std::string> &observablesOf(ExperimentType type) { return info(type).observables; }
 
@@ -328,7 +388,11 @@ const Experiment &ExperimentSet::find(const std::string &id) const {
     for (const auto &e : experiments)
         if (e.id == id)
             return e;
-    throw std::invalid_argument("no experiment '" + id + "' in " + directory);
+    std::string ids;
+    for (const auto &e : experiments)
+        ids += (ids.empty() ? "" : ", ") + e.id;
+    throw std::invalid_argument("no experiment '" + id + "' in " + directory +
+                                " (its experiments: " + ids + ")");
 }
 
 std::size_t loadingBranch(const Curve &curve) {
@@ -446,6 +510,21 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     e.labels[key] = c.text();
                 else
                     e.numbers[key] = c.number();
+                // A size in mm or cm under an SI name (80 for 80 mm) is said here, with its
+                // experiment, not as the test it would break or the group it would join.
+                if (const auto v = e.numbers.find(key);
+                    v != e.numbers.end() && dimensionOf(key) == "length") {
+                    std::ostringstream m;
+                    m << "experiment '" << e.id << "': " << key << " " << v->second;
+                    if (v->second < 0.0)
+                        c.fail(m.str() + ": a length, >= 0");
+                    if (v->second > kLongestLabSize_m && isToolOrBedSize(key)) {
+                        m << " m is larger than a lab test's " << kLongestLabSize_m
+                          << " m: given in mm? (conditions are in SI: " << v->second / 1000.0
+                          << " m for mm)";
+                        c.fail(m.str());
+                    }
+                }
             }
             // A radius where grainlink takes a diameter, or the other way round: read as the
             // condition it is, so the test is not set up from the base's size in its place.
@@ -532,6 +611,10 @@ ExperimentSet loadExperiments(const std::string &directory) {
                          std::string("pressure_Pa"));
             const auto filter = data.optional("filter");
             const TableFormat format = parseTableFormat(data);
+            const ConfigNode x_node = data["x"];
+            // Every key of data: read by now: a misspelt one is said before a file that it
+            // would have read (`skip_line`) fails to read.
+            data.finish();
             for (const ConfigNode &f : files.items()) {
                 const fs::path path = dir / f.text();
                 const DataTable table = [&] {
@@ -541,7 +624,7 @@ ExperimentSet loadExperiments(const std::string &directory) {
                         f.fail(e.what());
                     }
                 }();
-                const auto [xcol, xfac] = axisColumn(data["x"], table, e.x_name);
+                const auto [xcol, xfac] = axisColumn(x_node, table, e.x_name);
                 std::vector<std::tuple<std::string, std::size_t, double>> ycols;
                 for (const auto &o : obs_names) {
                     const auto [c, fac] = axisColumn(y[o], table, o);
@@ -571,6 +654,16 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     const bool no_x = table.missing(r, xcol);
                     bool gap = no_x;
                     const double x = no_x ? 0.0 : table.number(r, xcol) * xfac;
+                    // A slip lies in [-1, 1): given in % under `unit: "-"` (11.3 for 0.113) it
+                    // would drop out of every bin, or reach the wheel test as a slip of 11.
+                    if (e.x_name == "slip" && !no_x && !(x >= -1.0 && x < 1.0)) {
+                        std::ostringstream m;
+                        m << path.string() << ":" << table.lines[r] << ": column '"
+                          << table.header[xcol] << "': slip " << x << " lies outside [-1, 1)"
+                          << (x_node["unit"].text() == "%" ? ""
+                                                           : ": a slip in %? give unit: \"%\"");
+                        x_node["unit"].fail(m.str());
+                    }
                     Trial t;
                     t.source = path.string() + ":" + std::to_string(table.lines[r]);
                     for (const auto &[o, c, fac] : ycols) {
@@ -642,7 +735,6 @@ ExperimentSet loadExperiments(const std::string &directory) {
                 checkWheelSinkage(e, data);
             if (filter)
                 filter->finish();
-            data.finish();
         }
 
         // A value of y with its `unit` (a threshold, a sigma), in the data's own terms: a force
@@ -713,6 +805,7 @@ ExperimentSet loadExperiments(const std::string &directory) {
                 (*bins)["edges"].fail("give at least two increasing edges");
             bins->finish();
         }
+        refuseUncomparable(e, node);
         node.finish();
         set.experiments.push_back(std::move(e));
     }

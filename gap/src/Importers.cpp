@@ -33,8 +33,7 @@ DataTable readCsv(const fs::path &path) {
 std::size_t column(const DataTable &c, const std::string &name) {
     if (const auto col = c.find(name))
         return *col;
-    throw std::runtime_error(c.file + ": no column '" + name + "' (its columns: " + c.names() +
-                             ")");
+    throw config::ConfigError(c.missingColumn(name));
 }
 
 /// Writes the named columns of `c` to `path` (a copy of just what the folder uses).
@@ -313,10 +312,17 @@ namespace {
 /// options instead.
 std::string withImportOptions(std::string message) {
     const std::pair<const char *, const char *> keys[] = {{"data.decimal: \",\"", "--decimal ,"},
+                                                          {"data.delimiter: ", "--delimiter "},
                                                           {"data.delimiter", "--delimiter"},
                                                           {"data.decimal", "--decimal"},
                                                           {"data.units_row: true", "--units-row"},
-                                                          {"data.columns", "--columns"}};
+                                                          {"data.columns: ", "--columns "},
+                                                          {"data.columns", "--columns"},
+                                                          {"give data.skip_lines (the lines before "
+                                                           "the header) or start it with "
+                                                           "data.comment",
+                                                           "delete it, or start it with the mark "
+                                                           "of --comment"}};
     for (const auto &[key, option] : keys)
         for (std::size_t at; (at = message.find(key)) != std::string::npos;)
             message.replace(at, std::string(key).size(), option);

@@ -82,6 +82,10 @@ constexpr const char *kWheelConditions[] = {"wheel_radius_m",   "wheel_width_m",
 /// depth (read by the tests whose bed is the soil's deposition: plates, shear plates, wheels).
 constexpr const char *kSoilConditions[] = {"gravity_m_s2", "bed_depth_m"};
 
+/// Conditions that describe an experiment without setting up its test: a loading speed, read
+/// by the rate check (addRateCheckWhereSpeedDiffers).
+constexpr const char *kDescribingConditions[] = {"speed_m_s"};
+
 /// What a test is run for besides its type and box: its gravity, a wheel's geometry, load and
 /// slope.
 std::string setupOf(const Experiment &e) {
@@ -139,11 +143,16 @@ std::vector<double> conditionValues(const ExperimentSet &set, const std::vector<
         const Experiment &e = set.find(id);
         const auto it = e.numbers.find(key);
         if (it == e.numbers.end()) {
-            // A condition it gives that nothing reads is most likely this one misspelt.
-            const std::vector<std::string> read = simulatedConditions(e.type);
+            // A condition it gives that nothing reads is most likely this one misspelt; one that
+            // a test of any type reads, or that describes the experiment, is no misspelling.
+            std::set<std::string> known(std::begin(kDescribingConditions),
+                                        std::end(kDescribingConditions));
+            for (const ExperimentType t : experimentTypes())
+                for (const std::string &c : simulatedConditions(t))
+                    known.insert(c);
             std::string unread;
             for (const auto &[k, value] : e.numbers)
-                if (std::find(read.begin(), read.end(), k) == read.end())
+                if (!known.count(k))
                     unread += (unread.empty() ? "" : ", ") + ("'" + k + "'");
             throw std::invalid_argument(
                 e.source + ": experiment '" + id + "' (" + typeName(e.type) +
@@ -495,9 +504,14 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                             (key == "box" ? "boxes" : "conditions." + key) +
                             "): the base's own soil stands in " + listed(ids) + ")");
     }
-    if (out.experiments.empty())
-        throw std::invalid_argument(base.path + ": no test in `tests` simulates any experiment of " +
-                                    set.directory);
+    // Every one left out: said with why, as each was (a gravity of -9.81 is no missing test).
+    if (out.experiments.empty()) {
+        std::string why;
+        for (std::size_t i = left_out.size() - set.experiments.size(); i < left_out.size(); ++i)
+            why += (why.empty() ? "" : "; ") + left_out[i];
+        throw std::invalid_argument(base.path + ": every experiment of " + set.directory +
+                                    " is left out, none is simulated: " + why);
+    }
     return out;
 }
 
@@ -861,9 +875,16 @@ study::Study StudySimulator::studyOf(const ExperimentSet &design,
                 const YAML::Node scenario = scenarioNode(design, gs[g], requests[r], seed);
                 if (kind.summary_file_of)
                     kind.summary_file = kind.summary_file_of(scenario);
-                const study::Point p = study::makePoint(
-                    kind, study::emitYaml(scenario),
-                    requests[r].label + " seed " + std::to_string(s) + " " + gs[g].front());
+                // Named by every experiment of its group: one lab test runs them all, and a
+                // refused scenario (a plate of 80 m) may be any one's, not the first's.
+                std::string ids;
+                for (std::size_t i = 0; i < gs[g].size() && i < 4; ++i)
+                    ids += (i ? ", " : "") + gs[g][i];
+                if (gs[g].size() > 4)
+                    ids += ", ... (" + std::to_string(gs[g].size()) + " experiments)";
+                const study::Point p =
+                    study::makePoint(kind, study::emitYaml(scenario),
+                                     requests[r].label + " seed " + std::to_string(s) + " " + ids);
                 auto [it, fresh] = index.try_emplace(p.id, st.points.size());
                 if (fresh)
                     st.points.push_back(p);

@@ -650,3 +650,148 @@ TEST_CASE("experiments.yaml: a plate force with z up becomes its pressure", "[ga
         "      y: {traction_N: {column: F, unit: N}, sinkage_m: {column: z_mm, unit: mm}}\n",
         "every run's sinkage is negative");
 }
+
+// An experiment that gives no bin was accepted and named "not compared" only after the
+// simulations had run: z-up data without `scale: -1`, or its own bins beyond its data.
+TEST_CASE("experiments.yaml: an experiment with no bin to compare is refused where it is read",
+          "[gap][experiments]") {
+    const fs::path dir = folder("nobin");
+    // z up, written from the deepest sample on: the most loaded sample is the first, so the
+    // curve reads as loading, but every sinkage lies below its recorded zero.
+    write(dir / "up.csv", "z_mm,p_kPa\n-8,100\n-6,70\n-4,40\n-2,15\n0,0\n");
+    const std::string head = "experiments:\n  - id: up\n    type: plate_sinkage\n"
+                             "    conditions: {plate_diameter_m: 0.04}\n"
+                             "    data:\n      files: [up.csv]\n";
+    const std::string y = "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n";
+    checkRefused(dir, head + "      x: {column: z_mm, unit: mm}\n" + y,
+                 "experiments.yaml:7: key 'experiments[0].data.x': experiment 'up' has no bin to "
+                 "compare: its sinkage_m (zeroed by its zero method) runs from -0.008 to 0");
+    checkRefused(dir, head + "      x: {column: z_mm, unit: mm}\n" + y, "add `scale: -1`");
+    // With the fix it reads, and gives bins.
+    write(dir / "experiments.yaml", head + "      x: {column: z_mm, unit: mm, scale: -1}\n" + y);
+    CHECK(designFeatures(loadExperiments(dir.string())).keys.size() >= 4);
+    // Its own bins beyond the data's 8 mm.
+    checkRefused(dir,
+                 head + "      x: {column: z_mm, unit: mm, scale: -1}\n" + y +
+                     "    bins: {edges: [20, 30, 40], unit: mm}\n",
+                 "experiments.yaml:9: key 'experiments[0].bins.edges': experiment 'up' has no bin "
+                 "to compare");
+    // A wheel whose runs all lie outside its own bins.
+    write(dir / "w.csv", "slip,F\n0.1,10\n0.3,20\n");
+    checkRefused(dir,
+                 "experiments:\n  - id: w\n    type: wheel_steady_state\n"
+                 "    data: {files: [w.csv], scatter: true, x: {column: slip, unit: '-'}, "
+                 "y: {traction_N: {column: F, unit: N}}}\n"
+                 "    bins: {edges: [0.5, 0.7, 0.9], unit: '-'}\n",
+                 "experiment 'w' has no bin to compare: its slip runs from 0.1 to 0.3");
+}
+
+TEST_CASE("experiments.yaml: a slip in % given as unit '-' is refused where it is read",
+          "[gap][experiments]") {
+    const fs::path dir = folder("slip");
+    write(dir / "w.csv", "run,slip_pct,F\n1,0.5,2\n2,10,8\n3,75,20\n");
+    const std::string yaml = "experiments:\n  - id: w\n    type: wheel_steady_state\n"
+                             "    data:\n      files: [w.csv]\n      scatter: true\n"
+                             "      x: {column: slip_pct, unit: UNIT}\n"
+                             "      y: {traction_N: {column: F, unit: N}}\n";
+    std::string dash = yaml;
+    dash.replace(dash.find("UNIT"), 4, "'-'");
+    checkRefused(
+        dir, dash,
+        "experiments.yaml:7: key 'experiments[0].data.x.unit': " + (dir / "w.csv").string() +
+            ":3: column 'slip_pct': slip 10 lies outside [-1, 1): a slip in %? give "
+            "unit: \"%\"");
+    std::string percent = yaml;
+    percent.replace(percent.find("UNIT"), 4, "'%'");
+    write(dir / "experiments.yaml", percent);
+    const ExperimentSet set = loadExperiments(dir.string());
+    REQUIRE(set.experiments[0].trials.size() == 3);
+    CHECK(set.experiments[0].trials[2].curves.at("traction_N").x[0] == Approx(0.75));
+}
+
+TEST_CASE("experiments.yaml: a size condition in mm is refused with its experiment and line",
+          "[gap][experiments]") {
+    const fs::path dir = folder("size");
+    linearTrial(dir / "a1.csv", 1.0);
+    linearTrial(dir / "a2.csv", 1.0);
+    linearTrial(dir / "a3.csv", 1.0);
+    // The second experiment's diameter in mm: named as its own, not as the first's of its box.
+    std::string second = plateYaml();
+    second.replace(second.find("id: p60"), 7, "id: p80");
+    second.replace(second.find("plate_diameter_m: 0.06"), 22, "plate_diameter_m: 80");
+    checkRefused(dir, plateYaml() + second.substr(second.find("  - id: p80")),
+                 "experiments.yaml:12: key 'experiments[1].conditions.plate_diameter_m': "
+                 "experiment 'p80': plate_diameter_m 80 m is larger than a lab test's 2 m: given "
+                 "in mm?");
+    std::string depth = plateYaml();
+    depth.replace(depth.find("box: large"), 10, "box: large, bed_depth_m: -0.1");
+    checkRefused(dir, depth, "experiment 'p60': bed_depth_m -0.1: a length, >= 0");
+    // A travel may be longer than a lab bin (a long test bed, a field run): read as given.
+    std::string travel = plateYaml();
+    travel.replace(travel.find("box: large"), 10, "box: large, travel_m: 5");
+    write(dir / "experiments.yaml", travel);
+    CHECK(loadExperiments(dir.string()).experiments[0].numbers.at("travel_m") == 5.0);
+}
+
+TEST_CASE("data files: an unknown key is named before a file fails to read, and lines before the "
+          "header are skipped with skip_lines",
+          "[gap][experiments]") {
+    const fs::path dir = folder("preamble");
+    // An instrument's export: a title, a line about the sample, a blank line, then the header.
+    write(dir / "s.txt", "Direct shear test ASTM D3080\nSample: sand A  10 kPa\n\n"
+                         "disp_mm\tshear_kPa\tvert_mm\n0\t0\t0\n0.5\t3\t-0.01\n1\t5\t-0.02\n");
+    const std::string head = "experiments:\n  - id: s\n    type: direct_shear\n"
+                             "    conditions: {normal_stress_Pa: 10000}\n"
+                             "    data:\n      files: [s.txt]\n      delimiter: tab\n";
+    const std::string axes = "      x: {column: disp_mm, unit: mm}\n"
+                             "      y: {shear_stress_Pa: {column: shear_kPa, unit: kPa}}\n";
+    // Read as it is, the title is the header: named as such, not as a decimal comma.
+    checkRefused(dir, head + axes,
+                 "s.txt:4: 3 cells where the header line names 1 (Direct shear test ASTM "
+                 "D3080): a title above the header? give data.skip_lines");
+    // A misspelt key is said first, not the file it would have read.
+    checkRefused(dir, head + "      skip_line: 3\n" + axes,
+                 "experiments.yaml:8: unknown key 'experiments[0].data.skip_line'");
+    write(dir / "experiments.yaml", head + "      skip_lines: 3\n" + axes);
+    const Curve &c =
+        loadExperiments(dir.string()).experiments[0].trials[0].curves.at("shear_stress_Pa");
+    REQUIRE(c.x.size() == 3);
+    CHECK(c.x[1] == Approx(0.0005));
+    CHECK(c.y[2] == Approx(5000.0));
+    checkRefused(dir, head + "      skip_lines: 9\n" + axes, "none after the 9 of data.skip_lines");
+}
+
+TEST_CASE("data files: the hints name the option that reads the file", "[gap][experiments]") {
+    const fs::path dir = folder("hints");
+    const std::string head = "experiments:\n  - id: p\n    type: plate_sinkage\n    data:\n";
+    const std::string zp = "      x: {column: z_mm, unit: mm}\n"
+                           "      y: {pressure_Pa: {column: p_kPa, unit: kPa}}\n";
+    // ';' between cells and decimal commas, with only the decimal mark given.
+    write(dir / "eu.csv", "\"z_mm\";\"p_kPa\"\n0,5;1,25\n1,0;2,5\n");
+    checkRefused(dir, head + "      files: [eu.csv]\n      decimal: ','\n" + zp,
+                 "the header reads as one column holding \";\": give data.delimiter: \";\"");
+    // A LIGGGHTS file read without columns: its names on the comment line, to copy.
+    write(dir / "lig.txt", "# Time-averaged data\n# TimeStep z_mm p_kPa\n100 1 5\n200 2 10\n");
+    checkRefused(dir, head + "      files: [lig.txt]\n      delimiter: whitespace\n" + zp,
+                 "give data.columns: [TimeStep, z_mm, p_kPa]");
+    // An empty file, and one of comments only.
+    write(dir / "empty.csv", "");
+    checkRefused(dir, head + "      files: [empty.csv]\n" + zp, "empty.csv is empty");
+    write(dir / "comments.csv", "# nothing yet\n");
+    checkRefused(dir, head + "      files: [comments.csv]\n" + zp,
+                 "comments.csv has no header line (its 1 line(s) are comments or blank)");
+    // A delimiter that is none of the four, said readably.
+    checkRefused(dir, head + "      files: [eu.csv]\n      delimiter: '|'\n" + zp,
+                 "'|' is no delimiter: give \",\", \";\", tab or whitespace");
+}
+
+TEST_CASE("an unknown experiment id is named with the set's ids", "[gap][experiments]") {
+    const fs::path dir = folder("ids");
+    linearTrial(dir / "a1.csv", 1.0);
+    linearTrial(dir / "a2.csv", 1.0);
+    linearTrial(dir / "a3.csv", 1.0);
+    write(dir / "experiments.yaml", plateYaml());
+    const ExperimentSet set = loadExperiments(dir.string());
+    CHECK_THROWS_WITH(set.find("p6"), Catch::Contains("no experiment 'p6'") &&
+                                          Catch::Contains("(its experiments: p60)"));
+}

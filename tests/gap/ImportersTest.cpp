@@ -159,6 +159,12 @@ TEST_CASE("import csv reads a file as the diagnosis does, and a failed import le
         importCsv(bad, out.string()),
         Catch::Contains(bad.files[0] + ":2: column 'z': 'mm' is not a finite number") &&
             Catch::Contains("give --units-row") && !Catch::Contains("data.units_row"));
+    // A ';' file read with the default ',': the option that reads it, not a decimal comma.
+    CsvImport no_delimiter = csv;
+    no_delimiter.id = "no_delimiter";
+    no_delimiter.delimiter = ",";
+    CHECK_THROWS_WITH(importCsv(no_delimiter, out.string()),
+                      Catch::Contains("give --delimiter \";\"") && !Catch::Contains("data."));
     // A unit of the wrong kind is named by its option, before any file is read or written.
     CsvImport wrong_unit = csv;
     wrong_unit.id = "wrong_unit";

@@ -174,7 +174,19 @@ TEST_CASE("experiments of a type the base model does not simulate are left out, 
     ExperimentSet only_wheels = set;
     only_wheels.experiments = {wheel};
     std::vector<std::string> all;
-    CHECK_THROWS_WITH(simulable(only_wheels, base, all), Catch::Contains("no test in `tests`"));
+    CHECK_THROWS_WITH(simulable(only_wheels, base, all),
+                      Catch::Contains("every experiment of") &&
+                          Catch::Contains("smooth_wheel (wheel_steady_state: ") &&
+                          Catch::Contains("has no tests.wheel_steady_state"));
+    // Every one left out for its gravity: said with that, not blamed on the base's tests.
+    ExperimentSet upside_down = set;
+    for (Experiment &e : upside_down.experiments)
+        e.numbers["gravity_m_s2"] = -9.81;
+    std::vector<std::string> none;
+    CHECK_THROWS_WITH(simulable(upside_down, base, none),
+                      Catch::Contains("is left out, none is simulated: ") &&
+                          Catch::Contains("gravity_m_s2 -9.81: the magnitude of a gravity") &&
+                          !Catch::Contains("no test in"));
 }
 
 TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, the wheel and "
@@ -623,7 +635,8 @@ TEST_CASE("a condition the test needs, given under another name, is named as lik
     // The reading says `plate_diam_m` is not simulated; the error that follows must not leave
     // the user to connect it with the plate_diameter_m it lacks.
     const BaseModel base = loadBaseModel(kDir + "/base.yaml");
-    Experiment plate = plateExperiment("p", {{"plate_diam_m", 0.02}}, {});
+    // speed_m_s describes the experiment (the rate check reads it): no misspelling.
+    Experiment plate = plateExperiment("p", {{"plate_diam_m", 0.02}, {"speed_m_s", 0.01}}, {});
     plate.numbers.erase("plate_diameter_m");
     ExperimentSet set;
     set.name = "misspelt";
@@ -801,4 +814,22 @@ TEST_CASE("a heap that spreads flat is an angle of repose of zero, not a missing
     const Curve &angle = curves[0].at("repose").at("angle_deg");
     REQUIRE(angle.scalar());
     CHECK(angle.y[0] == 0.0);
+}
+
+TEST_CASE("a lab test refused for one experiment of its group names every experiment of it",
+          "[gap][simulator]") {
+    // Plates in one box run as one lab test: a plate too large for the bin was named as the
+    // group's first experiment, which was not the one at fault.
+    const BaseModel base = loadBaseModel(kDir + "/base.yaml");
+    ExperimentSet set;
+    set.name = "group";
+    set.experiments = {plateExperiment("small", {{"plate_diameter_m", 0.02}}, {}),
+                       plateExperiment("huge", {{"plate_diameter_m", 0.5}}, {})};
+    const StudySimulator sim(base, (freshScratch("grainlink-gap-group") / "sims").string(), {});
+    VariantRequest plain;
+    plain.label = "base";
+    CHECK_THROWS_WITH(sim.plan(set, {plain}),
+                      Catch::Contains("base seed 0 small, huge: not a valid lab bevameter "
+                                      "scenario") &&
+                          Catch::Contains("reaches past the bed"));
 }

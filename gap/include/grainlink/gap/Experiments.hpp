@@ -22,6 +22,8 @@ enum class ExperimentType {
     Mole,             ///< x stroke [-] -> depth [m]
 };
 const char *typeName(ExperimentType type);
+/// Every experiment type, in the order of the enum.
+std::vector<ExperimentType> experimentTypes();
 ExperimentType parseType(const std::string &name); ///< throws std::invalid_argument
 /// The observables an experiment of `type` may hold (SI names, e.g. "pressure_Pa").
 const std::vector<std::string> &observablesOf(ExperimentType type);
