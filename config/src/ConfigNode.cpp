@@ -176,14 +176,21 @@ double ConfigNode::number() const {
     if (!node_.IsScalar())
         fail("expected a number");
     const std::string s = node_.Scalar();
+    std::size_t used = 0;
     try {
-        std::size_t used = 0;
         const double v = std::stod(s, &used);
         if (used != s.size() || !std::isfinite(v))
             throw std::invalid_argument(s);
         return v;
     } catch (const std::exception &) {
-        fail("expected a number, got '" + s + "'");
+        // A number with its unit written after it ("20 kPa"): the key's name carries the unit.
+        const bool unit_after =
+            used > 0 && used < s.size() && s.find_first_not_of(' ', used) != std::string::npos &&
+            std::isalpha(static_cast<unsigned char>(s[s.find_first_not_of(' ', used)]));
+        fail("expected a number, got '" + s + "'" +
+             (unit_after ? ": give the number alone, in the unit its key's name ends with "
+                           "(_Pa, _m, _N, _s, ...)"
+                         : ""));
     }
 }
 

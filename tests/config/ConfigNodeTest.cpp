@@ -107,3 +107,13 @@ TEST_CASE("a key's list index is digits only, at most nine of them: a number too
     CHECK_FALSE(grainlink::config::listIndex("1e3"));
     CHECK_FALSE(grainlink::config::listIndex("plate"));
 }
+
+TEST_CASE("a number written with its unit is refused with the unit's place named", "[config]") {
+    const ConfigNode c = load("conditions:\n  normal_stress_Pa: 20 kPa\n  depth_m: abc\n");
+    CHECK_THROWS_WITH(c["conditions"]["normal_stress_Pa"].number(),
+                      Contains("s.yaml:2: key 'conditions.normal_stress_Pa': expected a number, "
+                               "got '20 kPa': give the number alone, in the unit its key's name "
+                               "ends with"));
+    // No number at all: no such hint.
+    CHECK_THROWS_WITH(c["conditions"]["depth_m"].number(), !Contains("give the number alone"));
+}
