@@ -138,6 +138,12 @@ int printPlan(const gap::DiagnosisPlan &plan, const gap::ExperimentSet &set,
             measured += text;
         }
         std::printf("  %-20s measured %s\n", "", measured.c_str());
+        // The conditions as read, in SI: a diameter given in mm shows here too.
+        std::string conditions;
+        for (const auto &[key, value] : e.conditionText())
+            conditions += (conditions.empty() ? "" : ", ") + key + " " + value;
+        if (!conditions.empty())
+            std::printf("  %-20s conditions %s\n", "", conditions.c_str());
     }
     if (plan.held_out.size() < 2)
         std::printf("note: %s held out: the diagnosis can locate a gap but claim no effect (a "
@@ -268,6 +274,20 @@ GapCommand::GapCommand(CLI::App &app) {
                      "the columns' names of files without a header line (comma separated)")
         ->delimiter(',');
     import_csv_->add_flag("--units-row", csv_units_row_, "the line under the header holds units");
+    import_csv_
+        ->add_option("--skip-lines", csv_skip_lines_,
+                     "lines before the header (a title, a preamble), skipped")
+        ->check(CLI::NonNegativeNumber);
+    import_csv_->add_option("--x-scale", csv_x_scale_,
+                            "multiplies the x column (-1: another code's z up)");
+    import_csv_->add_option("--y-scale", csv_y_scale_,
+                            "OBSERVABLE=FACTOR multiplies that column (-1: a force along z up)");
+    import_csv_->add_option("--filter", csv_filter_,
+                            "COLUMN=VALUE: only the rows holding it (one slip angle of a file "
+                            "holding several)");
+    import_csv_->add_option("--zero", csv_zero_,
+                            "where x is zero: as_recorded, first_sample or "
+                            "force_threshold=VALUE:UNIT");
 }
 
 int GapCommand::run() const {
@@ -407,7 +427,39 @@ int GapCommand::importCsv() const {
         const auto [k, v] = split(c, '=');
         csv.conditions[k] = v;
     }
-    gap::importCsv(csv, out_);
+    csv.skip_lines = csv_skip_lines_;
+    csv.x_scale = csv_x_scale_;
+    const auto numberOf = [](const std::string &option, const std::string &text) {
+        char *end = nullptr;
+        const double v = std::strtod(text.c_str(), &end);
+        if (text.empty() || end != text.c_str() + text.size())
+            throw std::invalid_argument(option + ": '" + text + "' is not a number");
+        return v;
+    };
+    for (const std::string &s : csv_y_scale_) {
+        const auto [obs, factor] = split(s, '=');
+        csv.y_scale[obs] = numberOf("--y-scale " + s, factor);
+    }
+    for (const std::string &f : csv_filter_) {
+        const auto [column, value] = split(f, '=');
+        csv.filter[column] = numberOf("--filter " + f, value);
+    }
+    if (!csv_zero_.empty()) {
+        csv.zero_method = csv_zero_.substr(0, csv_zero_.find('='));
+        if (csv_zero_.find('=') != std::string::npos) {
+            if (csv.zero_method != "force_threshold")
+                throw std::invalid_argument("--zero " + csv_zero_ +
+                                            ": only force_threshold takes a value");
+            const auto [value, unit] = split(split(csv_zero_, '=').second, ':');
+            csv.zero_threshold = numberOf("--zero " + csv_zero_, value);
+            csv.zero_unit = unit;
+        } else if (csv.zero_method == "force_threshold") {
+            throw std::invalid_argument("--zero force_threshold: give its threshold, "
+                                        "force_threshold=VALUE:UNIT");
+        }
+    }
+    for (const std::string &warning : gap::importCsv(csv, out_))
+        std::fprintf(stderr, "grainlink: warning: %s\n", warning.c_str());
     std::printf("added experiment '%s' to %s/experiments.yaml\n", csv_id_.c_str(), out_.c_str());
     return 0;
 }

@@ -42,8 +42,11 @@ private:
     // selftest
     std::string scale_ = "ci", plan_;
     // import
-    std::string source_, sinkage_ = "synced", csv_id_, csv_type_, csv_x_;
-    std::vector<std::string> csv_files_, csv_y_, csv_conditions_, csv_columns_;
+    std::string source_, sinkage_ = "synced", csv_id_, csv_type_, csv_x_, csv_zero_;
+    std::vector<std::string> csv_files_, csv_y_, csv_conditions_, csv_columns_, csv_y_scale_,
+        csv_filter_;
+    double csv_x_scale_ = 1.0;
+    int csv_skip_lines_ = 0;
     bool csv_scatter_ = false, csv_units_row_ = false, no_wheels_ = false, no_plates_ = false;
     std::string csv_delimiter_ = ",", csv_decimal_ = ".", csv_comment_ = "#";
 };

@@ -119,11 +119,15 @@ std::optional<std::size_t> DataTable::find(const std::string &name) const {
     return std::size_t(it - header.begin());
 }
 
+std::string quotedNames(const std::vector<std::string> &names) {
+    std::string list;
+    for (const auto &n : names)
+        list += (list.empty() ? "'" : ", '") + n + "'";
+    return list;
+}
+
 std::string DataTable::names() const {
-    std::string have;
-    for (const auto &h : header)
-        have += (have.empty() ? "" : ", ") + h;
-    return have;
+    return quotedNames(header);
 }
 
 std::string DataTable::missingColumn(const std::string &name) const {

@@ -42,7 +42,7 @@ struct DataTable {
 
     /// The column of that name; none when it is missing. Throws when two columns share it.
     std::optional<std::size_t> find(const std::string &name) const;
-    /// The header's names, comma-separated, for a message.
+    /// The header's names quoted and comma-separated, for a message: 'Sinkage, mm', 'Comment'.
     std::string names() const;
     /// Why no column is named `name`: the file, its columns, and the likely cause (another
     /// delimiter, names on a comment line).
@@ -54,6 +54,10 @@ struct DataTable {
     /// file, line and column.
     double number(std::size_t row, std::size_t col) const;
 };
+
+/// Names quoted and comma-separated ('Sinkage, mm', 'Pressure, kPa'): a name holding a comma
+/// or a blank reads as one name. Every list of columns in a message is written by it.
+std::string quotedNames(const std::vector<std::string> &names);
 
 /// Splits one line into cells: quoted cells may hold the delimiter ("Sinkage, mm") and a
 /// doubled quote; blanks around a cell are dropped.

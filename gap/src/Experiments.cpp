@@ -327,6 +327,18 @@ std::vector<ExperimentType> experimentTypes() {
 
 const std::vector<std::string> &observablesOf(ExperimentType type) { return info(type).observables; }
 
+std::string notAnObservable(const std::string &name, ExperimentType type) {
+    std::vector<std::string> names = observablesOf(type);
+    // A plate's force is read as its pressure (given with conditions.plate_diameter_m).
+    if (type == ExperimentType::PlateSinkage)
+        names.push_back("force_N");
+    std::string list;
+    for (const auto &n : names)
+        list += (list.empty() ? "" : ", ") + n;
+    return "'" + name + "' is not an observable of " + typeName(type) +
+           " (its observables: " + list + ")";
+}
+
 const char *xNameOf(ExperimentType type) { return info(type).x_name; }
 
 ExperimentType parseType(const std::string &name) {
@@ -598,11 +610,7 @@ ExperimentSet loadExperiments(const std::string &directory) {
                 if (std::find(ti.observables.begin(), ti.observables.end(), o) ==
                         ti.observables.end() &&
                     !(o == "force_N" && plate_area > 0.0)) {
-                    std::string allowed;
-                    for (const auto &a : ti.observables)
-                        allowed += (allowed.empty() ? "" : ", ") + a;
-                    y[o].fail("'" + o + "' is not an observable of " + ti.name + " (" + allowed +
-                              ")");
+                    y[o].fail(notAnObservable(o, e.type));
                 }
             if (obs_names.empty())
                 y.fail("name at least one observable");

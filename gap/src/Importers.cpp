@@ -1,6 +1,7 @@
 #include "grainlink/gap/Importers.hpp"
 
 #include "grainlink/gap/Experiments.hpp"
+#include "grainlink/gap/StudySimulator.hpp"
 
 #include "DataTable.hpp"
 
@@ -10,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -311,118 +313,279 @@ namespace {
 /// A reader's message, which names data.* keys of experiments.yaml, with the importer's
 /// options instead.
 std::string withImportOptions(std::string message) {
-    const std::pair<const char *, const char *> keys[] = {{"data.decimal: \",\"", "--decimal ,"},
-                                                          {"data.delimiter: ", "--delimiter "},
-                                                          {"data.delimiter", "--delimiter"},
-                                                          {"data.decimal", "--decimal"},
-                                                          {"data.units_row: true", "--units-row"},
-                                                          {"data.columns: ", "--columns "},
-                                                          {"data.columns", "--columns"},
-                                                          {"give data.skip_lines (the lines before "
-                                                           "the header) or start it with "
-                                                           "data.comment",
-                                                           "delete it, or start it with the mark "
-                                                           "of --comment"}};
+    // `data.columns: [a, b]` is the option's comma-separated list.
+    static const std::regex columns(R"(data\.columns: \[([^\]]*)\])");
+    std::smatch m;
+    if (std::regex_search(message, m, columns)) {
+        std::string list = m[1];
+        for (std::size_t at; (at = list.find(", ")) != std::string::npos;)
+            list.erase(at + 1, 1);
+        message.replace(std::size_t(m.position(0)), std::size_t(m.length(0)), "--columns " + list);
+    }
+    const std::pair<const char *, const char *> keys[] = {
+        {"data.decimal: \",\"", "--decimal ,"},
+        {"data.delimiter: ", "--delimiter "},
+        {"data.delimiter", "--delimiter"},
+        {"data.decimal", "--decimal"},
+        {"data.units_row: true", "--units-row"},
+        {"data.columns", "--columns"},
+        {"data.skip_lines", "--skip-lines"},
+        {"start it with data.comment", "start it with the mark of --comment"},
+        {"data.comment", "--comment"}};
     for (const auto &[key, option] : keys)
         for (std::size_t at; (at = message.find(key)) != std::string::npos;)
             message.replace(at, std::string(key).size(), option);
     return message;
 }
 
-} // namespace
+std::string numberText(double v) {
+    char text[32];
+    std::snprintf(text, sizeof text, "%.6g", v);
+    return text;
+}
 
-void importCsv(const CsvImport &csv, const std::string &out) {
-    const fs::path dst(out);
-    const ExperimentType type = parseType(csv.type);
-    if (csv.id.empty() || csv.id[0] == '.' || csv.id.find_first_of(" /\\\t\n") != std::string::npos)
-        throw std::invalid_argument("--id '" + csv.id +
-                                    "': an id is one word without spaces or "
-                                    "slashes");
-    const bool scalar = std::string(xNameOf(type)).empty();
-    if (scalar != csv.x_column.empty())
-        throw std::invalid_argument(scalar ? "--x: a " + csv.type +
-                                                 " is one value a row (its --y column): give no --x"
-                                           : "--x COLUMN:UNIT: a " + csv.type + " needs its x");
-    if (csv.y.empty() || (scalar && csv.y.size() != 1))
-        throw std::invalid_argument(scalar ? "--y: give one column of values"
-                                           : "--y: name at least one observable");
+bool isNumberText(const std::string &text) {
+    char *end = nullptr;
+    std::strtod(text.c_str(), &end);
+    return !text.empty() && end == text.c_str() + text.size();
+}
 
-    if (csv.files.empty())
-        throw std::invalid_argument("give the CSV file (or one file per repeat)");
-    // Units before anything is read or written: an error names the option, not a file the
-    // import would have written and undone.
+std::string xOption(const CsvImport &csv) {
+    return "--x " + csv.x_column + ":" + csv.x_unit;
+}
+
+std::string yOption(const CsvImport &csv, const std::string &observable) {
+    const auto &[column, unit] = csv.y.at(observable);
+    return "--y " + observable + "=" + column + ":" + unit;
+}
+
+std::string zeroOption(const CsvImport &csv) {
+    return "--zero " + csv.zero_method +
+           (csv.zero_method == "force_threshold"
+                ? "=" + numberText(csv.zero_threshold) + ":" + csv.zero_unit
+                : std::string());
+}
+
+/// The condition that sets a type's test up, without which it cannot run (a plate's size, a
+/// shear box's load); "" where the base's own values stand in for every missing one.
+std::string neededCondition(ExperimentType type) {
+    switch (type) {
+    case ExperimentType::PlateSinkage:
+        return "plate_diameter_m";
+    case ExperimentType::DirectShear:
+        return "normal_stress_Pa";
+    case ExperimentType::BevameterShear:
+        return "normal_pressure_Pa";
+    default:
+        return "";
+    }
+}
+
+/// The --condition keys as diagnose reads them: a number under an SI name (not "40mm"), and a
+/// name the type's test knows; an unknown one is refused where it stands in for the condition
+/// the test needs, else returned as a warning (it describes, the simulation does not read it).
+std::vector<std::string> checkConditions(const CsvImport &csv, ExperimentType type) {
+    std::vector<std::string> known = simulatedConditions(type);
+    // Read as the test's own (experiments.yaml reads a radius as its diameter), or describing.
+    if (type == ExperimentType::PlateSinkage)
+        known.push_back("plate_radius_m");
+    if (type == ExperimentType::WheelSteadyState)
+        known.push_back("wheel_diameter_m");
+    for (const char *c : {"speed_m_s", "box", "preparation"})
+        known.push_back(c);
+    std::string list;
+    for (const auto &c : known)
+        list += (list.empty() ? "" : ", ") + c;
+    const std::string needed = neededCondition(type);
+    const bool needed_given =
+        needed.empty() || csv.conditions.count(needed) ||
+        (type == ExperimentType::PlateSinkage && csv.conditions.count("plate_radius_m"));
+    std::vector<std::string> warnings;
+    for (const auto &[key, value] : csv.conditions) {
+        const std::string option = "--condition " + key + "=" + value;
+        const bool label = key == "box" || key == "preparation";
+        const std::string dimension = dimensionOf(key);
+        if (!label && dimension != "dimensionless" && !isNumberText(value)) {
+            // "40mm": the number it stands for, in the key's SI unit.
+            std::string hint;
+            char *end = nullptr;
+            const double v = std::strtod(value.c_str(), &end);
+            std::string unit(end);
+            unit.erase(0, unit.find_first_not_of(' '));
+            try {
+                if (end != value.c_str())
+                    hint =
+                        " (" + numberText(v * unitFactor(unit, dimension)) + " for " + value + ")";
+            } catch (const std::invalid_argument &) {
+            }
+            throw std::invalid_argument(option + ": give " + key + " as a number in " +
+                                        unitOf(key) + ", the SI unit its name ends in" + hint);
+        }
+        if (label || std::find(known.begin(), known.end(), key) != known.end() ||
+            (dimension == "dimensionless" && !isNumberText(value)))
+            continue; // a text condition names a soil the base may describe
+        const std::string why = "'" + key + "' is not a condition of " + csv.type +
+                                " (misspelt? its conditions: " + list + ")";
+        if (!needed_given)
+            throw std::invalid_argument(option + ": " + why + "; its test needs " + needed);
+        warnings.push_back(option + ": " + why +
+                           ": kept as a description, the simulation does not read it");
+    }
+    return warnings;
+}
+
+/// Everything the options say that no file is needed for: the observables, their units and
+/// scales, the zero convention and the conditions. Said by the option, before anything is read
+/// or written. Returns the conditions' warnings.
+std::vector<std::string> checkOptions(const CsvImport &csv, ExperimentType type, bool scalar) {
+    const auto &observables = observablesOf(type);
+    for (const auto &[obs, col] : csv.y)
+        if (std::find(observables.begin(), observables.end(), obs) == observables.end() &&
+            !(obs == "force_N" && type == ExperimentType::PlateSinkage))
+            throw std::invalid_argument(yOption(csv, obs) + ": " +
+                                        notAnObservable(obs, parseType(csv.type)));
     const auto checkUnit = [](const std::string &option, const std::string &unit,
-                              const std::string &si_name) {
+                              const std::string &dimension) {
         try {
-            unitFactor(unit, dimensionOf(si_name));
+            unitFactor(unit, dimension);
         } catch (const std::invalid_argument &e) {
             throw std::invalid_argument(option + ": " + e.what());
         }
     };
-    if (!scalar) {
-        checkUnit("--x " + csv.x_column + ":" + csv.x_unit, csv.x_unit, xNameOf(type));
-        for (const auto &[obs, col] : csv.y)
-            checkUnit("--y " + obs + "=" + col.first + ":" + col.second, col.second, obs);
-    }
-
-    // Read and checked before anything is written: an error names the user's file and line.
-    TableFormat format;
-    format.delimitedBy(csv.delimiter);
-    format.decimal = csv.decimal.empty() ? '.' : csv.decimal[0];
-    format.comment = csv.comment;
-    format.columns = csv.columns;
-    format.units_row = csv.units_row;
-    std::vector<std::string> columns;
-    if (!csv.x_column.empty())
-        columns.push_back(csv.x_column);
+    if (!scalar)
+        checkUnit(xOption(csv), csv.x_unit, dimensionOf(xNameOf(type)));
     for (const auto &[obs, col] : csv.y)
-        columns.push_back(col.first);
-    std::vector<DataTable> tables;
-    for (const std::string &file : csv.files) {
-        try {
-            tables.push_back(readDataTable(file, format));
-            const DataTable &c = tables.back();
-            for (const std::string &name : columns) {
-                const std::size_t col = column(c, name);
-                for (std::size_t r = 0; r < c.rows.size(); ++r)
-                    if (!c.missing(r, col))
-                        c.number(r, col);
-            }
-        } catch (const config::ConfigError &e) {
-            throw config::ConfigError(withImportOptions(e.what()));
+        checkUnit(yOption(csv, obs), col.second, dimensionOf(obs));
+    const auto checkScale = [](const std::string &option, double scale) {
+        if (scale == 0.0 || !std::isfinite(scale))
+            throw std::invalid_argument(option + ": a scale multiplies the column: give a "
+                                                 "finite number other than 0");
+    };
+    if (scalar && csv.x_scale != 1.0)
+        throw std::invalid_argument("--x-scale: a " + csv.type + " has no x");
+    checkScale("--x-scale " + numberText(csv.x_scale), csv.x_scale);
+    for (const auto &[obs, scale] : csv.y_scale) {
+        if (!csv.y.count(obs))
+            throw std::invalid_argument("--y-scale " + obs + "=" + numberText(scale) + ": no --y " +
+                                        obs + "=COLUMN:UNIT to scale");
+        checkScale("--y-scale " + obs + "=" + numberText(scale), scale);
+    }
+    if (!csv.zero_method.empty()) {
+        if (scalar)
+            throw std::invalid_argument(zeroOption(csv) + ": a " + csv.type + " has no x to zero");
+        if (csv.zero_method != "as_recorded" && csv.zero_method != "first_sample" &&
+            csv.zero_method != "force_threshold")
+            throw std::invalid_argument(zeroOption(csv) + ": use as_recorded, first_sample or "
+                                                          "force_threshold=VALUE:UNIT");
+        // The threshold is a value of the first observable (a plate's force where it gives one).
+        if (csv.zero_method == "force_threshold")
+            checkUnit(zeroOption(csv), csv.zero_unit, dimensionOf(csv.y.begin()->first));
+    }
+    return checkConditions(csv, type);
+}
+
+/// The rows of `c` holding every value of `filter` (column -> value, as experiments.yaml's
+/// data.filter matches them).
+DataTable filtered(const DataTable &c, const std::map<std::string, double> &filter) {
+    DataTable kept = c;
+    kept.rows.clear();
+    kept.lines.clear();
+    std::vector<std::pair<std::size_t, double>> keys;
+    for (const auto &[name, value] : filter) {
+        const auto col = c.find(name);
+        if (!col)
+            throw std::invalid_argument("--filter " + name + "=" + numberText(value) + ": " +
+                                        c.missingColumn(name));
+        keys.emplace_back(*col, value);
+    }
+    for (std::size_t r = 0; r < c.rows.size(); ++r) {
+        bool selected = true;
+        for (const auto &[col, v] : keys)
+            selected = selected && !c.missing(r, col) &&
+                       std::abs(c.number(r, col) - v) <= 1e-9 * (1 + std::abs(v));
+        if (selected) {
+            kept.rows.push_back(c.rows[r]);
+            kept.lines.push_back(c.lines[r]);
         }
     }
-
-    const fs::path yaml = dst / "experiments.yaml";
-    YAML::Node root = loadOrNew(yaml, folderName(out));
-    for (const auto &e : root["experiments"])
-        if (e["id"].as<std::string>() == csv.id)
-            throw std::invalid_argument("experiment id '" + csv.id + "' is already in " +
-                                        yaml.string());
-    // The copies: data/ID.csv, or data/ID_1.csv ... for repeats.
-    std::vector<std::string> copies;
-    for (std::size_t k = 0; !scalar && k < tables.size(); ++k) {
-        copies.push_back("data/" + csv.id +
-                         (tables.size() > 1 ? "_" + std::to_string(k + 1) : std::string()) +
-                         ".csv");
-        if (fs::exists(dst / copies.back()))
-            throw std::invalid_argument((dst / copies.back()).string() +
-                                        " exists already: give another --id");
+    if (kept.rows.empty() && !keys.empty()) {
+        std::string option;
+        for (const auto &[name, value] : filter)
+            option +=
+                (option.empty() ? "--filter " : " --filter ") + name + "=" + numberText(value);
+        throw std::invalid_argument(option + ": no row of " + c.file + " holds it");
     }
+    return kept;
+}
 
+/// A scatter's columns besides those it reads that take a few values, each on several rows:
+/// most likely a condition of the test (a wheel's slip angle) merged into one experiment.
+std::vector<std::string> varyingColumns(const DataTable &c, const std::vector<std::string> &read,
+                                        const std::string &id) {
+    std::vector<std::string> warnings;
+    // Each column's grouping of the rows (a row's first row of the same value): a column that
+    // groups them as one already said does (a side force that follows the slip angle) is not said.
+    std::vector<std::vector<std::size_t>> said;
+    for (std::size_t col = 0; col < c.header.size(); ++col) {
+        if (std::find(read.begin(), read.end(), c.header[col]) != read.end())
+            continue;
+        std::vector<double> of_row(c.rows.size(), NAN);
+        try {
+            for (std::size_t r = 0; r < c.rows.size(); ++r)
+                if (!c.missing(r, col))
+                    of_row[r] = c.number(r, col);
+        } catch (const config::ConfigError &) {
+            continue; // text: a comment, a label
+        }
+        std::vector<std::size_t> groups(c.rows.size());
+        for (std::size_t r = 0; r < c.rows.size(); ++r)
+            groups[r] = std::size_t(
+                std::find_if(of_row.begin(), of_row.end(),
+                             [&](double v) {
+                                 return v == of_row[r] || (std::isnan(v) && std::isnan(of_row[r]));
+                             }) -
+                of_row.begin());
+        if (std::find(said.begin(), said.end(), groups) != said.end())
+            continue;
+        std::vector<double> values;
+        for (double v : of_row)
+            if (!std::isnan(v))
+                values.push_back(v);
+        std::sort(values.begin(), values.end());
+        values.erase(std::unique(values.begin(), values.end()), values.end());
+        // Three rows a value on average: a run counter or a measured load takes more values.
+        if (values.size() < 2 || 3 * values.size() > c.rows.size())
+            continue;
+        std::string list;
+        for (std::size_t i = 0; i < values.size() && i < 5; ++i)
+            list += (i ? ", " : "") + numberText(values[i]);
+        const std::string name = c.header[col];
+        said.push_back(groups);
+        warnings.push_back(c.file + ": column '" + name + "' takes " +
+                           std::to_string(values.size()) + " values (" + list +
+                           (values.size() > 5 ? ", ..." : "") + ") over the " +
+                           std::to_string(c.rows.size()) + " rows merged into experiment '" + id +
+                           "': if it is a condition of the test (a slip angle, a load), import "
+                           "one experiment per value: --filter " +
+                           name + "=" + numberText(values[0]) + " --id " + id + "_" +
+                           numberText(values[0]) + " with its --condition, and so on");
+    }
+    return warnings;
+}
+
+/// The experiments.yaml node of the import (its copies named in `copies`).
+YAML::Node experimentNode(const CsvImport &csv, bool scalar, const std::vector<DataTable> &tables,
+                          const std::vector<std::string> &copies) {
     YAML::Node e;
     e["id"] = csv.id;
     e["type"] = csv.type;
     if (!csv.conditions.empty()) {
         YAML::Node cond;
-        for (const auto &[k, v] : csv.conditions) {
-            char *end = nullptr;
-            const double d = std::strtod(v.c_str(), &end);
-            if (!v.empty() && end == v.c_str() + v.size())
-                cond[k] = d;
+        for (const auto &[k, v] : csv.conditions)
+            if (isNumberText(v))
+                cond[k] = std::strtod(v.c_str(), nullptr);
             else
                 cond[k] = v;
-        }
         e["conditions"] = flow(cond);
     }
     YAML::Node data;
@@ -444,21 +607,178 @@ void importCsv(const CsvImport &csv, const std::string &out) {
         YAML::Node x;
         x["column"] = csv.x_column;
         x["unit"] = csv.x_unit;
+        if (csv.x_scale != 1.0)
+            x["scale"] = csv.x_scale;
         data["x"] = flow(x);
         YAML::Node y;
         for (const auto &[obs, col] : csv.y) {
             YAML::Node n;
             n["column"] = col.first;
             n["unit"] = col.second;
+            if (const auto s = csv.y_scale.find(obs); s != csv.y_scale.end() && s->second != 1.0)
+                n["scale"] = s->second;
             y[obs] = flow(n);
         }
         data["y"] = y;
     }
     e["data"] = data;
+    if (!csv.zero_method.empty()) {
+        YAML::Node zero;
+        zero["method"] = csv.zero_method;
+        if (csv.zero_method == "force_threshold") {
+            zero["threshold"] = csv.zero_threshold;
+            zero["unit"] = csv.zero_unit;
+        }
+        e["zero"] = flow(zero);
+    }
+    return e;
+}
+
+/// A message of the read-back names experiments.yaml and the data/ copies, which a failed
+/// import undoes: said instead with the option or the input file (and its line) it came from.
+std::string asImportInput(const std::string &message, const CsvImport &csv, const fs::path &yaml,
+                          const std::vector<fs::path> &copies,
+                          const std::vector<DataTable> &tables) {
+    std::string text = message;
+    static const std::regex located(R"(^:\d+: key 'experiments\[\d+\]\.([^']*)': )");
+    std::smatch m;
+    const std::string tail =
+        text.rfind(yaml.string(), 0) == 0 ? text.substr(yaml.string().size()) : std::string();
+    if (std::regex_search(tail, m, located)) {
+        const std::string key = m[1];
+        std::string rest = m.suffix();
+        std::string option;
+        if (key.rfind("conditions.", 0) == 0) {
+            const std::string name = key.substr(11);
+            const auto given = csv.conditions.find(name);
+            option = "--condition " + name +
+                     (given == csv.conditions.end() ? std::string() : "=" + given->second);
+        } else if (key.rfind("data.y.", 0) == 0) {
+            const std::string obs = key.substr(7, key.find('.', 7) - 7);
+            option = csv.y.count(obs) ? yOption(csv, obs) : "--y";
+        } else if (key.rfind("data.x", 0) == 0) {
+            option = xOption(csv);
+        } else if (key == "data.values" || key == "data.unit") {
+            option = yOption(csv, csv.y.begin()->first);
+        } else if (key.rfind("zero", 0) == 0) {
+            option = zeroOption(csv);
+        }
+        if (!option.empty() || key.rfind("data.files", 0) == 0)
+            text = (option.empty() ? "" : option + ": ") + rest;
+    }
+    const std::pair<std::string, std::string> keys[] = {
+        {"conditions.", "--condition "}, {"give unit: \"%\"", "give --x " + csv.x_column + ":%"}};
+    for (const auto &[key, option] : keys)
+        for (std::size_t at; (at = text.find(key)) != std::string::npos;)
+            text.replace(at, key.size(), option);
+    // A copy's line: its two comment lines and header, then the input's rows in order.
+    for (std::size_t k = 0; k < copies.size(); ++k)
+        for (std::size_t at; (at = text.find(copies[k].string())) != std::string::npos;) {
+            std::size_t end = at + copies[k].string().size();
+            std::string input = csv.files[k];
+            if (end < text.size() && text[end] == ':' && end + 1 < text.size() &&
+                std::isdigit(static_cast<unsigned char>(text[end + 1]))) {
+                std::size_t digits = end + 1;
+                while (digits < text.size() &&
+                       std::isdigit(static_cast<unsigned char>(text[digits])))
+                    ++digits;
+                const long row = std::stol(text.substr(end + 1, digits - end - 1)) - 4;
+                if (row >= 0 && std::size_t(row) < tables[k].lines.size())
+                    input += ":" + std::to_string(tables[k].lines[std::size_t(row)]);
+                end = digits;
+            }
+            text.replace(at, end - at, input);
+        }
+    return text;
+}
+
+} // namespace
+
+std::vector<std::string> importCsv(const CsvImport &csv, const std::string &out) {
+    const fs::path dst(out);
+    const ExperimentType type = parseType(csv.type);
+    if (csv.id.empty() || csv.id[0] == '.' || csv.id.find_first_of(" /\\\t\n") != std::string::npos)
+        throw std::invalid_argument("--id '" + csv.id +
+                                    "': an id is one word without spaces or "
+                                    "slashes");
+    const bool scalar = std::string(xNameOf(type)).empty();
+    if (scalar != csv.x_column.empty())
+        throw std::invalid_argument(scalar ? "--x: a " + csv.type +
+                                                 " is one value a row (its --y column): give no --x"
+                                           : "--x COLUMN:UNIT: a " + csv.type + " needs its x");
+    if (csv.y.empty() || (scalar && csv.y.size() != 1))
+        throw std::invalid_argument(scalar ? "--y: give one column of values"
+                                           : "--y: name at least one observable");
+
+    if (csv.files.empty())
+        throw std::invalid_argument("give the CSV file (or one file per repeat)");
+    // Options before anything is read or written: an error names the option, not a file the
+    // import would have written and undone.
+    std::vector<std::string> warnings = checkOptions(csv, type, scalar);
+
+    // Read and checked before anything is written: an error names the user's file and line.
+    TableFormat format;
+    format.delimitedBy(csv.delimiter);
+    format.decimal = csv.decimal.empty() ? '.' : csv.decimal[0];
+    format.comment = csv.comment;
+    format.columns = csv.columns;
+    format.units_row = csv.units_row;
+    format.skip_lines = csv.skip_lines;
+    std::vector<std::string> columns;
+    if (!csv.x_column.empty())
+        columns.push_back(csv.x_column);
+    for (const auto &[obs, col] : csv.y)
+        columns.push_back(col.first);
+    std::vector<DataTable> tables;
+    for (const std::string &file : csv.files) {
+        try {
+            tables.push_back(filtered(readDataTable(file, format), csv.filter));
+            const DataTable &c = tables.back();
+            for (const std::string &name : columns) {
+                const std::size_t col = column(c, name);
+                for (std::size_t r = 0; r < c.rows.size(); ++r)
+                    if (!c.missing(r, col))
+                        c.number(r, col);
+            }
+        } catch (const config::ConfigError &e) {
+            throw config::ConfigError(withImportOptions(e.what()));
+        }
+        if (csv.scatter) {
+            std::vector<std::string> read = columns;
+            for (const auto &[name, value] : csv.filter)
+                read.push_back(name);
+            for (std::string &w : varyingColumns(tables.back(), read, csv.id))
+                warnings.push_back(std::move(w));
+        }
+    }
+
+    const fs::path yaml = dst / "experiments.yaml";
+    YAML::Node root = loadOrNew(yaml, folderName(out));
+    for (const auto &e : root["experiments"])
+        if (e["id"].as<std::string>() == csv.id)
+            throw std::invalid_argument("experiment id '" + csv.id + "' is already in " +
+                                        yaml.string());
+    // The copies: data/ID.csv, or data/ID_1.csv ... for repeats.
+    std::vector<std::string> copies;
+    std::vector<fs::path> copy_paths;
+    for (std::size_t k = 0; !scalar && k < tables.size(); ++k) {
+        copies.push_back("data/" + csv.id +
+                         (tables.size() > 1 ? "_" + std::to_string(k + 1) : std::string()) +
+                         ".csv");
+        copy_paths.push_back(dst / copies.back());
+        if (fs::exists(copy_paths.back()))
+            throw std::invalid_argument(copy_paths.back().string() +
+                                        " exists already: give another --id");
+    }
+    const YAML::Node e = experimentNode(csv, scalar, tables, copies);
+    std::string rows; // the copy's header says which rows it holds
+    for (const auto &[name, value] : csv.filter)
+        rows += (rows.empty() ? ", the rows with " : " and ") + name + " = " + numberText(value);
 
     // Written, read back strictly, and undone if it does not read: a failed import leaves the
     // folder as it was.
-    const bool existed = fs::exists(yaml);
+    const bool existed = fs::exists(yaml), had_out = fs::exists(dst),
+               had_data = fs::exists(dst / "data");
     std::string before;
     if (existed) {
         std::ifstream in(yaml);
@@ -467,22 +787,27 @@ void importCsv(const CsvImport &csv, const std::string &out) {
     fs::create_directories(dst / "data");
     try {
         for (std::size_t k = 0; k < copies.size(); ++k)
-            writeColumns(tables[k], columns, csv.files[k], dst / copies[k],
-                         "imported by grainlink gap import csv");
+            writeColumns(tables[k], columns, csv.files[k], copy_paths[k],
+                         "imported by grainlink gap import csv" + rows);
         root["experiments"].push_back(e);
         save(root, yaml, "# Measurements for grainlink gap (docs/gap.md).\n");
         loadExperiments(out);
-    } catch (...) {
-        for (const std::string &copy : copies)
-            fs::remove(dst / copy);
+    } catch (const std::exception &error) {
+        for (const fs::path &copy : copy_paths)
+            fs::remove(copy);
         if (existed) {
             std::ofstream(yaml.string() + ".tmp") << before;
             fs::rename(yaml.string() + ".tmp", yaml);
         } else {
             fs::remove(yaml);
         }
-        throw;
+        if (!had_data)
+            fs::remove(dst / "data");
+        if (!had_out)
+            fs::remove(dst);
+        throw std::invalid_argument(asImportInput(error.what(), csv, yaml, copy_paths, tables));
     }
+    return warnings;
 }
 
 } // namespace grainlink::gap

@@ -21,8 +21,6 @@ namespace grainlink::gap {
 
 using config::ConfigNode;
 
-std::vector<std::string> simulatedConditions(ExperimentType type);
-
 namespace {
 
 /// A test section's loading speeds: a plate's, a shear box's, a carriage's (in m/s, what an

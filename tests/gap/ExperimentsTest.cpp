@@ -428,7 +428,7 @@ TEST_CASE("data files from other codes and European spreadsheets: names holding 
           std::vector<double>{1250.0, 2500.0});
     write(dir / "commas.csv", "z_mm,p_kPa\n0,5,1,25\n1,0,2,5\n");
     checkRefused(dir, head + "      files: [commas.csv]\n" + zp,
-                 "commas.csv:2: 4 cells where the header line names 2 (z_mm, p_kPa)");
+                 "commas.csv:2: 4 cells where the header line names 2 ('z_mm', 'p_kPa')");
     // A trailing delimiter is no extra cell.
     write(dir / "trailing.csv", "z_mm,p_kPa,\n1,2,\n2,4,\n");
     write(dir / "experiments.yaml", head + "      files: [trailing.csv]\n" + zp);
@@ -470,7 +470,7 @@ TEST_CASE("data files from other codes and European spreadsheets: names holding 
     checkRefused(dir,
                  head + "      files: [lig.txt]\n      delimiter: whitespace\n" +
                      "      columns: [z_m, p_kPa]\n" + lig_axes,
-                 "lig.txt:3: 3 cells where data.columns names 2 (z_m, p_kPa)");
+                 "lig.txt:3: 3 cells where data.columns names 2 ('z_m', 'p_kPa')");
     checkRefused(dir,
                  head + "      files: [lig.txt]\n      delimiter: whitespace\n" +
                      "      columns: [step, z_m, p_kPa, extra]\n" + lig_axes,
@@ -747,8 +747,8 @@ TEST_CASE("data files: an unknown key is named before a file fails to read, and 
                              "      y: {shear_stress_Pa: {column: shear_kPa, unit: kPa}}\n";
     // Read as it is, the title is the header: named as such, not as a decimal comma.
     checkRefused(dir, head + axes,
-                 "s.txt:4: 3 cells where the header line names 1 (Direct shear test ASTM "
-                 "D3080): a title above the header? give data.skip_lines");
+                 "s.txt:4: 3 cells where the header line names 1 ('Direct shear test ASTM "
+                 "D3080'): a title above the header? give data.skip_lines");
     // A misspelt key is said first, not the file it would have read.
     checkRefused(dir, head + "      skip_line: 3\n" + axes,
                  "experiments.yaml:8: unknown key 'experiments[0].data.skip_line'");

@@ -198,3 +198,196 @@ TEST_CASE("import csv reads a file as the diagnosis does, and a failed import le
     CHECK(fs::exists(out / "data" / "repeats_1.csv"));
     CHECK(fs::exists(out / "data" / "repeats_2.csv"));
 }
+
+namespace {
+
+std::string writeInput(const std::string &name, const std::string &text) {
+    const fs::path p =
+        fs::temp_directory_path() / (name + "-" + std::to_string(::getpid()) + ".csv");
+    std::ofstream(p) << text;
+    return p.string();
+}
+
+CsvImport plate(const std::string &file) {
+    CsvImport csv;
+    csv.files = {file};
+    csv.id = "p40";
+    csv.type = "plate_sinkage";
+    csv.x_column = "Sinkage, mm";
+    csv.x_unit = "mm";
+    csv.y["pressure_Pa"] = {"Pressure, kPa", "kPa"};
+    csv.units_row = true;
+    return csv;
+}
+
+const char *kPlateRun = "\"Sinkage, mm\",\"Pressure, kPa\",\"Comment\"\nmm,kPa,-\n"
+                        "0.5,7.3,ok\n1.0,12.0,ok\n1.5,18.5,ok\n";
+
+} // namespace
+
+TEST_CASE("import csv names a wrong observable with every observable of its type, and a "
+          "missing column among its quoted columns",
+          "[gap][import]") {
+    const fs::path out = scratch("csv-names");
+    CsvImport wrong = plate(writeInput("names", kPlateRun));
+    wrong.y = {{"pressure", {"Pressure, kPa", "kPa"}}};
+    // Not a unit error: the name is wrong, and a plate may give its pressure or its force.
+    CHECK_THROWS_WITH(importCsv(wrong, out.string()),
+                      "--y pressure=Pressure, kPa:kPa: 'pressure' is not an observable of "
+                      "plate_sinkage (its observables: pressure_Pa, force_N)");
+    // A scalar's one value too: its name was not checked, and any name became angle_deg.
+    CsvImport repose;
+    repose.files = {writeInput("names-repose", "trial,angle\n1,29.5\n2,30.1\n")};
+    repose.id = "repose";
+    repose.type = "angle_of_repose";
+    repose.y["angle"] = {"angle", "deg"};
+    CHECK_THROWS_WITH(importCsv(repose, out.string()),
+                      Catch::Contains("'angle' is not an observable of angle_of_repose (its "
+                                      "observables: angle_deg)"));
+    CsvImport missing = plate(wrong.files[0]);
+    missing.x_column = "Sinkage";
+    CHECK_THROWS_WITH(importCsv(missing, out.string()),
+                      Catch::Contains("column 'Sinkage' is not in " + wrong.files[0] +
+                                      " (its columns: 'Sinkage, mm', 'Pressure, kPa', 'Comment')"));
+    CHECK_FALSE(fs::exists(out));
+}
+
+TEST_CASE("import csv names the --condition or the input file of an error, never the folder it "
+          "would have written",
+          "[gap][import]") {
+    const fs::path out = scratch("csv-cond");
+    CsvImport csv = plate(writeInput("cond", kPlateRun));
+    csv.conditions = {{"plate_diameter_m", "40mm"}};
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      Catch::StartsWith("--condition plate_diameter_m=40mm: ") &&
+                          Catch::Contains("(0.04 for 40mm)"));
+    // Refused by the read-back of what the import wrote: said by the option all the same, and
+    // the folder it made is gone.
+    csv.conditions = {{"plate_diameter_m", "40"}};
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      Catch::StartsWith("--condition plate_diameter_m=40: ") &&
+                          Catch::Contains("given in mm?") && !Catch::Contains("experiments.yaml"));
+    CHECK_FALSE(fs::exists(out));
+    // A force needs the plate's size: the option to give, not the key of a file.
+    csv.conditions.clear();
+    csv.y = {{"force_N", {"Pressure, kPa", "N"}}};
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      Catch::StartsWith("--y force_N=Pressure, kPa:N: ") &&
+                          Catch::Contains("--condition plate_diameter_m") &&
+                          !Catch::Contains("conditions."));
+    // An error found in the copy names the input file and its own line: a slip in % under "-"
+    // on the input's line 4 (a comment and the header above it; the copy's own line 4 is the
+    // first row).
+    CsvImport wheel;
+    wheel.files = {writeInput("cond-wheel", "# tester\ns,dp\n0.1,1\n12,2\n30,3\n")};
+    wheel.id = "w";
+    wheel.type = "wheel_steady_state";
+    wheel.x_column = "s";
+    wheel.x_unit = "-";
+    wheel.y["drawbar_pull_N"] = {"dp", "N"};
+    wheel.scatter = true;
+    CHECK_THROWS_WITH(importCsv(wheel, out.string()),
+                      Catch::StartsWith("--x s:-: " + wheel.files[0] + ":4: column 's': slip 12") &&
+                          Catch::Contains("give --x s:%") && !Catch::Contains("data/"));
+    // One sample is no curve: said of the input file.
+    CsvImport one =
+        plate(writeInput("cond-one", "\"Sinkage, mm\",\"Pressure, kPa\"\nmm,kPa\n1,2\n"));
+    CHECK_THROWS_WITH(importCsv(one, out.string()),
+                      Catch::StartsWith(one.files[0] + ": 'pressure_Pa' has 1 sample(s)"));
+    CHECK_FALSE(fs::exists(out));
+}
+
+TEST_CASE("import csv checks condition names as the diagnosis reads them", "[gap][import]") {
+    const fs::path out = scratch("csv-condname");
+    CsvImport csv = plate(writeInput("condname", kPlateRun));
+    // The plate's size misspelt: its test could not be set up, so it is refused.
+    csv.conditions = {{"plate_diam", "0.04"}};
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      Catch::StartsWith("--condition plate_diam=0.04: 'plate_diam' is not a "
+                                        "condition of plate_sinkage (misspelt?") &&
+                          Catch::Contains("plate_diameter_m, gravity_m_s2, bed_depth_m"));
+    // With the size given, an unknown one is kept, but said.
+    csv.conditions = {{"plate_diameter_m", "0.04"}, {"gravty_m_s2", "1.62"}, {"box", "large"}};
+    const auto warnings = importCsv(csv, out.string());
+    REQUIRE(warnings.size() == 1);
+    CHECK_THAT(warnings[0], Catch::StartsWith("--condition gravty_m_s2=1.62: 'gravty_m_s2' is "
+                                              "not a condition of plate_sinkage (misspelt?"));
+    CHECK(loadExperiments(out.string()).find("p40").numbers.at("plate_diameter_m") == 0.04);
+}
+
+TEST_CASE("import csv reads another code's z-up output: skipped lines, scales and a zero",
+          "[gap][import]") {
+    const fs::path out = scratch("csv-zup");
+    // A title line, z up: the plate goes down (z < 0) and the soil pushes it up, its force on
+    // the soil negative.
+    CsvImport csv;
+    csv.files = {writeInput("zup", "LIGGGHTS plate run 1\nstep,z_m,fz_N\n0,0.0,0\n"
+                                   "1,-0.001,-2\n2,-0.002,-5\n")};
+    csv.id = "lig";
+    csv.type = "plate_sinkage";
+    csv.x_column = "z_m";
+    csv.x_unit = "m";
+    csv.y["force_N"] = {"fz_N", "N"};
+    csv.conditions = {{"plate_diameter_m", "0.02"}};
+    CHECK_THROWS_WITH(importCsv(csv, out.string()), Catch::Contains("--skip-lines"));
+    csv.skip_lines = 1;
+    CHECK_THROWS(importCsv(csv, out.string())); // the other sign: refused
+    csv.x_scale = -1.0;
+    csv.y_scale["force_N"] = -1.0;
+    csv.zero_method = "force_threshold";
+    csv.zero_threshold = 1.0;
+    csv.zero_unit = "N";
+    CsvImport bad_scale = csv;
+    bad_scale.y_scale = {{"pressure_Pa", -1.0}};
+    CHECK_THROWS_WITH(importCsv(bad_scale, out.string()),
+                      Catch::StartsWith("--y-scale pressure_Pa=-1: no --y pressure_Pa"));
+    CsvImport bad_zero = csv;
+    bad_zero.zero_unit = "mm";
+    CHECK_THROWS_WITH(importCsv(bad_zero, out.string()),
+                      Catch::StartsWith("--zero force_threshold=1:mm: ") &&
+                          Catch::Contains("not a force"));
+    importCsv(csv, out.string());
+    const ExperimentSet set = loadExperiments(out.string());
+    const Experiment &e = set.find("lig");
+    const double area = M_PI * 0.01 * 0.01;
+    CHECK(e.zero.method == ZeroConvention::Method::ForceThreshold);
+    CHECK(e.zero.threshold == Approx(1.0 / area));
+    // 2 N (the first force over 1 N) at 1 mm down is the zero: 5 N at 1 mm below it.
+    const Curve c = applyZero(e.trials[0].curves.at("pressure_Pa"), e.zero);
+    CHECK(c.x.back() == Approx(0.001));
+    CHECK(c.y.back() == Approx(5.0 / area));
+}
+
+TEST_CASE("import csv says a column that varies within a scatter, and --filter takes one value",
+          "[gap][import]") {
+    const fs::path out = scratch("csv-filter");
+    // Two slip angles in one file, the side force following the angle, a run counter.
+    std::string text = "run,beta_deg,slip,dp_N,fy_N\n";
+    for (int r = 0; r < 8; ++r)
+        text += std::to_string(r + 1) + "," + (r < 4 ? "0" : "15") + ",0." + std::to_string(r + 1) +
+                "," + std::to_string(r) + "," + (r < 4 ? "0" : "-0.75") + "\n";
+    CsvImport csv;
+    csv.files = {writeInput("filter", text)};
+    csv.id = "w";
+    csv.type = "wheel_steady_state";
+    csv.x_column = "slip";
+    csv.x_unit = "-";
+    csv.y["drawbar_pull_N"] = {"dp_N", "N"};
+    csv.scatter = true;
+    const auto merged = importCsv(csv, out.string());
+    REQUIRE(merged.size() == 1); // not the run counter, nor fy_N, which follows beta_deg
+    CHECK_THAT(merged[0], Catch::Contains("column 'beta_deg' takes 2 values (0, 15)") &&
+                              Catch::Contains("--filter beta_deg=0"));
+    csv.id = "w15";
+    csv.filter = {{"beta_deg", 15.0}};
+    csv.conditions = {{"slip_angle_deg", "15"}};
+    CHECK(importCsv(csv, out.string()).empty());
+    const ExperimentSet set = loadExperiments(out.string());
+    const Experiment &e = set.find("w15");
+    REQUIRE(e.trials.size() == 4);
+    CHECK(e.trials[0].curves.at("drawbar_pull_N").y[0] == 4.0); // run 5, the first at 15 deg
+    csv.id = "w30";
+    csv.filter = {{"beta_deg", 30.0}};
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      "--filter beta_deg=30: no row of " + csv.files[0] + " holds it");
+}

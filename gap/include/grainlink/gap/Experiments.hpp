@@ -27,6 +27,10 @@ std::vector<ExperimentType> experimentTypes();
 ExperimentType parseType(const std::string &name); ///< throws std::invalid_argument
 /// The observables an experiment of `type` may hold (SI names, e.g. "pressure_Pa").
 const std::vector<std::string> &observablesOf(ExperimentType type);
+/// "'pressure' is not an observable of plate_sinkage (its observables: pressure_Pa,
+/// force_N)": every name an experiment of that type may give under data.y (a plate's force
+/// among them), for the importer and experiments.yaml's reader alike.
+std::string notAnObservable(const std::string &name, ExperimentType type);
 /// The SI name of its x ("sinkage_m", "slip"); "" for a scalar.
 const char *xNameOf(ExperimentType type);
 

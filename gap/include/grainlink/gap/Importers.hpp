@@ -37,7 +37,22 @@ struct CsvImport {
     std::string comment = "#";   ///< lines starting with it are skipped
     std::vector<std::string> columns; ///< the names of a file without a header line
     bool units_row = false;           ///< the line under the header holds units
+    int skip_lines = 0;               ///< lines before the header (a title), skipped
+    /// Multiply a column as read (-1: another code's z up); experiments.yaml's `scale:`.
+    double x_scale = 1.0;
+    std::map<std::string, double> y_scale; ///< observable -> its column's scale
+    /// Only the rows holding these values (column -> value): one experiment of a file that
+    /// holds several (a wheel's slip angles). The copy keeps just those rows.
+    std::map<std::string, double> filter;
+    /// experiments.yaml's `zero:`: "" (none written: as_recorded), "as_recorded",
+    /// "first_sample" or "force_threshold" with its threshold in `zero_unit`.
+    std::string zero_method;
+    double zero_threshold = 0.0;
+    std::string zero_unit;
 };
-void importCsv(const CsvImport &csv, const std::string &out);
+/// Returns warnings to show the user (a column that varies within the experiment, a condition
+/// the simulation does not read); errors name the option or the input file, never the folder
+/// being written.
+std::vector<std::string> importCsv(const CsvImport &csv, const std::string &out);
 
 } // namespace grainlink::gap
