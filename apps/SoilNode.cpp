@@ -101,11 +101,18 @@ public:
                                                2.0 * scenario_.deposition.radius.largest())
                                  .c_str(),
                              1000.0 * (lowestPoint(b) - surface_));
-            if (in.window == 0 && !resumed_ && lowestPoint(b) < surface_)
-                throw coupling::CouplingError("body '" + options_.bodies[b] + "' starts " +
-                                              std::to_string(1000.0 * (surface_ - lowestPoint(b))) +
-                                              " mm inside the settled bed (surface at z = " +
-                                              std::to_string(surface_) + " m): start it higher");
+            if (in.window == 0 && !resumed_ && scenario_.bury_bodies) {
+                // Placed in the ground before the test: the grains where it stands go.
+                const std::size_t gone = dem::bury(*sys_, int(b));
+                std::fprintf(stderr, "[%s] body '%s' buried: %zu grains in its place removed\n",
+                             options_.name.c_str(), options_.bodies[b].c_str(), gone);
+            }
+            if (in.window == 0 && !resumed_ && lowestPoint(b) < surface_ && !scenario_.bury_bodies)
+                throw coupling::CouplingError(
+                    "body '" + options_.bodies[b] + "' starts " +
+                    std::to_string(1000.0 * (surface_ - lowestPoint(b))) +
+                    " mm inside the settled bed (surface at z = " + std::to_string(surface_) +
+                    " m): start it higher, or bury it (soil.bury_bodies: true)");
             if (in.window == 0 && !resumed_)
                 refuseStartingOverlap(b);
         }

@@ -236,6 +236,24 @@ std::size_t strikeOff(DemSystem &system, double height_m) {
     return removed;
 }
 
+std::size_t bury(DemSystem &system, int body) {
+    const ParticleStore &p = system.particles();
+    const MeshBody &b = system.body(body);
+    const std::vector<std::size_t> gone =
+        grainsInMesh(p.position, p.radius, b.worldVertices(), b.mesh());
+    if (gone.empty())
+        return 0;
+    std::vector<std::size_t> kept;
+    kept.reserve(p.size() - gone.size());
+    for (std::size_t i = 0, g = 0; i < p.size(); ++i)
+        if (g < gone.size() && gone[g] == i)
+            ++g;
+        else
+            kept.push_back(i);
+    keepParticles(system, kept);
+    return gone.size();
+}
+
 CompactionReport compact(DemSystem &system, const CompactionSpec &spec, const Vec3 &lower_m,
                          const Vec3 &upper_m) {
     spec.validate();

@@ -490,6 +490,10 @@ DemScenario parseScenario(const ConfigNode &root, bool coupled) {
             root.number("wall_clearance_m", 2.0 * s.deposition.radius.largest());
         if (!(s.wall_clearance_m >= 0.0))
             root["wall_clearance_m"].fail("must be >= 0 (0: no check)");
+        s.bury_bodies = root.boolean("bury_bodies", false);
+    } else if (root.has("bury_bodies")) {
+        root["bury_bodies"].fail("only a coupled soil (grainlink dem-node) has bodies to bury: "
+                                 "remove the key");
     } else if (root.has("wall_clearance_m")) {
         root["wall_clearance_m"].fail("only a coupled soil (grainlink dem-node) watches its bodies' "
                                       "clearance to the walls: remove the key");

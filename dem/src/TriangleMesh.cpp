@@ -235,6 +235,58 @@ void writeStlBinary(const TriangleMesh &mesh, const std::string &path) {
     }
 }
 
+namespace {
+/// Whether a ray from p along `direction` crosses triangle (a, b, c) (Moeller-Trumbore).
+bool rayCrosses(const Vec3 &p, const Vec3 &direction, const Vec3 &a, const Vec3 &b, const Vec3 &c) {
+    const Vec3 e1 = b - a, e2 = c - a, h = direction.cross(e2);
+    const double det = e1.dot(h);
+    if (std::abs(det) < 1e-300)
+        return false; // parallel
+    const Vec3 s = p - a;
+    const double u = s.dot(h) / det;
+    if (u < 0.0 || u > 1.0)
+        return false;
+    const Vec3 q = s.cross(e1);
+    const double v = direction.dot(q) / det;
+    return v >= 0.0 && u + v <= 1.0 && e2.dot(q) / det > 0.0;
+}
+} // namespace
+
+std::vector<std::size_t> grainsInMesh(const std::vector<Vec3> &centres_m,
+                                      const std::vector<double> &radii_m,
+                                      const std::vector<Vec3> &world_vertices_m,
+                                      const TriangleMesh &mesh) {
+    std::vector<std::size_t> in;
+    if (world_vertices_m.empty())
+        return in;
+    Vec3 lo = world_vertices_m.front(), hi = lo;
+    for (const Vec3 &v : world_vertices_m) {
+        lo = lo.cwiseMin(v);
+        hi = hi.cwiseMax(v);
+    }
+    // A direction no facet of a parametric body lies along, so that a ray meets no edge
+    // exactly.
+    const Vec3 direction = Vec3(0.1234, 0.3141, 0.9412).normalized();
+    for (std::size_t i = 0; i < centres_m.size(); ++i) {
+        const Vec3 &x = centres_m[i];
+        const double r = radii_m[i];
+        if ((x.array() < lo.array() - r).any() || (x.array() > hi.array() + r).any())
+            continue;
+        bool touches = false;
+        int crossings = 0;
+        for (const auto &t : mesh.triangles) {
+            const Vec3 &a = world_vertices_m[std::size_t(t[0])],
+                       &b = world_vertices_m[std::size_t(t[1])],
+                       &c = world_vertices_m[std::size_t(t[2])];
+            touches = touches || (closestPointOnTriangle(x, a, b, c) - x).squaredNorm() < r * r;
+            crossings += rayCrosses(x, direction, a, b, c);
+        }
+        if (touches || crossings % 2 == 1)
+            in.push_back(i);
+    }
+    return in;
+}
+
 GrainOverlap deepestGrainOverlap(const std::vector<Vec3> &centres_m,
                                  const std::vector<double> &radii_m,
                                  const std::vector<Vec3> &world_vertices_m,

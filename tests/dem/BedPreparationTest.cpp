@@ -3,6 +3,8 @@
 
 #include "grainlink/dem/Deposition.hpp"
 #include "grainlink/dem/ScenarioRun.hpp"
+#include "grainlink/dem/TriangleMesh.hpp"
+#include "grainlink/dem/Walls.hpp"
 
 #include <catch2/catch.hpp>
 
@@ -373,4 +375,50 @@ TEST_CASE("a body placed cutting the highest grain is refused naming the grain a
     above.position_m = p.position[top] + Vec3(0.0, 0.0, r + 0.001);
     sys->addBody(MeshBody("above", makeRectangle(0.001, 0.001, 1, 1), above));
     CHECK(startingOverlapError(*sys, 1, 0.4).empty());
+}
+
+TEST_CASE("bury: a body placed in the bed removes exactly the grains it touches or holds, and no "
+          "other",
+          "[dem][preparation]") {
+    auto sys = copyOfSettledBed();
+    const std::vector<Vec3> before = sys->particles().position;
+    const std::vector<double> radii = sys->particles().radius;
+    // A closed cylinder of radius 6 mm and width 20 mm about y, its axis 15 mm above the floor
+    // (the bed is about 34 mm deep): well inside the grains.
+    const double R = 0.006, w = 0.02;
+    const Vec3 axis(0.02, 0.02, 0.015);
+    RigidBodyState at;
+    at.position_m = axis;
+    const int body = sys->addBody(MeshBody("tool", makeCylinder(R, w, 256), at));
+    // Reference: a grain goes where its centre lies within its radius of the solid cylinder
+    // (distance by hand: radial and axial excess). The 256-gon lies within R (1 - cos(pi/256))
+    // = 0.5 um of the circle: grains within 5 um of touching are left out of the comparison.
+    std::size_t expected = 0, borderline = 0;
+    std::vector<bool> goes(before.size());
+    for (std::size_t i = 0; i < before.size(); ++i) {
+        const Vec3 d = before[i] - axis;
+        const double radial = std::hypot(d.x(), d.z()) - R, axial = std::abs(d.y()) - 0.5 * w;
+        const double distance = std::hypot(std::max(0.0, radial), std::max(0.0, axial)); // 0 inside
+        goes[i] = distance < radii[i];
+        expected += goes[i];
+        borderline += std::abs(distance - radii[i]) < 5e-6;
+    }
+    REQUIRE(borderline == 0);
+    REQUIRE(expected > 10);
+    const std::size_t gone = bury(*sys, body);
+    CHECK(gone == expected);
+    CHECK(sys->particles().size() == before.size() - expected);
+    // Those left are the others, where they were, and none touches the body.
+    std::vector<Vec3> kept;
+    for (std::size_t i = 0; i < before.size(); ++i)
+        if (!goes[i])
+            kept.push_back(before[i]);
+    CHECK(sys->particles().position == kept);
+    const MeshBody &b = sys->body(body);
+    CHECK(deepestGrainOverlap(sys->particles().position, sys->particles().radius, b.worldVertices(),
+                              b.mesh())
+              .ratio == 0.0);
+    // The bed steps on from there (histories kept for the grains left).
+    sys->run(20);
+    CHECK(sys->particles().size() == before.size() - expected);
 }

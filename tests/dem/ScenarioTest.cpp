@@ -196,7 +196,7 @@ TEST_CASE("a mesh whose size cannot fit the grains is refused", "[dem][scenario]
           "0.05, 0.2) m, 15 grain diameters across");
 }
 
-TEST_CASE("wall clearance is a coupled soil's key", "[dem][scenario]") {
+TEST_CASE("wall clearance and burying the bodies are a coupled soil's keys", "[dem][scenario]") {
     // A coupled soil watches its bodies' distance to the walls: one largest grain diameter by
     // default (tiny.yaml: 2 x 5 mm), or what the key says; `grainlink dem` refuses the key.
     const std::string coupled = replaced(kValid, "run: {duration_s: 0.1}\n", "");
@@ -208,6 +208,13 @@ TEST_CASE("wall clearance is a coupled soil's key", "[dem][scenario]") {
     CHECK(errorOf(kValid + "wall_clearance_m: 0.03\n") ==
           "bad.yaml:16: key 'wall_clearance_m': only a coupled soil (grainlink dem-node) watches "
           "its bodies' clearance to the walls: remove the key");
+    // Burying the bodies likewise: off by default, a coupled soil's alone.
+    CHECK_FALSE(parseScenario(ConfigNode::loadString(coupled, "c.yaml"), true).bury_bodies);
+    CHECK(parseScenario(ConfigNode::loadString(coupled + "bury_bodies: true\n", "c.yaml"), true)
+              .bury_bodies);
+    CHECK(errorOf(kValid + "bury_bodies: true\n") ==
+          "bad.yaml:16: key 'bury_bodies': only a coupled soil (grainlink dem-node) has bodies to "
+          "bury: remove the key");
 }
 
 TEST_CASE("thread count: --threads beats the scenario beats OMP_NUM_THREADS", "[dem][scenario]") {

@@ -47,6 +47,11 @@ double packingFraction(const ParticleStore &particles, double footprint_area_m2)
 /// went; throws if none would be left. Does not settle.
 std::size_t strikeOff(DemSystem &system, double height_m);
 
+/// Buries mesh body `body` where it is placed: removes every grain it touches or holds
+/// (grainsInMesh), keeping the others' contact histories, as a tool pushed in before the test
+/// leaves the grains around it. Returns how many went. Does not settle.
+std::size_t bury(DemSystem &system, int body);
+
 struct CompactionReport {
     double target_force_N = 0.0; ///< [N] pressure x footprint area
     double hold_force_N = 0.0;   ///< [N] plate's mean reaction over the second half of the hold

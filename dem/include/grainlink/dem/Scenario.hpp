@@ -63,6 +63,10 @@ struct DemScenario {
     /// [m] coupled soil (`wall_clearance_m`): the run stops when a body comes this close to a
     /// wall; by default one largest grain diameter. Unused by `grainlink dem`.
     double wall_clearance_m = 0.0;
+    /// Coupled soil (`bury_bodies`): bodies that start inside the bed remove the grains they
+    /// touch or hold (a mole or an anchor placed in the ground before the test) instead of
+    /// being refused.
+    bool bury_bodies = false;
 };
 
 /// Bounds on the counts a scenario may ask for: a typo or a wrapped negative stops at its key

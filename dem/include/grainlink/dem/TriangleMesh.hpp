@@ -54,6 +54,14 @@ GrainOverlap deepestGrainOverlap(const std::vector<Vec3> &centres_m,
                                  const std::vector<Vec3> &world_vertices_m,
                                  const TriangleMesh &mesh);
 
+/// The grains a placed closed mesh (vertices in the world frame) touches or holds: every grain
+/// whose centre lies within its radius of the surface, or inside it (an odd number of the
+/// surface's crossings on a ray from the centre). Ascending indices.
+std::vector<std::size_t> grainsInMesh(const std::vector<Vec3> &centres_m,
+                                      const std::vector<double> &radii_m,
+                                      const std::vector<Vec3> &world_vertices_m,
+                                      const TriangleMesh &mesh);
+
 /// The most facets around a parametric body (wheel, plate, ring, tube) a scenario may ask for:
 /// far beyond any grain-resolved need, and small enough that a typo cannot exhaust memory.
 constexpr int kMaxMeshSegments = 100000;
