@@ -2,6 +2,7 @@
 // library; this is its command line.
 #include "GapCommand.hpp"
 
+#include "grainlink/config/Number.hpp"
 #include "grainlink/gap/Importers.hpp"
 #include "grainlink/gap/Report.hpp"
 #include "grainlink/gap/Selftest.hpp"
@@ -430,11 +431,9 @@ int GapCommand::importCsv() const {
     csv.skip_lines = csv_skip_lines_;
     csv.x_scale = csv_x_scale_;
     const auto numberOf = [](const std::string &option, const std::string &text) {
-        char *end = nullptr;
-        const double v = std::strtod(text.c_str(), &end);
-        if (text.empty() || end != text.c_str() + text.size())
-            throw std::invalid_argument(option + ": '" + text + "' is not a number");
-        return v;
+        if (const auto v = config::wholeNumber(text))
+            return *v;
+        throw std::invalid_argument(option + ": '" + text + "' is not a number");
     };
     for (const std::string &s : csv_y_scale_) {
         const auto [obs, factor] = split(s, '=');

@@ -106,8 +106,7 @@ public:
                 const std::size_t gone = dem::bury(*sys_, int(b));
                 std::fprintf(stderr, "[%s] body '%s' buried: %zu grains in its place removed\n",
                              options_.name.c_str(), options_.bodies[b].c_str(), gone);
-            }
-            if (in.window == 0 && !resumed_ && lowestPoint(b) < surface_ && !scenario_.bury_bodies)
+            } else if (in.window == 0 && !resumed_ && lowestPoint(b) < surface_)
                 throw coupling::CouplingError(
                     "body '" + options_.bodies[b] + "' starts " +
                     std::to_string(1000.0 * (surface_ - lowestPoint(b))) +

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <sstream>
 #include <stdexcept>
@@ -236,6 +237,32 @@ void writeStlBinary(const TriangleMesh &mesh, const std::string &path) {
 }
 
 namespace {
+/// The placed mesh's axis-aligned box, and whether a grain at x of radius r lies beyond it.
+struct Box {
+    Vec3 lo, hi;
+    explicit Box(const std::vector<Vec3> &vertices) : lo(vertices.front()), hi(lo) {
+        for (const Vec3 &v : vertices) {
+            lo = lo.cwiseMin(v);
+            hi = hi.cwiseMax(v);
+        }
+    }
+    bool outOfReach(const Vec3 &x, double r) const {
+        return (x.array() < lo.array() - r).any() || (x.array() > hi.array() + r).any();
+    }
+};
+
+/// The squared distance from x to the placed mesh's surface.
+double squaredDistance(const Vec3 &x, const std::vector<Vec3> &vertices, const TriangleMesh &mesh) {
+    double d2 = std::numeric_limits<double>::infinity();
+    for (const auto &t : mesh.triangles)
+        d2 = std::min(
+            d2, (closestPointOnTriangle(x, vertices[std::size_t(t[0])], vertices[std::size_t(t[1])],
+                                        vertices[std::size_t(t[2])]) -
+                 x)
+                    .squaredNorm());
+    return d2;
+}
+
 /// Whether a ray from p along `direction` crosses triangle (a, b, c) (Moeller-Trumbore).
 bool rayCrosses(const Vec3 &p, const Vec3 &direction, const Vec3 &a, const Vec3 &b, const Vec3 &c) {
     const Vec3 e1 = b - a, e2 = c - a, h = direction.cross(e2);
@@ -259,29 +286,25 @@ std::vector<std::size_t> grainsInMesh(const std::vector<Vec3> &centres_m,
     std::vector<std::size_t> in;
     if (world_vertices_m.empty())
         return in;
-    Vec3 lo = world_vertices_m.front(), hi = lo;
-    for (const Vec3 &v : world_vertices_m) {
-        lo = lo.cwiseMin(v);
-        hi = hi.cwiseMax(v);
-    }
+    const Box box(world_vertices_m);
     // A direction no facet of a parametric body lies along, so that a ray meets no edge
     // exactly.
     const Vec3 direction = Vec3(0.1234, 0.3141, 0.9412).normalized();
     for (std::size_t i = 0; i < centres_m.size(); ++i) {
         const Vec3 &x = centres_m[i];
         const double r = radii_m[i];
-        if ((x.array() < lo.array() - r).any() || (x.array() > hi.array() + r).any())
+        if (box.outOfReach(x, r))
             continue;
-        bool touches = false;
-        int crossings = 0;
-        for (const auto &t : mesh.triangles) {
-            const Vec3 &a = world_vertices_m[std::size_t(t[0])],
-                       &b = world_vertices_m[std::size_t(t[1])],
-                       &c = world_vertices_m[std::size_t(t[2])];
-            touches = touches || (closestPointOnTriangle(x, a, b, c) - x).squaredNorm() < r * r;
-            crossings += rayCrosses(x, direction, a, b, c);
+        if (squaredDistance(x, world_vertices_m, mesh) < r * r) {
+            in.push_back(i);
+            continue;
         }
-        if (touches || crossings % 2 == 1)
+        int crossings = 0;
+        for (const auto &t : mesh.triangles)
+            crossings += rayCrosses(x, direction, world_vertices_m[std::size_t(t[0])],
+                                    world_vertices_m[std::size_t(t[1])],
+                                    world_vertices_m[std::size_t(t[2])]);
+        if (crossings % 2 == 1)
             in.push_back(i);
     }
     return in;
@@ -294,23 +317,13 @@ GrainOverlap deepestGrainOverlap(const std::vector<Vec3> &centres_m,
     GrainOverlap deepest;
     if (world_vertices_m.empty())
         return deepest;
-    Vec3 lo = world_vertices_m.front(), hi = lo;
-    for (const Vec3 &v : world_vertices_m) {
-        lo = lo.cwiseMin(v);
-        hi = hi.cwiseMax(v);
-    }
+    const Box box(world_vertices_m);
     for (std::size_t i = 0; i < centres_m.size(); ++i) {
         const Vec3 &x = centres_m[i];
         const double r = radii_m[i];
-        if ((x.array() < lo.array() - r).any() || (x.array() > hi.array() + r).any())
+        if (box.outOfReach(x, r))
             continue; // cannot reach the mesh
-        double d2 = r * r;
-        for (const auto &t : mesh.triangles) {
-            const Vec3 q = closestPointOnTriangle(x, world_vertices_m[std::size_t(t[0])],
-                                                  world_vertices_m[std::size_t(t[1])],
-                                                  world_vertices_m[std::size_t(t[2])]);
-            d2 = std::min(d2, (q - x).squaredNorm());
-        }
+        const double d2 = std::min(r * r, squaredDistance(x, world_vertices_m, mesh));
         const double ratio = (r - std::sqrt(d2)) / r;
         if (ratio > deepest.ratio)
             deepest = {i, ratio};

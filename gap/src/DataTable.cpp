@@ -1,5 +1,7 @@
 #include "DataTable.hpp"
 
+#include "grainlink/config/Number.hpp"
+
 #include "grainlink/config/ConfigNode.hpp"
 
 #include <algorithm>
@@ -64,11 +66,8 @@ char otherDelimiter(const DataTable &t) {
 /// a comment line.
 bool numericHeader(const DataTable &t) {
     return !t.header_given &&
-           std::all_of(t.header.begin(), t.header.end(), [&](const std::string &h) {
-               char *end = nullptr;
-               std::strtod(h.c_str(), &end);
-               return !h.empty() && end == h.c_str() + h.size();
-           });
+           std::all_of(t.header.begin(), t.header.end(),
+                       [](const std::string &h) { return config::wholeNumber(h).has_value(); });
 }
 
 } // namespace

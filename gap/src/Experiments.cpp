@@ -327,11 +327,24 @@ std::vector<ExperimentType> experimentTypes() {
 
 const std::vector<std::string> &observablesOf(ExperimentType type) { return info(type).observables; }
 
-std::string notAnObservable(const std::string &name, ExperimentType type) {
+namespace {
+/// The names data.y takes: the type's observables, and a plate's force, read as its pressure
+/// (given with conditions.plate_diameter_m).
+std::vector<std::string> observableNames(ExperimentType type) {
     std::vector<std::string> names = observablesOf(type);
-    // A plate's force is read as its pressure (given with conditions.plate_diameter_m).
     if (type == ExperimentType::PlateSinkage)
         names.push_back("force_N");
+    return names;
+}
+} // namespace
+
+bool isObservableOf(const std::string &name, ExperimentType type) {
+    const std::vector<std::string> names = observableNames(type);
+    return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+std::string notAnObservable(const std::string &name, ExperimentType type) {
+    const std::vector<std::string> names = observableNames(type);
     std::string list;
     for (const auto &n : names)
         list += (list.empty() ? "" : ", ") + n;
@@ -607,11 +620,8 @@ ExperimentSet loadExperiments(const std::string &directory) {
                 plate_area = M_PI * d->second * d->second / 4.0;
             }
             for (const auto &o : obs_names)
-                if (std::find(ti.observables.begin(), ti.observables.end(), o) ==
-                        ti.observables.end() &&
-                    !(o == "force_N" && plate_area > 0.0)) {
+                if (!isObservableOf(o, e.type) || (o == "force_N" && !(plate_area > 0.0)))
                     y[o].fail(notAnObservable(o, e.type));
-                }
             if (obs_names.empty())
                 y.fail("name at least one observable");
             e.observables = obs_names;

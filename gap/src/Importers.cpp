@@ -6,6 +6,7 @@
 #include "DataTable.hpp"
 
 #include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/config/Number.hpp"
 
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
@@ -339,15 +340,11 @@ std::string withImportOptions(std::string message) {
 }
 
 std::string numberText(double v) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.6g", v);
-    return text;
+    return config::significant(v, 6);
 }
 
 bool isNumberText(const std::string &text) {
-    char *end = nullptr;
-    std::strtod(text.c_str(), &end);
-    return !text.empty() && end == text.c_str() + text.size();
+    return config::wholeNumber(text).has_value();
 }
 
 std::string xOption(const CsvImport &csv) {
@@ -438,12 +435,9 @@ std::vector<std::string> checkConditions(const CsvImport &csv, ExperimentType ty
 /// scales, the zero convention and the conditions. Said by the option, before anything is read
 /// or written. Returns the conditions' warnings.
 std::vector<std::string> checkOptions(const CsvImport &csv, ExperimentType type, bool scalar) {
-    const auto &observables = observablesOf(type);
     for (const auto &[obs, col] : csv.y)
-        if (std::find(observables.begin(), observables.end(), obs) == observables.end() &&
-            !(obs == "force_N" && type == ExperimentType::PlateSinkage))
-            throw std::invalid_argument(yOption(csv, obs) + ": " +
-                                        notAnObservable(obs, parseType(csv.type)));
+        if (!isObservableOf(obs, type))
+            throw std::invalid_argument(yOption(csv, obs) + ": " + notAnObservable(obs, type));
     const auto checkUnit = [](const std::string &option, const std::string &unit,
                               const std::string &dimension) {
         try {

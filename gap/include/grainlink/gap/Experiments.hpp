@@ -31,6 +31,9 @@ const std::vector<std::string> &observablesOf(ExperimentType type);
 /// force_N)": every name an experiment of that type may give under data.y (a plate's force
 /// among them), for the importer and experiments.yaml's reader alike.
 std::string notAnObservable(const std::string &name, ExperimentType type);
+/// Whether an experiment of that type may give `name` under data.y (a plate's force among
+/// them): what notAnObservable lists.
+bool isObservableOf(const std::string &name, ExperimentType type);
 /// The SI name of its x ("sinkage_m", "slip"); "" for a scalar.
 const char *xNameOf(ExperimentType type);
 
