@@ -27,19 +27,50 @@ struct TypeInfo {
     const char *name;
     const char *x_name; ///< SI name of x; "" for a scalar
     std::vector<std::string> observables;
+    ConditionNames conditions;
 };
 
 const std::vector<TypeInfo> &types() {
+    // Gravity's magnitude makes every test's soil, and a bed's depth every test whose bed is the
+    // soil's deposition (the shear box is the direct shear test's own, its depth too).
     static const std::vector<TypeInfo> t{
-        {ExperimentType::PlateSinkage, "plate_sinkage", "sinkage_m", {"pressure_Pa"}},
-        {ExperimentType::BevameterShear, "bevameter_shear", "shear_displacement_m",
-         {"shear_stress_Pa"}},
-        {ExperimentType::DirectShear, "direct_shear", "shear_displacement_m", {"shear_stress_Pa"}},
-        {ExperimentType::AngleOfRepose, "angle_of_repose", "", {"angle_deg"}},
-        {ExperimentType::WheelSteadyState, "wheel_steady_state", "slip",
+        {ExperimentType::PlateSinkage,
+         "plate_sinkage",
+         "sinkage_m",
+         {"pressure_Pa"},
+         {{"plate_diameter_m", "gravity_m_s2", "bed_depth_m"},
+          "plate_diameter_m",
+          {{"plate_radius_m", "plate_diameter_m", 2.0}}}},
+        {ExperimentType::BevameterShear,
+         "bevameter_shear",
+         "shear_displacement_m",
+         {"shear_stress_Pa"},
+         {{"normal_pressure_Pa", "gravity_m_s2", "bed_depth_m"}, "normal_pressure_Pa", {}}},
+        {ExperimentType::DirectShear,
+         "direct_shear",
+         "shear_displacement_m",
+         {"shear_stress_Pa"},
+         {{"normal_stress_Pa", "gravity_m_s2"}, "normal_stress_Pa", {}}},
+        {ExperimentType::AngleOfRepose,
+         "angle_of_repose",
+         "",
+         {"angle_deg"},
+         {{"gravity_m_s2"}, "", {}}},
+        {ExperimentType::WheelSteadyState,
+         "wheel_steady_state",
+         "slip",
          {"traction_N", "drawbar_pull_N", "vertical_load_N", "side_force_N", "sinkage_m",
-          "torque_N_m"}},
-        {ExperimentType::Mole, "mole", "stroke", {"depth_m"}},
+          "torque_N_m"},
+         // One test per geometry, load and slope, one slip per run.
+         {{"wheel_radius_m", "wheel_width_m", "grouser_count", "grouser_height_m", "load_N",
+           "slip_angle_deg", "slope_deg", "gravity_m_s2", "bed_depth_m"},
+          "",
+          {{"wheel_diameter_m", "wheel_radius_m", 0.5}}}},
+        {ExperimentType::Mole,
+         "mole",
+         "stroke",
+         {"depth_m"},
+         {{"gravity_m_s2", "bed_depth_m"}, "", {}}},
     };
     return t;
 }
@@ -137,12 +168,6 @@ bool isToolOrBedSize(const std::string &key) {
             return true;
     return false;
 }
-
-/// Conditions under another size's name: (that name, grainlink's, the factor to it).
-constexpr std::tuple<const char *, const char *, double> kOtherSizeNames[] = {
-    {"plate_radius_m", "plate_diameter_m", 2.0},
-    {"wheel_diameter_m", "wheel_radius_m", 0.5},
-};
 
 /// Suffix -> dimension of grainlink's SI names (`plate_diameter_m`, `normal_stress_Pa`).
 const std::vector<std::pair<std::string, std::string>> &suffixes() {
@@ -326,6 +351,15 @@ std::vector<ExperimentType> experimentTypes() {
 }
 
 const std::vector<std::string> &observablesOf(ExperimentType type) { return info(type).observables; }
+
+const ConditionNames &conditionsOf(ExperimentType type) {
+    return info(type).conditions;
+}
+
+const std::vector<std::string> &describingConditions() {
+    static const std::vector<std::string> d{"speed_m_s", "box", "preparation"};
+    return d;
+}
 
 namespace {
 /// The names data.y takes: the type's observables, and a plate's force, read as its pressure
@@ -553,7 +587,7 @@ ExperimentSet loadExperiments(const std::string &directory) {
             }
             // A radius where grainlink takes a diameter, or the other way round: read as the
             // condition it is, so the test is not set up from the base's size in its place.
-            for (const auto &[other, name, factor] : kOtherSizeNames) {
+            for (const auto &[other, name, factor] : conditionsOf(e.type).aliases) {
                 const auto given = e.numbers.find(other);
                 if (given == e.numbers.end())
                     continue;

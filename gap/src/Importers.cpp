@@ -1,7 +1,6 @@
 #include "grainlink/gap/Importers.hpp"
 
 #include "grainlink/gap/Experiments.hpp"
-#include "grainlink/gap/StudySimulator.hpp"
 
 #include "DataTable.hpp"
 
@@ -363,40 +362,24 @@ std::string zeroOption(const CsvImport &csv) {
                 : std::string());
 }
 
-/// The condition that sets a type's test up, without which it cannot run (a plate's size, a
-/// shear box's load); "" where the base's own values stand in for every missing one.
-std::string neededCondition(ExperimentType type) {
-    switch (type) {
-    case ExperimentType::PlateSinkage:
-        return "plate_diameter_m";
-    case ExperimentType::DirectShear:
-        return "normal_stress_Pa";
-    case ExperimentType::BevameterShear:
-        return "normal_pressure_Pa";
-    default:
-        return "";
-    }
-}
-
 /// The --condition keys as diagnose reads them: a number under an SI name (not "40mm"), and a
 /// name the type's test knows; an unknown one is refused where it stands in for the condition
 /// the test needs, else returned as a warning (it describes, the simulation does not read it).
 std::vector<std::string> checkConditions(const CsvImport &csv, ExperimentType type) {
-    std::vector<std::string> known = simulatedConditions(type);
-    // Read as the test's own (experiments.yaml reads a radius as its diameter), or describing.
-    if (type == ExperimentType::PlateSinkage)
-        known.push_back("plate_radius_m");
-    if (type == ExperimentType::WheelSteadyState)
-        known.push_back("wheel_diameter_m");
-    for (const char *c : {"speed_m_s", "box", "preparation"})
-        known.push_back(c);
+    const ConditionNames &names = conditionsOf(type);
+    // The test's own, under grainlink's name or another (a radius read as its diameter), or
+    // describing it.
+    std::vector<std::string> known = names.simulated;
+    const std::string &needed = names.per_experiment;
+    bool needed_given = needed.empty() || csv.conditions.count(needed);
+    for (const SizeAlias &a : names.aliases) {
+        known.push_back(a.given);
+        needed_given = needed_given || (a.name == needed && csv.conditions.count(a.given));
+    }
+    known.insert(known.end(), describingConditions().begin(), describingConditions().end());
     std::string list;
     for (const auto &c : known)
         list += (list.empty() ? "" : ", ") + c;
-    const std::string needed = neededCondition(type);
-    const bool needed_given =
-        needed.empty() || csv.conditions.count(needed) ||
-        (type == ExperimentType::PlateSinkage && csv.conditions.count("plate_radius_m"));
     std::vector<std::string> warnings;
     for (const auto &[key, value] : csv.conditions) {
         const std::string option = "--condition " + key + "=" + value;

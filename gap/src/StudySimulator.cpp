@@ -71,33 +71,15 @@ std::string boxOf(const Experiment &e) {
     return it == e.labels.end() ? "" : it->second;
 }
 
-/// The conditions of a wheel experiment that make its test (the wheel, its load, the slope):
-/// wheel experiments that share them run as one test, one slip per run.
-constexpr const char *kWheelConditions[] = {"wheel_radius_m",   "wheel_width_m", "grouser_count",
-                                            "grouser_height_m", "load_N",        "slip_angle_deg",
-                                            "slope_deg"};
-/// The conditions of any experiment that make its soil: its gravity's magnitude and its bed's
-/// depth (read by the tests whose bed is the soil's deposition: plates, shear plates, wheels).
-constexpr const char *kSoilConditions[] = {"gravity_m_s2", "bed_depth_m"};
-
-/// Conditions that describe an experiment without setting up its test: a loading speed, read
-/// by the rate check (addRateCheckWhereSpeedDiffers).
-constexpr const char *kDescribingConditions[] = {"speed_m_s"};
-
-/// What a test is run for besides its type and box: its gravity, a wheel's geometry, load and
-/// slope.
+/// What a test is run for besides its type and box: its gravity, a bed's depth, a wheel's
+/// geometry, load and slope; not what each of its experiments is run at (a plate's size).
 std::string setupOf(const Experiment &e) {
     std::ostringstream key;
     key.precision(12);
-    const auto add = [&](const char *c) {
-        if (const auto it = e.numbers.find(c); it != e.numbers.end())
+    const ConditionNames &names = conditionsOf(e.type);
+    for (const std::string &c : names.simulated)
+        if (const auto it = e.numbers.find(c); it != e.numbers.end() && c != names.per_experiment)
             key << c << '=' << it->second << ';';
-    };
-    for (const char *c : kSoilConditions)
-        add(c);
-    if (e.type == ExperimentType::WheelSteadyState)
-        for (const char *c : kWheelConditions)
-            add(c);
     return key.str();
 }
 
@@ -143,10 +125,10 @@ std::vector<double> conditionValues(const ExperimentSet &set, const std::vector<
         if (it == e.numbers.end()) {
             // A condition it gives that nothing reads is most likely this one misspelt; one that
             // a test of any type reads, or that describes the experiment, is no misspelling.
-            std::set<std::string> known(std::begin(kDescribingConditions),
-                                        std::end(kDescribingConditions));
+            std::set<std::string> known(describingConditions().begin(),
+                                        describingConditions().end());
             for (const ExperimentType t : experimentTypes())
-                for (const std::string &c : simulatedConditions(t))
+                for (const std::string &c : conditionsOf(t).simulated)
                     known.insert(c);
             std::string unread;
             for (const auto &[k, value] : e.numbers)
@@ -221,7 +203,7 @@ void setGravity(YAML::Node soil, const Experiment &e) {
 /// grows with the count, so that the grains go in as sparsely as the base's.
 void setBedDepth(YAML::Node soil, const Experiment &e) {
     const auto it = e.numbers.find("bed_depth_m");
-    const std::vector<std::string> read = simulatedConditions(e.type);
+    const std::vector<std::string> &read = conditionsOf(e.type).simulated;
     if (it == e.numbers.end() || std::find(read.begin(), read.end(), "bed_depth_m") == read.end())
         return;
     constexpr double kDensestPour = 0.64; // random close packing of spheres
@@ -427,30 +409,6 @@ bool close(double a, double b) {
 
 } // namespace
 
-/// The conditions the lab's test of a type is set up from (besides `box`); any other is
-/// described, not simulated.
-std::vector<std::string> simulatedConditions(ExperimentType type) {
-    switch (type) {
-    case ExperimentType::PlateSinkage:
-        return {"plate_diameter_m", "gravity_m_s2", "bed_depth_m"};
-    case ExperimentType::DirectShear: // the shear box is the test's own: its depth too
-        return {"normal_stress_Pa", "gravity_m_s2"};
-    case ExperimentType::BevameterShear:
-        return {"normal_pressure_Pa", "gravity_m_s2", "bed_depth_m"};
-    case ExperimentType::AngleOfRepose:
-        return {"gravity_m_s2"};
-    case ExperimentType::Mole:
-        return {"gravity_m_s2", "bed_depth_m"};
-    case ExperimentType::WheelSteadyState: {
-        std::vector<std::string> c(std::begin(kWheelConditions), std::end(kWheelConditions));
-        c.insert(c.end(), std::begin(kSoilConditions), std::end(kSoilConditions));
-        return c;
-    }
-    default:
-        return {};
-    }
-}
-
 ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                         std::vector<std::string> &left_out) {
     ExperimentSet out = set;
@@ -458,6 +416,7 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     // A condition the simulation does not read is said, once with its experiments:
     // `wheel_load_N` for `load_N` would otherwise leave the base's load in silence.
     std::map<std::string, std::vector<std::string>> unused;
+    std::map<std::string, std::set<ExperimentType>> unused_by;
     std::map<std::pair<std::string, std::string>, std::vector<std::string>> undescribed;
     for (const Experiment &e : set.experiments)
         if (!base.tests.count(typeName(e.type)))
@@ -466,17 +425,19 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
         else if (const std::string why = unsupported(e); !why.empty())
             left_out.push_back(e.id + " (" + typeName(e.type) + ": " + why + ")");
         else {
-            const std::vector<std::string> used = simulatedConditions(e.type);
+            const std::vector<std::string> &used = conditionsOf(e.type).simulated;
             for (const auto &[key, value] : e.conditionText()) {
                 const auto described = base.conditions.find(key);
                 if (key == "box" && !containerOf(e.type)) {
                     unused[key].push_back(e.id); // the test builds its own box
+                    unused_by[key].insert(e.type);
                 } else if (described != base.conditions.end() || key == "box") {
                     // A text condition the base gives soils for: this value among them?
                     if (described == base.conditions.end() || !described->second.count(value))
                         undescribed[{key, value}].push_back(e.id);
                 } else if (std::find(used.begin(), used.end(), key) == used.end()) {
                     unused[key].push_back(e.id);
+                    unused_by[key].insert(e.type);
                 }
             }
             out.experiments.push_back(e);
@@ -488,14 +449,19 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
         return list + (ids.size() > 4 ? ", ..." : "") + " (" + std::to_string(ids.size()) +
                (ids.size() == 1 ? " experiment" : " experiments");
     };
-    for (const auto &[key, ids] : unused)
+    for (const auto &[key, ids] : unused) {
+        std::string read;
+        for (const ExperimentType t : unused_by[key]) {
+            read += std::string("; a ") + typeName(t) + " test is set up from ";
+            for (const std::string &c : conditionsOf(t).simulated)
+                read += c + ", ";
+        }
         out.notes.push_back("condition '" + key +
                             "' is not simulated (the base's own value stands) in " + listed(ids) +
-                            "; the tests are set up from plate_diameter_m, normal_stress_Pa, "
-                            "normal_pressure_Pa, the wheel's radius, width, grouser count and "
-                            "height, load_N, slip_angle_deg, slope_deg, gravity_m_s2, "
-                            "bed_depth_m (plates and wheels), and the text conditions the "
-                            "base's boxes: and conditions: describe)");
+                            read +
+                            "and the text conditions the base's boxes: and conditions: "
+                            "describe)");
+    }
     for (const auto &[condition, ids] : undescribed) {
         const auto &[key, value] = condition;
         out.notes.push_back(key + " '" + value + "' has no soil in " + base.path + " (" +

@@ -237,7 +237,8 @@ TEST_CASE("wheel experiments become the lab's wheel test: one run per slip bin, 
     REQUIRE(said.notes.size() == 1);
     CHECK_THAT(said.notes[0], Catch::Contains("condition 'wheel_load_N' is not simulated") &&
                                   Catch::Contains("in smooth_beta0 (1 experiment") &&
-                                  Catch::Contains("the wheel's radius"));
+                                  Catch::Contains("a wheel_steady_state test is set up from "
+                                                  "wheel_radius_m, wheel_width_m"));
 
     const fs::path scratch = fs::temp_directory_path() / "grainlink-gap-wheel-test";
     fs::remove_all(scratch);

@@ -37,6 +37,29 @@ bool isObservableOf(const std::string &name, ExperimentType type);
 /// The SI name of its x ("sinkage_m", "slip"); "" for a scalar.
 const char *xNameOf(ExperimentType type);
 
+/// A condition given under another size's name, read as grainlink's: `plate_radius_m` as
+/// `plate_diameter_m` (factor 2).
+struct SizeAlias {
+    const char *given, *name;
+    double factor;
+};
+/// The conditions an experiment of a type may give: one table for experiments.yaml's reader,
+/// the CSV importer and the simulation.
+struct ConditionNames {
+    /// What its test is set up from, besides `box`; any other is described, not simulated.
+    std::vector<std::string> simulated;
+    /// The one its test is run at experiment by experiment (a plate's size, a shear box's
+    /// load), without which it cannot run; "" where the base's values stand in for every one.
+    /// The others of `simulated` make its setup: experiments that share them run as one test.
+    std::string per_experiment;
+    std::vector<SizeAlias> aliases;
+};
+const ConditionNames &conditionsOf(ExperimentType type);
+/// Conditions that describe an experiment of any type without setting up its test: its loading
+/// speed (read by the rate check), its box and its bed's preparation (text naming which of the
+/// base's soils it was).
+const std::vector<std::string> &describingConditions();
+
 /// The SI factor of a unit name ("kPa" -> 1000, "mm" -> 0.001, "deg" -> 1); throws naming the
 /// unit when it is unknown or not of `dimension` ("length", "pressure", "force", ...).
 double unitFactor(const std::string &unit, const std::string &dimension);

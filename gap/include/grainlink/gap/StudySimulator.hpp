@@ -41,10 +41,6 @@ BaseModel loadBaseModel(const std::string &path);
 ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                         std::vector<std::string> &left_out);
 
-/// The conditions a type's test is set up from (its table in StudySimulator.cpp): what the
-/// diagnosis and an import check a condition's name against.
-std::vector<std::string> simulatedConditions(ExperimentType type);
-
 /// Where an experiment states its loading speed (`speed_m_s`) and its test is simulated at
 /// another (by more than 10 %), the base's numerical checks get the loading rate check
 /// (`rate`, factor 0.5) when they lack it: the simulated rate is not the measured one, so its
