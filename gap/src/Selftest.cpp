@@ -140,6 +140,24 @@ void scoreTwin(const Diagnosis &d, const Effect *hidden, SelftestTwin &t, Selfte
     }
 }
 
+std::optional<TwinKey> drawUntilMade(const std::function<std::optional<double>(int)> &draw,
+                                     const std::function<TwinKey(std::optional<double>)> &make,
+                                     int tries, std::vector<std::string> &failures) {
+    for (int k = 0; k < tries; ++k) {
+        const std::optional<double> strength = draw(k);
+        try {
+            return make(strength);
+        } catch (const std::exception &e) {
+            std::ostringstream why;
+            if (strength)
+                why << " at " << *strength;
+            why << ": " << e.what();
+            failures.push_back(why.str());
+        }
+    }
+    return std::nullopt;
+}
+
 SelftestResult runSelftest(const SelftestOptions &o) {
     const auto t0 = std::chrono::steady_clock::now();
     const BaseModel base = loadBaseModel(o.base_model);
@@ -193,22 +211,39 @@ SelftestResult runSelftest(const SelftestOptions &o) {
         to.noise = plan.noise;
         to.level_noise = plan.level_noise;
         to.own_beds = plan.own_beds;
-        if (p.strength)
-            to.strength = *p.strength;
-        else if (!p.effect.empty())
-            to.strength = drawStrength(resolveAgainst(o.catalogue.find(p.effect), reference),
-                                       to.seed, plan.strengths);
-        std::fprintf(stderr, "[selftest] twin %u/%zu: %s%s\n", k, planned.size(), p.name.c_str(),
-                     to.strength ? (" at " + std::to_string(*to.strength)).c_str() : "");
-        TwinKey key;
-        try {
-            key = makeTwin(design, o.catalogue, sim, to, folder, key_path);
-        } catch (const std::exception &e) {
-            // A twin whose simulations failed cannot be scored: said, and left out.
-            std::fprintf(stderr, "[selftest] twin %s not made: %s\n", p.name.c_str(), e.what());
-            R.failed_twins.push_back(p.name + ": " + e.what());
-            continue;
+        // A drawn strength whose twin cannot be simulated on this design (its grains past the
+        // overlap limit) is drawn again from the same prior, each try said: left out, the soft
+        // surface layer went unscored on every draw of the full self-test (below about 0.2 on
+        // its soft base).
+        const bool drawn = !p.strength && !p.effect.empty();
+        std::vector<std::string> tries;
+        const std::optional<TwinKey> made = drawUntilMade(
+            [&](int draw) -> std::optional<double> {
+                if (p.strength)
+                    return p.strength;
+                if (!drawn)
+                    return std::nullopt;
+                return drawStrength(resolveAgainst(o.catalogue.find(p.effect), reference),
+                                    to.seed + 100003u * unsigned(draw), plan.strengths);
+            },
+            [&](std::optional<double> strength) {
+                to.strength = strength;
+                std::fprintf(stderr, "[selftest] twin %u/%zu: %s%s\n", k, planned.size(),
+                             p.name.c_str(),
+                             strength ? (" at " + std::to_string(*strength)).c_str() : "");
+                return makeTwin(design, o.catalogue, sim, to, folder, key_path);
+            },
+            drawn ? kStrengthDraws : 1, tries);
+        for (std::string &t : tries)
+            t = p.name + t;
+        if (!made) { // a twin whose simulations failed cannot be scored: said, and left out
+            R.failed_twins.push_back(tries.back());
+            tries.pop_back();
         }
+        R.redrawn.insert(R.redrawn.end(), tries.begin(), tries.end());
+        if (!made)
+            continue;
+        const TwinKey key = *made;
 
         // Blind: the diagnosis gets the folder and the catalogue, never the key.
         const ExperimentSet set = loadExperiments(folder);
@@ -309,6 +344,8 @@ SelftestResult runSelftest(const SelftestOptions &o) {
             rep << " | " << (cells.count(c) ? std::to_string(cells.at(c)) : "0");
         rep << '\n';
     }
+    for (const auto &f : R.redrawn)
+        rep << "twin not made, its strength drawn again: " << f << '\n';
     for (const auto &f : R.failed_twins)
         rep << "twin not made (left out of the scores): " << f << '\n';
     rep << "\ntwins:\n";

@@ -1372,3 +1372,63 @@ TEST_CASE("diagnosis: an effect whose kinds of observable ask for different stre
     CHECK(kindStrength(two, "plate_sinkage/pressure_Pa") == Approx(1.5).epsilon(0.05));
     CHECK(kindStrength(two, "angle_of_repose/angle_deg") == Approx(41.0 / 30.0).epsilon(0.05));
 }
+
+TEST_CASE("selftest: a drawn strength whose twin cannot be simulated is drawn again from its "
+          "prior, each failed try said, and left out only after the last",
+          "[gap][selftest]") {
+    // The full self-test's soft surface layer: drawn from the far half of its prior (0.1-1, off
+    // at 1), its twins below about 0.2 pressed the soft base's grains past the overlap limit.
+    const Effect &layer = shippedEffects().find("soft_surface_layer");
+    const auto draw = [&](int k) -> std::optional<double> {
+        return drawStrength(layer, 1201u + 100003u * unsigned(k), StrengthDraw::FarHalf);
+    };
+    std::vector<double> tried;
+    const auto make = [&](double below) {
+        return [&tried, below](std::optional<double> s) {
+            tried.push_back(*s);
+            if (*s < below)
+                throw std::runtime_error("twin: no repeat of experiment 'wide_d20' was simulated");
+            TwinKey key;
+            key.effect = "soft_surface_layer";
+            key.strength = *s;
+            return key;
+        };
+    };
+    std::vector<std::string> failures;
+    SECTION("made at the first strength that can be simulated") {
+        // Below 0.2 nothing is made; the draws are the prior's own, so the first one at or
+        // above it is the twin.
+        const std::optional<TwinKey> made =
+            drawUntilMade(draw, make(0.2), kStrengthDraws, failures);
+        std::size_t first_ok = 0;
+        while (first_ok < tried.size() && tried[first_ok] < 0.2)
+            ++first_ok;
+        REQUIRE(first_ok < std::size_t(kStrengthDraws)); // these seeds reach one within 4 draws
+        REQUIRE(made);
+        CHECK(made->strength == tried.back());
+        CHECK(tried.size() == first_ok + 1);
+        REQUIRE(failures.size() == first_ok);
+        for (std::size_t i = 0; i < failures.size(); ++i) {
+            CHECK_THAT(failures[i], Catch::StartsWith(" at 0.") &&
+                                        Catch::Contains("no repeat of experiment 'wide_d20'"));
+            CHECK(tried[i] >= 0.1);
+            CHECK(tried[i] < 0.2);
+        }
+        // Each try is a new draw from the far half of the prior (0.1 to 10^-0.5).
+        for (double s : tried)
+            CHECK((s >= 0.1 && s <= std::pow(10.0, -0.5) + 1e-12));
+        CHECK(std::set<double>(tried.begin(), tried.end()).size() == tried.size());
+    }
+    SECTION("left out, every try said, when none can be simulated") {
+        CHECK_FALSE(drawUntilMade(draw, make(1.0), kStrengthDraws, failures));
+        CHECK(tried.size() == std::size_t(kStrengthDraws));
+        CHECK(failures.size() == std::size_t(kStrengthDraws));
+    }
+    SECTION("a strength given by the plan (out of the catalogue) is tried once") {
+        const auto given = [](int) -> std::optional<double> { return 0.15; };
+        CHECK_FALSE(drawUntilMade(given, make(0.2), 1, failures));
+        CHECK(tried == std::vector<double>{0.15});
+        REQUIRE(failures.size() == 1);
+        CHECK_THAT(failures[0], Catch::StartsWith(" at 0.15: twin: no repeat"));
+    }
+}

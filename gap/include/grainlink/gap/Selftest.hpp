@@ -6,6 +6,8 @@
 #include "grainlink/gap/Twin.hpp"
 #include "grainlink/study/Study.hpp"
 
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -41,6 +43,9 @@ struct SelftestTwin {
 struct SelftestResult {
     std::vector<SelftestTwin> twins;
     std::vector<std::string> failed_twins; ///< twins whose simulations failed, with why
+    /// Drawn strengths whose twin could not be simulated on the design, with why: each drawn
+    /// again from the same prior (a soft surface layer's grains past the overlap limit).
+    std::vector<std::string> redrawn;
     std::string line;   ///< "selftest: top-1 A/B (P %), strength within 25 %: C/D, ..."
     std::string report; ///< the line, the confusion matrix and every twin
     bool passed = false; ///< every target of docs/gap.md met
@@ -53,6 +58,17 @@ struct SelftestResult {
 };
 
 SelftestResult runSelftest(const SelftestOptions &options);
+
+/// How often a self-test draws an effect's strength before it leaves the twin out.
+constexpr int kStrengthDraws = 4;
+
+/// A twin made at the strength `draw(k)` gives for the k-th try, by `make`, tried again where
+/// `make` throws (its simulations failed), `tries` times in all. Each failure is added to
+/// `failures` as " at STRENGTH: why" (": why" without a strength). Nothing where every try
+/// failed.
+std::optional<TwinKey> drawUntilMade(const std::function<std::optional<double>(int)> &draw,
+                                     const std::function<TwinKey(std::optional<double>)> &make,
+                                     int tries, std::vector<std::string> &failures);
 
 /// Scores one twin's diagnosis against its key and adds it to R's counts (docs/gap.md, "The
 /// self-test"): t.key, t.weak, t.outcome and t.claimed are set; `hidden` is the key's effect
