@@ -231,6 +231,7 @@ SelftestResult runSelftest(const SelftestOptions &o) {
                 std::fprintf(stderr, "[selftest] twin %u/%zu: %s%s\n", k, planned.size(),
                              p.name.c_str(),
                              strength ? (" at " + std::to_string(*strength)).c_str() : "");
+                fs::remove_all(folder); // no file of a failed draw stays beside the twin
                 return makeTwin(design, o.catalogue, sim, to, folder, key_path);
             },
             drawn ? kStrengthDraws : 1, tries);
