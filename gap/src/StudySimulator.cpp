@@ -416,7 +416,6 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     // A condition the simulation does not read is said, once with its experiments:
     // `wheel_load_N` for `load_N` would otherwise leave the base's load in silence.
     std::map<std::string, std::vector<std::string>> unused;
-    std::map<std::string, std::set<ExperimentType>> unused_by;
     std::map<std::pair<std::string, std::string>, std::vector<std::string>> undescribed;
     for (const Experiment &e : set.experiments)
         if (!base.tests.count(typeName(e.type)))
@@ -430,14 +429,12 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                 const auto described = base.conditions.find(key);
                 if (key == "box" && !containerOf(e.type)) {
                     unused[key].push_back(e.id); // the test builds its own box
-                    unused_by[key].insert(e.type);
                 } else if (described != base.conditions.end() || key == "box") {
                     // A text condition the base gives soils for: this value among them?
                     if (described == base.conditions.end() || !described->second.count(value))
                         undescribed[{key, value}].push_back(e.id);
                 } else if (std::find(used.begin(), used.end(), key) == used.end()) {
                     unused[key].push_back(e.id);
-                    unused_by[key].insert(e.type);
                 }
             }
             out.experiments.push_back(e);
@@ -450,8 +447,11 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
                (ids.size() == 1 ? " experiment" : " experiments");
     };
     for (const auto &[key, ids] : unused) {
+        std::set<ExperimentType> types;
+        for (const std::string &id : ids)
+            types.insert(set.find(id).type);
         std::string read;
-        for (const ExperimentType t : unused_by[key]) {
+        for (const ExperimentType t : types) {
             read += std::string("; a ") + typeName(t) + " test is set up from ";
             for (const std::string &c : conditionsOf(t).simulated)
                 read += c + ", ";
