@@ -383,9 +383,8 @@ std::vector<std::string> checkConditions(const CsvImport &csv, ExperimentType ty
     std::vector<std::string> warnings;
     for (const auto &[key, value] : csv.conditions) {
         const std::string option = "--condition " + key + "=" + value;
-        const bool label = key == "box" || key == "preparation";
         const std::string dimension = dimensionOf(key);
-        if (!label && dimension != "dimensionless" && !isNumberText(value)) {
+        if (dimension != "dimensionless" && !isNumberText(value)) {
             // "40mm": the number it stands for, in the key's SI unit.
             std::string hint;
             char *end = nullptr;
@@ -401,7 +400,7 @@ std::vector<std::string> checkConditions(const CsvImport &csv, ExperimentType ty
             throw std::invalid_argument(option + ": give " + key + " as a number in " +
                                         unitOf(key) + ", the SI unit its name ends in" + hint);
         }
-        if (label || std::find(known.begin(), known.end(), key) != known.end() ||
+        if (std::find(known.begin(), known.end(), key) != known.end() ||
             (dimension == "dimensionless" && !isNumberText(value)))
             continue; // a text condition names a soil the base may describe
         const std::string why = "'" + key + "' is not a condition of " + csv.type +
