@@ -252,8 +252,8 @@ ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidat
         // Nothing to predict: the best fit of the calibration experiments, confirmed or not (a
         // held-out gap of 0 everywhere would name whichever came first).
         for (const CandidateResult &R : candidates)
-            if (R.applicability.empty() && R.fit.features > 0 && std::isfinite(R.fit.chi2) &&
-                (!c.by_gap || R.fit.chi2 < c.by_gap->fit.chi2))
+            if (R.applicability.empty() && R.actsOnDesign() && R.fit.features > 0 &&
+                std::isfinite(R.fit.chi2) && (!c.by_gap || R.fit.chi2 < c.by_gap->fit.chi2))
                 c.by_gap = &R;
         return c;
     }
@@ -886,7 +886,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // of close fits is not final; the confirming runs and the held-out experiments decide.
         const double tie = 2.0 * leader.result.fit.chi2 + 4.0 * leader.result.fit.birge;
         for (std::size_t i : applicable)
-            if (int(to_confirm.size()) < opt.max_confirmed && live[i].result.calibration_gain > 0.0 &&
+            if (int(to_confirm.size()) < opt.max_confirmed &&
+                live[i].result.calibration_gain > 0.0 && live[i].result.actsOnDesign() &&
                 (to_confirm.empty() || live[i].result.fit.chi2 <= tie))
                 to_confirm.push_back(i);
     }
@@ -963,6 +964,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         std::vector<VariantRequest> more;
         for (std::size_t i : applicable)
             if (failed > 0 && live[i].result.calibration_gain > 0.0 &&
+                live[i].result.actsOnDesign() &&
                 std::find(to_confirm.begin(), to_confirm.end(), i) == to_confirm.end()) {
                 to_confirm.push_back(i);
                 more.push_back(confirmRequest(i));
@@ -1079,7 +1081,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     if (!any_explains && !single_leaves_no_gap && resolved && claim_possible) {
         std::vector<std::size_t> pool;
         for (std::size_t i : applicable)
-            if (int(pool.size()) < opt.pair_pool && live[i].result.calibration_gain > 0.0)
+            if (int(pool.size()) < opt.pair_pool && live[i].result.calibration_gain > 0.0 &&
+                live[i].result.actsOnDesign())
                 pool.push_back(i);
         std::vector<PairResult> pairs;
         for (std::size_t a = 0; a < pool.size(); ++a)
@@ -1295,6 +1298,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                           : best->fit.at_prior_edge ? ", at its prior's edge: not claimed"
                                                     : "")
                       << ")";
+            else if (std::none_of(D.candidates.begin(), D.candidates.end(),
+                                  [](const CandidateResult &R) {
+                                      return R.applicability.empty() && R.actsOnDesign();
+                                  }))
+                claim << "; no candidate acts on these experiments (none changes them by a unit "
+                         "of their validation uncertainty)";
             if (const CandidateResult *nearest = closest.by_p_value; nearest && nearest != best) {
                 D.nearest_to_claim = nearest->name;
                 claim << "; nearest to a claim: " << nearest->name << " at "
@@ -1337,7 +1346,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // are what the design cannot separate. A candidate that the calibration leaves at off,
         // or whose signature is within the noise, reproduces nothing: not a twin of anything.
         const auto acts = [&](const CandidateResult &R) {
-            return R.calibration_gain > 1.0 && R.signature_chi2 >= 1.0;
+            return R.calibration_gain > 1.0 && R.actsOnDesign();
         };
         if (acts(live[applicable[0]].result))
             for (std::size_t b = 1; b < applicable.size(); ++b)

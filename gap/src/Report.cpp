@@ -122,7 +122,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
         } else {
             cj["applicable"] = true;
             cj["signature_chi2"] = number(c.signature_chi2);
-            cj["acts_on_design"] = c.signature_chi2 >= 1.0;
+            cj["acts_on_design"] = c.actsOnDesign();
             cj["strength"] = strength(c.effect, c.fit);
             cj["calibration_chi2"] = number(c.fit.chi2);
             cj["calibration_chi2_gain"] = number(c.calibration_gain);
@@ -231,7 +231,7 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
             r << "not applicable (" << c.applicability << ")\n";
             continue;
         }
-        if (c.signature_chi2 < 1.0) {
+        if (!c.actsOnDesign()) {
             r << "no signature on these experiments (its strongest simulated change moves them by "
               << "chi^2 " << c.signature_chi2 << ")\n";
             continue;

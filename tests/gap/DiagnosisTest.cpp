@@ -681,6 +681,33 @@ const CandidateResult &candidate(const Diagnosis &d, const std::string &name) {
 }
 } // namespace
 
+TEST_CASE("diagnosis: a candidate that does not act on the design is neither confirmed nor named "
+          "closest",
+          "[gap][diagnosis]") {
+    // On the CMU wheels (eight beds, --only sensor_zero_offset) a zero offset, which moves a
+    // wheel's features by chi^2 0, was confirmed and named closest ("held-out gap 69 % -> 69 %").
+    // Here the only candidate changes the plates' pressure by 0.05 % against a hidden cohesion.
+    const EffectCatalogue c = shippedEffects();
+    Effect faint = c.find("grain_density");
+    faint.name = "faint_density";
+    faint.prior = {0.999, 1.001, 1.0, false};
+    faint.signature = {0.9995, 1.0005};
+    AnalyticSimulator sim;
+    sim.alias["faint_density"] = "grain_density";
+    const Diagnosis d =
+        diagnose(measuredSet({"cohesion", 4.0e4}, 7), {&faint}, sim, analyticOptions());
+    INFO(d.claim);
+    REQUIRE(d.verdict.gap);
+    const CandidateResult &r = candidate(d, "faint_density");
+    CHECK(r.applicability.empty());
+    CHECK(r.signature_chi2 < 1.0);
+    CHECK(r.calibration_gain > 0.0); // it leans towards the gap: it used to be confirmed
+    CHECK_FALSE(r.confirmed);
+    CHECK(d.outcome == Diagnosis::Outcome::Unexplained);
+    CHECK(d.best_model.empty());
+    CHECK_THAT(d.claim, Catch::Contains("no candidate acts on these experiments"));
+}
+
 TEST_CASE("diagnosis: held-out plates that the model presses into the same beds are judged "
           "per plate with those beds' luck measured",
           "[gap][diagnosis]") {
@@ -984,6 +1011,7 @@ TEST_CASE("when nothing is claimed the closest by held-out gap and the nearest t
         R.confirmed = confirmed;
         R.held_out.gap = gap;
         R.versus_null.p_value = p;
+        R.signature_chi2 = 10.0; // each acts on the design
         return R;
     };
     const std::vector<CandidateResult> candidates{candidate("rig_compliance", true, 1.20, 0.82),

@@ -100,7 +100,10 @@ struct CandidateResult {
     Effect effect;             ///< resolved against the base
     StrengthFit fit;           ///< on the calibration features
     double signature_chi2 = 0.0; ///< its largest simulated change of the design, in chi^2 (u_val);
-                                 ///< below about 1 the effect does not act on these experiments
+                                 ///< below 1 the effect does not act on these experiments
+    /// Whether its strongest simulated change moves the design by a unit of u_val or more: one
+    /// that does not can explain no gap here, and is neither confirmed nor named closest.
+    bool actsOnDesign() const { return signature_chi2 >= 1.0; }
     double calibration_gain = 0.0; ///< chi^2 with the effect off minus at its best strength
     HeldOutScore predicted;    ///< held-out score from the signature (before confirmation)
     bool confirmed = false;    ///< re-simulated at the fitted strength
