@@ -878,6 +878,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         after = testGap(meas.keys, z, opt.alpha, opt.flag_at);
         return versus_null.mean_gain > 0.0;
     };
+    // Worth re-simulating, alone or in a pair: the calibration moves it off "off", and it acts
+    // on the design at all.
+    const auto promising = [&](std::size_t i) {
+        return live[i].result.calibration_gain > 0.0 && live[i].result.actsOnDesign();
+    };
     std::vector<std::size_t> to_confirm;
     if (!applicable.empty()) {
         const Live &leader = live[applicable.front()];
@@ -886,8 +891,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // of close fits is not final; the confirming runs and the held-out experiments decide.
         const double tie = 2.0 * leader.result.fit.chi2 + 4.0 * leader.result.fit.birge;
         for (std::size_t i : applicable)
-            if (int(to_confirm.size()) < opt.max_confirmed &&
-                live[i].result.calibration_gain > 0.0 && live[i].result.actsOnDesign() &&
+            if (int(to_confirm.size()) < opt.max_confirmed && promising(i) &&
                 (to_confirm.empty() || live[i].result.fit.chi2 <= tie))
                 to_confirm.push_back(i);
     }
@@ -963,8 +967,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             failed += !coversBase(meanAndVariance(rows, bed_sd).first, V.simulated, meas.keys);
         std::vector<VariantRequest> more;
         for (std::size_t i : applicable)
-            if (failed > 0 && live[i].result.calibration_gain > 0.0 &&
-                live[i].result.actsOnDesign() &&
+            if (failed > 0 && promising(i) &&
                 std::find(to_confirm.begin(), to_confirm.end(), i) == to_confirm.end()) {
                 to_confirm.push_back(i);
                 more.push_back(confirmRequest(i));
@@ -1081,8 +1084,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     if (!any_explains && !single_leaves_no_gap && resolved && claim_possible) {
         std::vector<std::size_t> pool;
         for (std::size_t i : applicable)
-            if (int(pool.size()) < opt.pair_pool && live[i].result.calibration_gain > 0.0 &&
-                live[i].result.actsOnDesign())
+            if (int(pool.size()) < opt.pair_pool && promising(i))
                 pool.push_back(i);
         std::vector<PairResult> pairs;
         for (std::size_t a = 0; a < pool.size(); ++a)
