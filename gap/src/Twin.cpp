@@ -101,14 +101,23 @@ Design loadDesign(const std::string &path) {
     return d;
 }
 
-double drawStrength(const Effect &effect, unsigned seed, StrengthDraw draw) {
+double drawStrength(const Effect &effect, unsigned seed, StrengthDraw draw,
+                    const std::vector<double> &failed) {
     std::mt19937 rng(seed * 2654435761u + 17u);
     const Prior &p = effect.prior;
-    const double lo = p.toScale(p.lo), hi = p.toScale(p.hi);
+    double lo = p.toScale(p.lo), hi = p.toScale(p.hi);
+    const double off_t = p.toScale(p.off);
+    for (double f : failed) { // what failed there fails farther from off too
+        const double t = p.toScale(f);
+        if (t < off_t)
+            lo = std::max(lo, t);
+        else if (t > off_t)
+            hi = std::min(hi, t);
+    }
     std::uniform_real_distribution<double> u(lo, hi);
     double t = u(rng);
     if (draw == StrengthDraw::FarHalf) {
-        const double off = std::clamp(p.toScale(p.off), lo, hi);
+        const double off = std::clamp(off_t, lo, hi);
         const double side = t < off ? off - lo : hi - off;
         const double d = std::abs(t - off);
         t = off + std::copysign(0.5 * side + 0.5 * d, t - off);
@@ -236,7 +245,8 @@ void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves,
         YAML::Node data;
         if (e.x_name.empty()) {
             if (scalar_values.empty())
-                throw std::runtime_error("twin: no repeat of experiment '" + e.id + "' gave a value "
+                throw std::runtime_error("twin: no repeat of experiment '" + e.id +
+                                         "' gave a value "
                                          "(an angle of repose without a heap)");
             data["values"] = scalar_values;
             data["unit"] = "deg";

@@ -49,7 +49,7 @@ double pressure(double z, double d, const std::string &box, const Truth &t) {
                std::pow(0.02, -t.exponent_shift) * std::pow(d / 0.08, t.size_trend) * confinement;
     if (t.effect == "grain_stiffness") // stiffer grains: more pressure within an elastic zone
         p *= 1.0 + (std::pow(t.strength, 0.5) - 1.0) * std::exp(-z / (0.06 * d)); // ~ the plate
-    
+
     if (t.effect == "cohesion") // a bearing term that grows with the plate
         p += t.strength * 0.08 * (d / 0.1) * std::min(1.0, z / 0.003);
     if (t.effect == "domain_size") // a narrower box confines the larger plates more
@@ -130,8 +130,9 @@ public:
     }
     std::vector<std::string> checks() const override { return {"resolution"}; }
     YAML::Node referenceScenario() const override {
-        return YAML::Load("soil: {contact: {rolling: {model: none}, tangential: {stick_angle_deg: 30}}, "
-                          "deposition: {radius: {distribution: constant, value_m: 0.002}}}");
+        return YAML::Load(
+            "soil: {contact: {rolling: {model: none}, tangential: {stick_angle_deg: 30}}, "
+            "deposition: {radius: {distribution: constant, value_m: 0.002}}}");
     }
     std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &set, const FeatureDesign &design,
                                           const std::vector<VariantRequest> &requests) override {
@@ -226,7 +227,8 @@ TEST_CASE("diagnosis on an analytic soil names the hidden effect and its strengt
                                     {"rig_compliance", 2.0e-5}};
     for (const Truth &t : truths) {
         const Diagnosis d = run(t);
-        INFO(t.effect << ": " << d.claim << " | null gap " << d.held_out_null.gap << " smse " << d.held_out_null.smse << " base smse " << d.held_out_base.smse);
+        INFO(t.effect << ": " << d.claim << " | null gap " << d.held_out_null.gap << " smse "
+                      << d.held_out_null.smse << " base smse " << d.held_out_base.smse);
         for (const auto &c : d.candidates)
             if (c.confirmed)
                 UNSCOPED_INFO(c.name << " smse " << c.held_out.smse << " n " << c.held_out.features
@@ -394,7 +396,8 @@ TEST_CASE("diagnosis on an analytic soil: the null model interpolates between ca
     // plates, the generic discrepancy predicts the 70 and 90 mm ones; calibrated on the 50 and
     // 70 mm plates, it fades towards the base model on the larger ones, where the effect's
     // physics still holds.
-    const Diagnosis inside = run({"grain_density", 1.6}, 7, {"large_70", "large_90", "small_70", "small_90"});
+    const Diagnosis inside =
+        run({"grain_density", 1.6}, 7, {"large_70", "large_90", "small_70", "small_90"});
     CHECK(inside.held_out_null.gap < 0.25 * inside.held_out_base.gap);
     const Diagnosis beyond = run({"grain_density", 1.6});
     CHECK(beyond.held_out_null.gap > 0.4 * beyond.held_out_base.gap);
@@ -443,7 +446,8 @@ TEST_CASE("the diagnosis writes diagnosis.json, features.csv, report.txt and a s
     CHECK(lines == int(d.design.size()) + 1);
     if (std::find(files.begin(), files.end(), "report.html") != files.end()) {
         std::ifstream page(dir / "report.html");
-        const std::string text((std::istreambuf_iterator<char>(page)), std::istreambuf_iterator<char>());
+        const std::string text((std::istreambuf_iterator<char>(page)),
+                               std::istreambuf_iterator<char>());
         CHECK(text.find("data:image/png;base64,") != std::string::npos);
         CHECK(text.find("explained") != std::string::npos);
     } else {
@@ -456,7 +460,8 @@ TEST_CASE("diagnosis against another code's soil: a difference outside the catal
           "[gap][diagnosis][mismatch]") {
     // The measuring world's soil has another exponent of z or another trend with plate size
     // than the base model, and no catalogue effect: a gap, which no effect may claim.
-    const std::vector<Truth> worlds{{"", 0.0, -0.25, 0.0}, {"", 0.0, 0.0, 0.3}, {"", 0.0, 0.15, -0.3}};
+    const std::vector<Truth> worlds{
+        {"", 0.0, -0.25, 0.0}, {"", 0.0, 0.0, 0.3}, {"", 0.0, 0.15, -0.3}};
     for (const Truth &t : worlds)
         for (unsigned seed : {1u, 2u}) {
             const Diagnosis d = run(t, seed);
@@ -861,8 +866,8 @@ TEST_CASE("diagnosis: a claim names a rival that leaves no gap without beating t
     c.effects.push_back(loose);
     AnalyticSimulator sim;
     sim.alias["cohesion_loose"] = "cohesion";
-    // 0.125: there (and at 0.12 and 0.13) its p against the null, 0.052, misses the level 0.025 while
-    // its mean of four beds stays close enough to leave no gap; at 0.11 it beats the null, at
+    // 0.125: there (and at 0.12 and 0.13) its p against the null, 0.052, misses the level 0.025
+    // while its mean of four beds stays close enough to leave no gap; at 0.11 it beats the null, at
     // 0.15 its mean drifts into a gap.
     sim.confirm_scatter_of["cohesion_loose"] = 0.125;
     DiagnosisOptions o = analyticOptions();
@@ -1402,13 +1407,13 @@ TEST_CASE("diagnosis: an effect whose kinds of observable ask for different stre
 }
 
 TEST_CASE("selftest: a drawn strength whose twin cannot be simulated is drawn again from its "
-          "prior, each failed try said, and left out only after the last",
+          "prior cut at it, each failed try said, and left out only after the last",
           "[gap][selftest]") {
     // The full self-test's soft surface layer: drawn from the far half of its prior (0.1-1, off
-    // at 1), its twins below about 0.2 pressed the soft base's grains past the overlap limit.
+    // at 1), its twins below about 0.3 pressed the soft base's grains past the overlap limit.
     const Effect &layer = shippedEffects().find("soft_surface_layer");
-    const auto draw = [&](int k) -> std::optional<double> {
-        return drawStrength(layer, 1201u + 100003u * unsigned(k), StrengthDraw::FarHalf);
+    const auto draw = [&](int k, const std::vector<double> &failed) -> std::optional<double> {
+        return drawStrength(layer, 1201u + 100003u * unsigned(k), StrengthDraw::FarHalf, failed);
     };
     std::vector<double> tried;
     const auto make = [&](double below) {
@@ -1423,37 +1428,39 @@ TEST_CASE("selftest: a drawn strength whose twin cannot be simulated is drawn ag
         };
     };
     std::vector<std::string> failures;
-    SECTION("made at the first strength that can be simulated") {
-        // Below 0.2 nothing is made; the draws are the prior's own, so the first one at or
-        // above it is the twin.
+    SECTION("made at the first strength that can be simulated, each try nearer off") {
+        // Below 0.3 nothing is made (on the full self-test's base 0.283 failed, 0.4 ran). The
+        // first draw is the far half's own (0.1 to 10^-0.5); each after a failure lies between
+        // it and off, so the tries climb towards the runnable strengths.
         const std::optional<TwinKey> made =
-            drawUntilMade(draw, make(0.2), kStrengthDraws, failures);
-        std::size_t first_ok = 0;
-        while (first_ok < tried.size() && tried[first_ok] < 0.2)
-            ++first_ok;
-        REQUIRE(first_ok < std::size_t(kStrengthDraws)); // these seeds reach one within 4 draws
-        REQUIRE(made);
+            drawUntilMade(draw, make(0.3), kStrengthDraws, failures);
+        REQUIRE(made); // these seeds reach one within 4 draws
         CHECK(made->strength == tried.back());
-        CHECK(tried.size() == first_ok + 1);
-        REQUIRE(failures.size() == first_ok);
+        CHECK(made->strength >= 0.3);
+        CHECK(tried.front() >= 0.1);
+        CHECK(tried.front() <= std::pow(10.0, -0.5) + 1e-12);
+        REQUIRE(failures.size() == tried.size() - 1);
+        REQUIRE_FALSE(failures.empty()); // the first draw, below 0.3, failed
         for (std::size_t i = 0; i < failures.size(); ++i) {
             CHECK_THAT(failures[i], Catch::StartsWith(" at 0.") &&
                                         Catch::Contains("no repeat of experiment 'wide_d20'"));
-            CHECK(tried[i] >= 0.1);
-            CHECK(tried[i] < 0.2);
+            CHECK(tried[i] < 0.3);
+            CHECK(tried[i + 1] > tried[i]);
+            // the far half of what is left, [failed, sqrt(failed)] on the log scale
+            CHECK(tried[i + 1] <= std::sqrt(tried[i]) * (1 + 1e-12));
         }
-        // Each try is a new draw from the far half of the prior (0.1 to 10^-0.5).
-        for (double s : tried)
-            CHECK((s >= 0.1 && s <= std::pow(10.0, -0.5) + 1e-12));
-        CHECK(std::set<double>(tried.begin(), tried.end()).size() == tried.size());
     }
     SECTION("left out, every try said, when none can be simulated") {
         CHECK_FALSE(drawUntilMade(draw, make(1.0), kStrengthDraws, failures));
         CHECK(tried.size() == std::size_t(kStrengthDraws));
         CHECK(failures.size() == std::size_t(kStrengthDraws));
+        for (std::size_t i = 1; i < tried.size(); ++i)
+            CHECK(tried[i] > tried[i - 1]);
     }
     SECTION("a strength given by the plan (out of the catalogue) is tried once") {
-        const auto given = [](int) -> std::optional<double> { return 0.15; };
+        const auto given = [](int, const std::vector<double> &) -> std::optional<double> {
+            return 0.15;
+        };
         CHECK_FALSE(drawUntilMade(given, make(0.2), 1, failures));
         CHECK(tried == std::vector<double>{0.15});
         REQUIRE(failures.size() == 1);

@@ -73,10 +73,12 @@ TEST_CASE("effects resolve their off value against the base", "[gap][effects]") 
     CHECK(inapplicable(c.find("rolling_resistance"), base).empty());
 }
 
-TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off", "[gap][effects]") {
+TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off",
+          "[gap][effects]") {
     const YAML::Node base = YAML::Load(kScenario);
     const EffectCatalogue c = shippedEffects();
-    const YAML::Node stiff = applyEffect(c.find("grain_stiffness"), 4.0, base, ExperimentType::PlateSinkage);
+    const YAML::Node stiff =
+        applyEffect(c.find("grain_stiffness"), 4.0, base, ExperimentType::PlateSinkage);
     CHECK(stiff["soil"]["material"]["youngs_modulus_Pa"].as<double>() == Approx(4.0e7));
     CHECK(stiff["soil"]["contact"]["tangential"]["stiffness_N_m"].as<double>() == Approx(800.0));
     CHECK(stiff["soil"]["contact"]["damping"]["coefficient_N_s_m"].as<double>() == Approx(0.2));
@@ -96,11 +98,13 @@ TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off"
     CHECK_FALSE(coh_off["soil"]["contact_wall"]);
     CHECK_FALSE(coh_off["soil"]["contact_tool"]);
 
-    const YAML::Node none = applyEffect(c.find("rolling_resistance"), 0.0, base, ExperimentType::PlateSinkage);
+    const YAML::Node none =
+        applyEffect(c.find("rolling_resistance"), 0.0, base, ExperimentType::PlateSinkage);
     CHECK(none["soil"]["contact"]["rolling"]["model"].as<std::string>() == "none");
     CHECK_FALSE(none["soil"]["contact"]["rolling"]["coefficient"]);
 
-    const YAML::Node wall = applyEffect(c.find("wall_friction"), 0.25, base, ExperimentType::PlateSinkage);
+    const YAML::Node wall =
+        applyEffect(c.find("wall_friction"), 0.25, base, ExperimentType::PlateSinkage);
     CHECK(wall["soil"]["walls"][0]["friction_coefficient"].as<double>() == Approx(0.25));
     // The grain-wall law in its tangential model's terms: linear -> the stick angle atan(mu).
     CHECK(wall["soil"]["contact_wall"]["tangential"]["stick_angle_deg"].as<double>() ==
@@ -109,14 +113,18 @@ TEST_CASE("effects edit the scenario: stiffness, cohesion, rolling switched off"
     // A wildcard path edits the walls there are; a test without walls gets none.
     YAML::Node wall_less = YAML::Clone(base);
     wall_less["soil"].remove("walls");
-    CHECK_FALSE(applyEffect(c.find("wall_friction"), 0.25, wall_less, ExperimentType::DirectShear)["soil"]["walls"]);
-    const YAML::Node tool = applyEffect(c.find("tool_friction"), 0.5, base, ExperimentType::DirectShear);
+    CHECK_FALSE(applyEffect(c.find("wall_friction"), 0.25, wall_less,
+                            ExperimentType::DirectShear)["soil"]["walls"]);
+    const YAML::Node tool =
+        applyEffect(c.find("tool_friction"), 0.5, base, ExperimentType::DirectShear);
     CHECK_FALSE(tool["bevameter"]["plate_friction_coefficient"]); // only for plate tests
     CHECK(tool["soil"]["contact_tool"]["tangential"]["stick_angle_deg"].as<double>() ==
           Approx(26.565051).epsilon(1e-6));
     YAML::Node mindlin = YAML::Clone(base);
-    mindlin["soil"]["contact"]["tangential"] = YAML::Load("{model: mindlin, friction_coefficient: 0.6}");
-    const YAML::Node tool_m = applyEffect(c.find("tool_friction"), 0.5, mindlin, ExperimentType::DirectShear);
+    mindlin["soil"]["contact"]["tangential"] =
+        YAML::Load("{model: mindlin, friction_coefficient: 0.6}");
+    const YAML::Node tool_m =
+        applyEffect(c.find("tool_friction"), 0.5, mindlin, ExperimentType::DirectShear);
     CHECK(tool_m["soil"]["contact_tool"]["tangential"]["friction_coefficient"].as<double>() == 0.5);
     CHECK_FALSE(tool_m["soil"]["contact_tool"]["tangential"]["stick_angle_deg"]);
     CHECK_FALSE(tool["soil"]["contact_wall"]);
@@ -185,7 +193,8 @@ TEST_CASE("polydispersity keeps the mean radius and the solid volume, domain siz
           "[gap][effects]") {
     const YAML::Node base = YAML::Load(kScenario);
     const EffectCatalogue c = shippedEffects();
-    const YAML::Node wide = applyEffect(c.find("polydispersity"), 0.3, base, ExperimentType::PlateSinkage);
+    const YAML::Node wide =
+        applyEffect(c.find("polydispersity"), 0.3, base, ExperimentType::PlateSinkage);
     const YAML::Node r = wide["soil"]["deposition"]["radius"];
     const double lo = r["min_m"].as<double>(), hi = r["max_m"].as<double>();
     CHECK(0.5 * (lo + hi) == Approx(0.002));
@@ -194,14 +203,14 @@ TEST_CASE("polydispersity keeps the mean radius and the solid volume, domain siz
     const auto volume = [](const YAML::Node &s) {
         const YAML::Node rr = s["soil"]["deposition"]["radius"];
         const double a = rr["min_m"].as<double>(), b = rr["max_m"].as<double>();
-        return s["soil"]["deposition"]["count"].as<double>() *
-               (std::pow(b, 4) - std::pow(a, 4)) / (4.0 * (b - a));
+        return s["soil"]["deposition"]["count"].as<double>() * (std::pow(b, 4) - std::pow(a, 4)) /
+               (4.0 * (b - a));
     };
     CHECK(volume(wide) == Approx(volume(base)).epsilon(1e-3));
-    CHECK(wide["soil"]["simulation"]["time_step_s"].as<double>() ==
-          Approx(4.0e-5 * 0.7 / 0.9));
+    CHECK(wide["soil"]["simulation"]["time_step_s"].as<double>() == Approx(4.0e-5 * 0.7 / 0.9));
 
-    const YAML::Node big = applyEffect(c.find("domain_size"), 1.5, base, ExperimentType::PlateSinkage);
+    const YAML::Node big =
+        applyEffect(c.find("domain_size"), 1.5, base, ExperimentType::PlateSinkage);
     const auto upper = big["soil"]["walls"][0]["upper_m"].as<std::vector<double>>();
     const auto lower = big["soil"]["walls"][0]["lower_m"].as<std::vector<double>>();
     CHECK(upper[0] - lower[0] == Approx(0.15));
@@ -244,17 +253,20 @@ wheel: {shape: {diameter_m: 0.116, width_m: 0.05}}
     CHECK(width(steered, 0.75) == Approx(footprint + 0.75 * (0.16 - footprint)));
 }
 
-TEST_CASE("measurement effects shift the simulated sinkage: a constant offset, or compliance x force",
-          "[gap][effects]") {
+TEST_CASE(
+    "measurement effects shift the simulated sinkage: a constant offset, or compliance x force",
+    "[gap][effects]") {
     const EffectCatalogue c = shippedEffects();
     Experiment e;
     e.type = ExperimentType::PlateSinkage;
     e.numbers["plate_diameter_m"] = 0.1;
     const Curve curve{{0.0, 0.01}, {0.0, 40000.0}};
-    const Curve zero = applyMeasurementEffect(c.find("sensor_zero_offset"), 0.001, e, "pressure_Pa", curve);
+    const Curve zero =
+        applyMeasurementEffect(c.find("sensor_zero_offset"), 0.001, e, "pressure_Pa", curve);
     CHECK(zero.x[1] == Approx(0.011));
     // 40 kPa on a 100 mm plate is 314 N; at 1e-5 m/N the rig adds 3.14 mm.
-    const Curve rig = applyMeasurementEffect(c.find("rig_compliance"), 1e-5, e, "pressure_Pa", curve);
+    const Curve rig =
+        applyMeasurementEffect(c.find("rig_compliance"), 1e-5, e, "pressure_Pa", curve);
     CHECK(rig.x[1] == Approx(0.01 + 1e-5 * 40000.0 * M_PI * 0.0025));
     CHECK(rig.x[0] == 0.0);
 }
@@ -306,5 +318,60 @@ TEST_CASE("a twin's strength drawn from the far half of its prior lies there and
         CHECK(highest == Approx(c.prior.hi).epsilon(0.01));
         if (below > 0)
             CHECK(lowest == Approx(c.prior.lo).epsilon(0.01).margin(1e-5));
+    }
+}
+
+TEST_CASE("a strength drawn again after twins that could not be simulated lies nearer off than "
+          "each of them, on its side, and fills the far half of what is left",
+          "[gap][selftest]") {
+    // The reference is the rule in words: the prior cut at each failed strength (it and all
+    // beyond it on its side of off left out), then the far half of each side of what is left.
+    struct Case {
+        Prior prior;
+        std::vector<double> failed;
+        double lo, hi;                     ///< the prior after the cuts
+        double far_lo_below, far_hi_above; ///< its far halves: s <= below, s >= above
+    };
+    const std::vector<Case> cases{
+        // the soft surface layer (off at the top): after 0.2, [0.2, sqrt 0.2]
+        {{0.1, 1.0, 1.0, true}, {0.2}, 0.2, 1.0, std::sqrt(0.2), 2.0},
+        // two failures on one side: the nearer cut holds
+        {{0.1, 1.0, 1.0, true}, {0.15, 0.3}, 0.3, 1.0, std::sqrt(0.3), 2.0},
+        // symmetric, one side cut: that side [-1.5, -0.75] mm, the other [1, 2] mm
+        {{-0.002, 0.002, 0.0, false}, {-0.0015}, -0.0015, 0.002, -0.00075, 0.001},
+        // both sides cut
+        {{-0.002, 0.002, 0.0, false}, {0.0015, -0.001}, -0.001, 0.0015, -0.0005, 0.00075},
+        // off below the prior: the failure cuts the top, [sqrt 30, 10]
+        {{3.0, 20.0, 1.0, true}, {10.0}, 3.0, 10.0, -1.0, std::sqrt(30.0)},
+    };
+    for (const Case &c : cases) {
+        Effect e;
+        e.name = "x";
+        e.prior = c.prior;
+        double lowest = c.hi, highest = c.lo;
+        int below = 0;
+        for (unsigned seed = 1; seed <= 2000; ++seed) {
+            const double s = drawStrength(e, seed, StrengthDraw::FarHalf, c.failed);
+            INFO("prior [" << c.prior.lo << ", " << c.prior.hi << "] cut to [" << c.lo << ", "
+                           << c.hi << "]: drew " << s);
+            REQUIRE(s >= c.lo - 1e-9 * std::abs(c.lo));
+            REQUIRE(s <= c.hi + 1e-9 * std::abs(c.hi));
+            for (double f : c.failed)
+                REQUIRE(s != f);
+            const bool in_low = s <= c.far_lo_below + 1e-9 * std::abs(c.far_lo_below),
+                       in_high = s >= c.far_hi_above - 1e-9 * std::abs(c.far_hi_above);
+            REQUIRE((in_low || in_high));
+            below += in_low;
+            lowest = std::min(lowest, s);
+            highest = std::max(highest, s);
+        }
+        const double t_lo = c.prior.toScale(c.lo), t_hi = c.prior.toScale(c.hi);
+        const double t_off = std::clamp(c.prior.toScale(c.prior.off), t_lo, t_hi);
+        CHECK(double(below) / 2000.0 == Approx((t_off - t_lo) / (t_hi - t_lo)).margin(0.04));
+        // Filled: the draws reach both ends of what is left (2000 draws)
+        if (below > 0)
+            CHECK(lowest == Approx(c.lo).epsilon(0.01).margin(1e-5));
+        if (below < 2000)
+            CHECK(highest == Approx(c.hi).epsilon(0.01).margin(1e-5));
     }
 }

@@ -23,7 +23,7 @@ struct Design {
 Design loadDesign(const std::string &path);
 
 struct TwinKey {
-    std::string effect;       ///< "" for a null twin
+    std::string effect; ///< "" for a null twin
     double strength = 0.0;
     bool in_catalogue = true;
     unsigned seed = 0;
@@ -32,11 +32,11 @@ struct TwinKey {
 };
 
 struct TwinOptions {
-    std::string effect;              ///< "" with !random: a null twin
-    std::optional<double> strength;  ///< none: drawn from the prior
-    unsigned seed = 1;               ///< the beds' seeds and the draws
-    double noise = 0.01;             ///< relative sd of every sample
-    double level_noise = 0.02;       ///< relative sd of a trial's level (its calibration)
+    std::string effect;             ///< "" with !random: a null twin
+    std::optional<double> strength; ///< none: drawn from the prior
+    unsigned seed = 1;              ///< the beds' seeds and the draws
+    double noise = 0.01;            ///< relative sd of every sample
+    double level_noise = 0.02;      ///< relative sd of a trial's level (its calibration)
     /// Every experiment's repeats on beds of its own, as a test bed rebuilt for every trial;
     /// otherwise trial t of every experiment of a group is made on bed t.
     bool own_beds = false;
@@ -50,8 +50,11 @@ enum class StrengthDraw {
 
 /// Draws a strength uniformly on the effect's prior (on its own scale), or on its far half: a
 /// draw at distance d from off on a side of length L is moved to L/2 + d/2 (an off outside the
-/// prior counts from the nearer end).
-double drawStrength(const Effect &effect, unsigned seed, StrengthDraw draw = StrengthDraw::Prior);
+/// prior counts from the nearer end). Each strength in `failed` (a twin that could not be
+/// simulated there) cuts the prior at it: that strength and all beyond it on its side of off
+/// are left out, the effect taken to grow harder to simulate the stronger it is.
+double drawStrength(const Effect &effect, unsigned seed, StrengthDraw draw = StrengthDraw::Prior,
+                    const std::vector<double> &failed = {});
 
 /// Writes a twin's measurements folder `out` (experiments.yaml + data/) from its simulated
 /// repeats (`curves[r]`: repeat r's curves per experiment id and observable) with the key's
