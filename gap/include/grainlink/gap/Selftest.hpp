@@ -60,7 +60,7 @@ struct SelftestResult {
 SelftestResult runSelftest(const SelftestOptions &options);
 
 /// How often a self-test draws an effect's strength before it leaves the twin out.
-constexpr int kStrengthDraws = 4;
+constexpr int kStrengthDraws = 6;
 
 /// A twin made at the strength `draw(k, failed)` gives for the k-th try (`failed`: the
 /// strengths tried before it), by `make`, tried again where `make` throws (its simulations
