@@ -1027,7 +1027,14 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             final_rows[again_of[i]] = again_rows[i];
         }
     }
-    const double level = opt.alpha / std::max<std::size_t>(1, confirm.size());
+    // The level is divided among the candidates that can be claimed: one whose confirming runs
+    // failed predicts nothing (and failed whatever the held-out data say), so it takes no
+    // share; the one confirmed in its place does.
+    std::size_t judged = 0;
+    for (const Eigen::MatrixXd &rows : final_rows)
+        judged += coversBase(meanAndVariance(rows, bed_sd).first, V.simulated, meas.keys);
+    const double level = opt.alpha / double(std::max<std::size_t>(1, judged));
+    D.single_level = level;
     for (std::size_t c = 0; c < to_confirm.size(); ++c) {
         Live &L = live[to_confirm[c]];
         CandidateResult &R = L.result;
@@ -1137,7 +1144,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const auto pair_rows = simulateValid(pr);
         for (const auto &r : pr)
             D.simulations += r.seeds;
-        const double pair_level = opt.alpha / std::max<std::size_t>(1, confirm.size() + pr.size());
+        const double pair_level = opt.alpha / double(std::max<std::size_t>(1, judged + pr.size()));
+        D.pair_level = pair_level;
         for (std::size_t i = 0; i < confirm_pairs; ++i) {
             PairResult &P = pairs[i];
             P.confirmed = true;

@@ -182,6 +182,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
             {{"model", p.model}, {"strength", p.strength}, {"mean", number(p.mean)},
              {"sd", number(p.sd)}});
     j["unexplained"] = d.unexplained;
+    j["claim_level"] = {{"single", number(d.single_level)}, {"pair", number(d.pair_level)}};
     j["simulations"] = d.simulations;
     return j;
 }

@@ -963,6 +963,11 @@ TEST_CASE("diagnosis: a candidate whose confirming runs failed is replaced by th
     INFO(d.claim);
     CHECK(d.explained_by != "cohesion");
     CHECK(confirmedCount(d) == confirmedCount(before) + 1);
+    // The level is divided among the candidates that can be claimed: the failed one takes no
+    // share (5 % over 3 before, over 3 again here, not 4).
+    REQUIRE(confirmedCount(before) >= 1);
+    CHECK(before.single_level == Approx(o.alpha / confirmedCount(before)));
+    CHECK(d.single_level == Approx(o.alpha / (confirmedCount(d) - 1)));
 }
 
 TEST_CASE("diagnosis: a candidate whose fitted strength is no valid scenario is taken as failed, "
@@ -982,6 +987,7 @@ TEST_CASE("diagnosis: a candidate whose fitted strength is no valid scenario is 
     AnalyticSimulator fine;
     const Diagnosis before = diagnose(set, c.diagnosable(), fine, analyticOptions());
     CHECK(confirmedCount(d) == confirmedCount(before) + 1);
+    CHECK(d.single_level == Approx(analyticOptions().alpha / (confirmedCount(d) - 1)));
 }
 
 TEST_CASE("diagnosis: a fitted strength the design cannot run is confirmed at the nearest that it "

@@ -201,6 +201,10 @@ struct Diagnosis {
     std::string claim;        ///< one sentence: the result (and what was not compared)
     std::string unexplained;  ///< what remains (features still flagged after the best model)
     int simulations = 0;      ///< variant x seed runs requested
+    /// The levels a confirmed single and a confirmed pair are tested at against the null:
+    /// alpha over the singles whose confirming runs ran (and the pairs confirmed); 0 when
+    /// nothing was confirmed.
+    double single_level = 0.0, pair_level = 0.0;
 };
 const char *outcomeName(Diagnosis::Outcome outcome);
 
