@@ -845,11 +845,15 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                                         const Eigen::VectorXd &strength_var) -> Eigen::VectorXd {
         return u2_fixed + meanAndVariance(rows, bed_sd).second + strength_var;
     };
+    // Its runs covered every feature the base reaches: a model that can be judged at all.
+    const auto ran = [&](const Eigen::MatrixXd &rows) {
+        return coversBase(meanAndVariance(rows, bed_sd).first, V.simulated, meas.keys);
+    };
     const auto evaluateModel = [&](const Eigen::MatrixXd &model_rows, HeldOutScore &score,
                                    DensityComparison &versus_null, GapVerdict &after,
                                    Eigen::VectorXd &mean, Eigen::VectorXd &z,
                                    const Eigen::VectorXd &strength_var) {
-        if (!coversBase(meanAndVariance(model_rows, bed_sd).first, V.simulated, meas.keys)) {
+        if (!ran(model_rows)) {
             // its runs failed somewhere: it predicts nothing there
             const double inf = std::numeric_limits<double>::infinity();
             score = HeldOutScore{};
@@ -964,7 +968,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     {
         int failed = 0;
         for (const auto &rows : confirm_rows)
-            failed += !coversBase(meanAndVariance(rows, bed_sd).first, V.simulated, meas.keys);
+            failed += !ran(rows);
         std::vector<VariantRequest> more;
         for (std::size_t i : applicable)
             if (failed > 0 && promising(i) &&
@@ -1032,7 +1036,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // share; the one confirmed in its place does.
     std::size_t judged = 0;
     for (const Eigen::MatrixXd &rows : final_rows)
-        judged += coversBase(meanAndVariance(rows, bed_sd).first, V.simulated, meas.keys);
+        judged += ran(rows);
     const double level = opt.alpha / double(std::max<std::size_t>(1, judged));
     D.single_level = level;
     for (std::size_t c = 0; c < to_confirm.size(); ++c) {
