@@ -99,14 +99,14 @@ TEST_CASE("Servo keys: the box's max_consolidation_time_s is max_load_time_s", "
                                            "control_interval_s: 0.00025, "
                                            "max_consolidation_time_s: 0.7}"));
     CHECK(old.test.servo.max_load_time_s == 0.7);
-    REQUIRE(old.warnings.size() == 1);
+    REQUIRE(old.warnings.size() == 2); // and the tiny box's width (the next test)
     CHECK_THAT(old.warnings[0], Contains("box.yaml:28: warning: "
                                          "'direct_shear.servo.max_consolidation_time_s' is "
                                          "deprecated; write 'direct_shear.servo.max_load_time_s'"));
     const auto block = parseBox(
         replacedOnce(kTinyShearBox, from, "control_interval_s: 0.00025, max_load_time_s: 0.7}"));
     CHECK(block.test.servo.max_load_time_s == 0.7);
-    CHECK(block.warnings.empty());
+    CHECK(block.warnings.size() == 1);
     CHECK_THROWS_WITH(parseBox(replacedOnce(kTinyShearBox, from,
                                             "control_interval_s: 0.00025, max_load_time_s: 0.7, "
                                             "max_consolidation_time_s: 0.7}")),
@@ -118,6 +118,28 @@ TEST_CASE("Servo keys: the box's max_consolidation_time_s is max_load_time_s", "
         Contains("direct_shear.servo.hold_s") && Contains("must be > 0"));
     CHECK(parseAnnulus(annulus("  servo: {gain_m_s_per_N: 0.1, max_speed_m_s: 0.05, hold_s: 0}\n"))
               .test.servo.hold_s == 0.0);
+}
+
+TEST_CASE("Direct shear: a box narrower than ten grain diameters is warned about with its key "
+          "and line (ASTM D3080)",
+          "[lab][config]") {
+    // The tiny box: 30 mm across, grains up to 2 x 2.25 mm: 6.67 diameters, under D3080's 10.
+    const auto tiny = parseBox(kTinyShearBox);
+    REQUIRE(tiny.warnings.size() == 1);
+    CHECK_THAT(tiny.warnings[0], Contains("box.yaml:19: warning: 'direct_shear.width_m'") &&
+                                     Contains("6.67 largest grain diameters across") &&
+                                     Contains("30 mm for grains up to 4.5 mm") &&
+                                     Contains("ASTM D3080 asks for at least 10"));
+    // 45 mm is ten diameters: no warning.
+    const auto wide =
+        parseBox(replacedOnce(replacedOnce(kTinyShearBox, "length_m: 0.03", "length_m: 0.045"),
+                              "width_m: 0.03", "width_m: 0.045"));
+    CHECK(wide.warnings.empty());
+    // The narrower side is the one named: a box 60 mm wide but 30 mm long in the shear direction.
+    const auto long_narrow =
+        parseBox(replacedOnce(kTinyShearBox, "width_m: 0.03", "width_m: 0.06"));
+    REQUIRE(long_narrow.warnings.size() == 1);
+    CHECK_THAT(long_narrow.warnings[0], Contains("box.yaml:18: warning: 'direct_shear.length_m'"));
 }
 
 TEST_CASE("Lab soil: keys a lab test would read and ignore are errors with their line",
