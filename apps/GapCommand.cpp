@@ -326,6 +326,10 @@ int GapCommand::diagnose() const {
     const std::string out = out_.empty() ? "out/gap/" + set.name : out_;
     gap::StudySimulator sim(base, sims_.empty() ? out + "/sims" : sims_,
                             executorOptions(executor_));
+    for (const std::string &warning : sim.labWarnings()) {
+        std::fprintf(stderr, "[gap] base: %s\n", warning.c_str());
+        set.notes.push_back(warning);
+    }
     gap::DiagnosisOptions options = diagnosisOptions(base);
     options.held_out = checkedHeldOut(held_out_, set, left_out);
     if (dry_run_)
@@ -349,6 +353,8 @@ int GapCommand::twin() const {
     const gap::Design design = gap::loadDesign(design_);
     gap::StudySimulator sim(base, sims_.empty() ? out_ + ".sims" : sims_,
                             executorOptions(executor_));
+    for (const std::string &warning : sim.labWarnings())
+        std::fprintf(stderr, "[gap] base: %s\n", warning.c_str());
     gap::TwinOptions o;
     o.seed = seed_;
     o.noise = noise_;

@@ -5,12 +5,14 @@
 #include "grainlink/config/ConfigNode.hpp"
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/LabSummary.hpp"
+#include "grainlink/lab/LabTest.hpp"
 #include "grainlink/study/ScenarioEdit.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <optional>
 #include <set>
 #include <sstream>
@@ -609,24 +611,39 @@ BaseModel loadBaseModel(const std::string &path) {
     return b;
 }
 
+namespace {
+
+/// A design of one experiment of `type` with one trial, nothing measured: what the base makes of
+/// such a test is read before any real experiment is.
+ExperimentSet standIn(ExperimentType type, const std::string &observable, Curve curve,
+                      std::map<std::string, double> numbers = {}) {
+    Experiment e;
+    e.id = testSectionOf(type);
+    e.type = type;
+    e.x_name = xNameOf(type);
+    e.observables = {observable};
+    e.numbers = std::move(numbers);
+    Trial t;
+    t.curves[observable] = std::move(curve);
+    e.trials.push_back(t);
+    ExperimentSet set;
+    set.experiments.push_back(e);
+    return set;
+}
+
+} // namespace
+
 StudySimulator::StudySimulator(BaseModel base, std::string directory,
                                study::ExecutorOptions executor)
     : base_(std::move(base)), directory_(std::move(directory)), executor_(std::move(executor)) {
+    collectLabWarnings();
     // A mole's run is read by `grainlink run`'s reader when a point runs, in a file the
     // diagnosis writes: a typo in the base's mole is said now, naming the base.
     const study::Kind run = study::standardKind("run", "");
     if (!base_.tests.count("mole") || !run.validate)
         return;
-    ExperimentSet stand_in;
-    Experiment e;
-    e.id = "mole";
-    e.type = ExperimentType::Mole;
-    e.x_name = xNameOf(e.type);
-    e.observables = {"depth_m"};
-    Trial t;
-    t.curves["depth_m"] = Curve{{0.0, 1.0}, {0.0, 0.0}};
-    e.trials.push_back(t);
-    stand_in.experiments.push_back(e);
+    const ExperimentSet stand_in =
+        standIn(ExperimentType::Mole, "depth_m", Curve{{0.0, 1.0}, {0.0, 0.0}});
     VariantRequest plain;
     plain.label = "base";
     try {
@@ -922,6 +939,37 @@ std::string StudySimulator::withBaseLine(const std::string &what) const {
         return what;
     const std::string where = baseLineOf(base_.path, what.substr(at + 5, end - at - 5));
     return where.empty() ? what : what + " (written in " + where + ")";
+}
+
+void StudySimulator::collectLabWarnings() {
+    // What the lab says of the base's direct shear box (one under ten grains across) is said
+    // once here, at the line of the base that wrote it, where it would otherwise sit unread in
+    // every run's log. An error is left to the runs' own check, which names it with its runs.
+    if (!base_.tests.count("direct_shear"))
+        return;
+    const ExperimentSet stand_in =
+        standIn(ExperimentType::DirectShear, "shear_stress_Pa", Curve{{0.0, 1.0e-3}, {0.0, 1.0}},
+                {{"normal_stress_Pa", 1.0e4}});
+    VariantRequest plain;
+    plain.label = "base";
+    try {
+        const lab::LabScenario scenario = lab::parseLabScenario(
+            "direct_shear",
+            ConfigNode::loadString(
+                study::emitYaml(scenarioNode(stand_in, {"direct_shear"}, plain, 0)), base_.path));
+        for (const std::string &w : lab::labWarnings(scenario)) {
+            const auto key = w.find("warning: '");
+            const auto end = key == std::string::npos ? key : w.find('\'', key + 10);
+            const std::string where =
+                end == std::string::npos
+                    ? ""
+                    : baseLineOf(base_.path, w.substr(key + 10, end - key - 10));
+            lab_warnings_.push_back(
+                (where.empty() ? base_.path : where) +
+                ": tests.direct_shear: " + (key == std::string::npos ? w : w.substr(key + 9)));
+        }
+    } catch (const std::exception &) {
+    }
 }
 
 std::vector<std::string> StudySimulator::runIds(const ExperimentSet &design,

@@ -725,6 +725,34 @@ TEST_CASE("a typo in the base model is named where the base wrote it, not only i
     fs::remove_all(scratch);
 }
 
+TEST_CASE("a direct shear box under ten grains across is said once, at the base's line, before "
+          "anything runs",
+          "[gap][simulator]") {
+    // The CI base's box is 30 mm for grains up to 4 mm: 7.5 diameters against ASTM D3080's 10.
+    const StudySimulator narrow(loadBaseModel(kDir + "/base.yaml"),
+                                (freshScratch("grainlink-gap-narrow-box") / "sims").string(), {});
+    REQUIRE(narrow.labWarnings().size() == 1);
+    CHECK_THAT(narrow.labWarnings()[0],
+               Catch::StartsWith(kDir + "/base.yaml:38: tests.direct_shear: ") &&
+                   Catch::Contains("'direct_shear.width_m': the box is 7.5 largest grain "
+                                   "diameters across") &&
+                   Catch::Contains("ASTM D3080"));
+    // 40 mm across is ten diameters: nothing to say.
+    const fs::path scratch = freshScratch("grainlink-gap-wide-box");
+    std::ifstream in(kDir + "/base.yaml");
+    std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    for (const std::string key : {"length_m: 0.03", "width_m: 0.03"}) {
+        const std::size_t at = text.find(key);
+        REQUIRE(at != std::string::npos);
+        text.replace(at, key.size(), key.substr(0, key.size() - 4) + "0.04");
+    }
+    std::ofstream(scratch / "base.yaml") << text;
+    const StudySimulator wide(loadBaseModel((scratch / "base.yaml").string()),
+                              (scratch / "sims").string(), {});
+    CHECK(wide.labWarnings().empty());
+    fs::remove_all(scratch);
+}
+
 TEST_CASE("a bed deeper than the base's bin is high is named with its experiment",
           "[gap][simulator]") {
     // bed_depth_m: 60 (mm meant) became a grain count of 5e7, refused as that count.

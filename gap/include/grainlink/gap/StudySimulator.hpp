@@ -86,6 +86,10 @@ public:
     std::vector<std::vector<std::string>>
     groups(const ExperimentSet &design, const std::vector<VariantRequest> &requests = {}) const;
 
+    /// The lab's warnings on the base's tests (a direct shear box under ten grains across),
+    /// each at the base's line that wrote the key: to be said before anything runs.
+    const std::vector<std::string> &labWarnings() const { return lab_warnings_; }
+
     int runsDone() const { return runs_done_; }
     int runsReused() const { return runs_reused_; }
 
@@ -120,10 +124,12 @@ private:
     std::vector<Overlay> overlaysOf(const Experiment &e) const;
     YAML::Node scenarioNode(const ExperimentSet &design, const std::vector<std::string> &group,
                             const VariantRequest &request, int seed) const;
+    void collectLabWarnings();
     BaseModel base_;
     std::string directory_;
     study::ExecutorOptions executor_;
     int runs_done_ = 0, runs_reused_ = 0;
+    std::vector<std::string> lab_warnings_;
 };
 
 } // namespace grainlink::gap
