@@ -120,7 +120,7 @@ std::vector<SoilTableRow> generateSoilTable(const SoilTableSpec &spec,
     std::optional<ReposeScenario> repose;
     if (!spec.repose_path.empty())
         repose = loadRepose(spec.repose_path);
-    for (const std::string &warning : shear.warnings) // deprecated spellings of the scenarios
+    for (const std::string &warning : shear.warnings) // old spellings, a box too narrow
         std::fprintf(stderr, "%s\n", warning.c_str());
     if (repose)
         for (const std::string &warning : repose->warnings)
