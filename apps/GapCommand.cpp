@@ -326,10 +326,8 @@ int GapCommand::diagnose() const {
     const std::string out = out_.empty() ? "out/gap/" + set.name : out_;
     gap::StudySimulator sim(base, sims_.empty() ? out + "/sims" : sims_,
                             executorOptions(executor_));
-    for (const std::string &warning : sim.labWarnings()) {
-        std::fprintf(stderr, "[gap] base: %s\n", warning.c_str());
-        set.notes.push_back(warning);
-    }
+    sim.sayLabWarnings();
+    set.notes.insert(set.notes.end(), sim.labWarnings().begin(), sim.labWarnings().end());
     gap::DiagnosisOptions options = diagnosisOptions(base);
     options.held_out = checkedHeldOut(held_out_, set, left_out);
     if (dry_run_)
@@ -353,8 +351,7 @@ int GapCommand::twin() const {
     const gap::Design design = gap::loadDesign(design_);
     gap::StudySimulator sim(base, sims_.empty() ? out_ + ".sims" : sims_,
                             executorOptions(executor_));
-    for (const std::string &warning : sim.labWarnings())
-        std::fprintf(stderr, "[gap] base: %s\n", warning.c_str());
+    sim.sayLabWarnings();
     gap::TwinOptions o;
     o.seed = seed_;
     o.noise = noise_;

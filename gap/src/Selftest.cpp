@@ -173,8 +173,7 @@ SelftestResult runSelftest(const SelftestOptions &o) {
         design);
     const std::string sims = o.sims.empty() ? o.out + "/sims" : o.sims;
     StudySimulator sim(base, sims, o.executor);
-    for (const std::string &warning : sim.labWarnings())
-        std::fprintf(stderr, "[gap] base: %s\n", warning.c_str());
+    sim.sayLabWarnings();
     fs::create_directories(o.out);
 
     // The twins: every catalogue effect (that can act on this base) at a random strength, the

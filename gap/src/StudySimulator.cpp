@@ -972,6 +972,11 @@ void StudySimulator::collectLabWarnings() {
     }
 }
 
+void StudySimulator::sayLabWarnings() const {
+    for (const std::string &warning : lab_warnings_)
+        std::fprintf(stderr, "[gap] base: %s\n", warning.c_str());
+}
+
 std::vector<std::string> StudySimulator::runIds(const ExperimentSet &design,
                                                 const VariantRequest &request) const {
     std::vector<Slot> slots;

@@ -89,6 +89,8 @@ public:
     /// The lab's warnings on the base's tests (a direct shear box under ten grains across),
     /// each at the base's line that wrote the key: to be said before anything runs.
     const std::vector<std::string> &labWarnings() const { return lab_warnings_; }
+    /// Prints them to stderr, one `[gap] base: ...` line each.
+    void sayLabWarnings() const;
 
     int runsDone() const { return runs_done_; }
     int runsReused() const { return runs_reused_; }
