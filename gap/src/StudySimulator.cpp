@@ -929,15 +929,22 @@ std::string baseLineOf(const std::string &base_path, const std::string &key) {
     }
 }
 
+/// Where the base wrote the key quoted right after `marker` in a message (the study's
+/// "key 'soil.x'", the lab's "warning: 'direct_shear.width_m'"); "" where it names none.
+std::string baseLineOfQuoted(const std::string &base_path, const std::string &what,
+                             const std::string &marker) {
+    const auto at = what.find(marker);
+    const auto end = at == std::string::npos ? at : what.find('\'', at + marker.size());
+    if (end == std::string::npos)
+        return "";
+    return baseLineOf(base_path, what.substr(at + marker.size(), end - at - marker.size()));
+}
+
 } // namespace
 
 std::string StudySimulator::withBaseLine(const std::string &what) const {
     // A generated scenario's error names its key; say where the base wrote it.
-    const auto at = what.find("key '");
-    const auto end = at == std::string::npos ? at : what.find('\'', at + 5);
-    if (end == std::string::npos)
-        return what;
-    const std::string where = baseLineOf(base_.path, what.substr(at + 5, end - at - 5));
+    const std::string where = baseLineOfQuoted(base_.path, what, "key '");
     return where.empty() ? what : what + " (written in " + where + ")";
 }
 
@@ -959,11 +966,7 @@ void StudySimulator::collectLabWarnings() {
                 study::emitYaml(scenarioNode(stand_in, {"direct_shear"}, plain, 0)), base_.path));
         for (const std::string &w : lab::labWarnings(scenario)) {
             const auto key = w.find("warning: '");
-            const auto end = key == std::string::npos ? key : w.find('\'', key + 10);
-            const std::string where =
-                end == std::string::npos
-                    ? ""
-                    : baseLineOf(base_.path, w.substr(key + 10, end - key - 10));
+            const std::string where = baseLineOfQuoted(base_.path, w, "warning: '");
             lab_warnings_.push_back(
                 (where.empty() ? base_.path : where) +
                 ": tests.direct_shear: " + (key == std::string::npos ? w : w.substr(key + 9)));
