@@ -16,8 +16,8 @@ int runLab(const LabOptions &options) {
     else if (options.check_factor != 0.0)
         throw std::invalid_argument("--check-factor needs --check walls or --check resolution");
     const lab::LabScenario scenario = lab::loadLabScenario(options.test, options.scenario_path);
-    for (const std::string &warning : lab::labWarnings(scenario))
-        std::fprintf(stderr, "%s\n", warning.c_str());
+    for (const config::KeyWarning &warning : lab::labWarnings(scenario))
+        std::fprintf(stderr, "%s\n", warning.text().c_str());
     lab::LabRunOptions run_options;
     run_options.output_directory = options.output_directory.empty()
                                        ? "out/" + lab::labScenarioName(scenario)

@@ -65,6 +65,14 @@ ConfigNode ConfigNode::loadString(const std::string &text, const std::string &na
     }
 }
 
+std::string KeyWarning::text() const {
+    return file + ":" + std::to_string(line) + ": warning: '" + key + "': " + message;
+}
+
+KeyWarning ConfigNode::warning(const std::string &message) const {
+    return {*file_, line(), path_, message};
+}
+
 void ConfigNode::fail(const std::string &message) const {
     std::ostringstream out;
     out << *file_ << ":" << line() << ": ";

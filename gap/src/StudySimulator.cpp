@@ -929,22 +929,17 @@ std::string baseLineOf(const std::string &base_path, const std::string &key) {
     }
 }
 
-/// Where the base wrote the key quoted right after `marker` in a message (the study's
-/// "key 'soil.x'", the lab's "warning: 'direct_shear.width_m'"); "" where it names none.
-std::string baseLineOfQuoted(const std::string &base_path, const std::string &what,
-                             const std::string &marker) {
-    const auto at = what.find(marker);
-    const auto end = at == std::string::npos ? at : what.find('\'', at + marker.size());
-    if (end == std::string::npos)
-        return "";
-    return baseLineOf(base_path, what.substr(at + marker.size(), end - at - marker.size()));
-}
-
 } // namespace
 
 std::string StudySimulator::withBaseLine(const std::string &what) const {
-    // A generated scenario's error names its key; say where the base wrote it.
-    const std::string where = baseLineOfQuoted(base_.path, what, "key '");
+    // A generated scenario's error names its key ("key 'soil.x'"); say where the base wrote it.
+    const std::string marker = "key '";
+    const auto at = what.find(marker);
+    const auto end = at == std::string::npos ? at : what.find('\'', at + marker.size());
+    const std::string where =
+        end == std::string::npos
+            ? ""
+            : baseLineOf(base_.path, what.substr(at + marker.size(), end - at - marker.size()));
     return where.empty() ? what : what + " (written in " + where + ")";
 }
 
@@ -964,12 +959,10 @@ void StudySimulator::collectLabWarnings() {
             "direct_shear",
             ConfigNode::loadString(
                 study::emitYaml(scenarioNode(stand_in, {"direct_shear"}, plain, 0)), base_.path));
-        for (const std::string &w : lab::labWarnings(scenario)) {
-            const auto key = w.find("warning: '");
-            const std::string where = baseLineOfQuoted(base_.path, w, "warning: '");
-            lab_warnings_.push_back(
-                (where.empty() ? base_.path : where) +
-                ": tests.direct_shear: " + (key == std::string::npos ? w : w.substr(key + 9)));
+        for (const config::KeyWarning &w : lab::labWarnings(scenario)) {
+            const std::string where = baseLineOf(base_.path, w.key);
+            lab_warnings_.push_back((where.empty() ? base_.path : where) +
+                                    ": tests.direct_shear: '" + w.key + "': " + w.message);
         }
     } catch (const std::exception &) {
     }

@@ -185,13 +185,12 @@ DirectShearScenario parseDirectShear(const config::ConfigNode &root) {
     if (grains_across < kMinGrainsAcross) {
         const auto key = t.width_m <= t.length_m ? b["width_m"] : b["length_m"];
         std::ostringstream msg;
-        msg << std::setprecision(3) << key.file() << ":" << key.line() << ": warning: '"
-            << key.path() << "': the box is " << grains_across
+        msg << std::setprecision(3) << "the box is " << grains_across
             << " largest grain diameters across (" << std::min(t.length_m, t.width_m) * 1e3
             << " mm for grains up to " << 2e3 * r_max << " mm); ASTM D3080 asks for at least "
             << kMinGrainsAcross
             << ", and below it the friction measured grows as the box narrows (docs/lab.md)";
-        s.warnings.push_back(msg.str());
+        s.warnings.push_back(key.warning(msg.str()));
     }
     root.finish();
     return s;

@@ -44,13 +44,13 @@ LoadServo ServoSpec::loadServo(double target_force_N) const {
     return servo;
 }
 
-std::string deprecationWarning(const config::ConfigNode &node, const std::string &spelling) {
-    return node.file() + ":" + std::to_string(node.line()) + ": warning: '" + node.path() +
-           "' is deprecated; write '" + spelling + "' instead (docs/lab.md)";
+config::KeyWarning deprecationWarning(const config::ConfigNode &node, const std::string &spelling) {
+    return node.warning("deprecated; write '" + spelling + "' instead (docs/lab.md)");
 }
 
 ServoSpec parseServo(const config::ConfigNode &node, const ServoSpec &defaults,
-                     std::vector<std::string> &warnings, const std::optional<ServoKeys> &old) {
+                     std::vector<config::KeyWarning> &warnings,
+                     const std::optional<ServoKeys> &old) {
     const ServoKeys block;
     const ServoKeys &names = old ? *old : block;
     // The key `key` (in `names`), whose `servo:` spelling is `block_key`.

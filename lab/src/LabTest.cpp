@@ -70,9 +70,10 @@ const std::string &labScenarioName(const LabScenario &scenario) {
     return std::visit([](const auto &s) -> const std::string & { return s.name; }, scenario);
 }
 
-const std::vector<std::string> &labWarnings(const LabScenario &scenario) {
-    return std::visit([](const auto &s) -> const std::vector<std::string> & { return s.warnings; },
-                      scenario);
+const std::vector<config::KeyWarning> &labWarnings(const LabScenario &scenario) {
+    return std::visit(
+        [](const auto &s) -> const std::vector<config::KeyWarning> & { return s.warnings; },
+        scenario);
 }
 
 void requireLabTest(const std::string &test) {

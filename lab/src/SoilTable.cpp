@@ -120,11 +120,11 @@ std::vector<SoilTableRow> generateSoilTable(const SoilTableSpec &spec,
     std::optional<ReposeScenario> repose;
     if (!spec.repose_path.empty())
         repose = loadRepose(spec.repose_path);
-    for (const std::string &warning : shear.warnings) // old spellings, a box too narrow
-        std::fprintf(stderr, "%s\n", warning.c_str());
+    for (const config::KeyWarning &warning : shear.warnings) // old spellings, a box too narrow
+        std::fprintf(stderr, "%s\n", warning.text().c_str());
     if (repose)
-        for (const std::string &warning : repose->warnings)
-            std::fprintf(stderr, "%s\n", warning.c_str());
+        for (const config::KeyWarning &warning : repose->warnings)
+            std::fprintf(stderr, "%s\n", warning.text().c_str());
     const auto start = std::chrono::steady_clock::now();
     std::vector<SoilTableRow> rows;
     const fs::path out(options.output_csv);

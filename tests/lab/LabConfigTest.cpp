@@ -68,11 +68,11 @@ TEST_CASE("Servo keys: the servo: block, and the annulus's old flat keys read th
     }
     // Each old key read is one warning naming its file, line and new spelling.
     REQUIRE(old.warnings.size() == 6);
-    CHECK_THAT(old.warnings[0], Contains("shear.yaml:26: warning: "
-                                         "'bevameter_shear.servo_gain_m_s_per_N' is deprecated; "
-                                         "write 'bevameter_shear.servo.gain_m_s_per_N'"));
-    CHECK_THAT(old.warnings[4], Contains("'bevameter_shear.load_hold_s'") &&
-                                    Contains("'bevameter_shear.servo.hold_s'"));
+    CHECK_THAT(old.warnings[0].text(),
+               Contains("shear.yaml:26: warning: 'bevameter_shear.servo_gain_m_s_per_N': "
+                        "deprecated; write 'bevameter_shear.servo.gain_m_s_per_N'"));
+    CHECK(old.warnings[4].key == "bevameter_shear.load_hold_s");
+    CHECK_THAT(old.warnings[4].message, Contains("'bevameter_shear.servo.hold_s'"));
 
     // The old spelling keeps its old defaults (a 0.01 m/s clamp, 0.02 s hold, 1 s to load);
     // the block asks for the clamp.
@@ -100,9 +100,9 @@ TEST_CASE("Servo keys: the box's max_consolidation_time_s is max_load_time_s", "
                                            "max_consolidation_time_s: 0.7}"));
     CHECK(old.test.servo.max_load_time_s == 0.7);
     REQUIRE(old.warnings.size() == 2); // and the tiny box's width (the next test)
-    CHECK_THAT(old.warnings[0], Contains("box.yaml:28: warning: "
-                                         "'direct_shear.servo.max_consolidation_time_s' is "
-                                         "deprecated; write 'direct_shear.servo.max_load_time_s'"));
+    CHECK_THAT(old.warnings[0].text(),
+               Contains("box.yaml:28: warning: 'direct_shear.servo.max_consolidation_time_s': "
+                        "deprecated; write 'direct_shear.servo.max_load_time_s'"));
     const auto block = parseBox(
         replacedOnce(kTinyShearBox, from, "control_interval_s: 0.00025, max_load_time_s: 0.7}"));
     CHECK(block.test.servo.max_load_time_s == 0.7);
@@ -126,10 +126,11 @@ TEST_CASE("Direct shear: a box narrower than ten grain diameters is warned about
     // The tiny box: 30 mm across, grains up to 2 x 2.25 mm: 6.67 diameters, under D3080's 10.
     const auto tiny = parseBox(kTinyShearBox);
     REQUIRE(tiny.warnings.size() == 1);
-    CHECK_THAT(tiny.warnings[0], Contains("box.yaml:19: warning: 'direct_shear.width_m'") &&
-                                     Contains("6.67 largest grain diameters across") &&
-                                     Contains("30 mm for grains up to 4.5 mm") &&
-                                     Contains("ASTM D3080 asks for at least 10"));
+    CHECK_THAT(tiny.warnings[0].text(),
+               Contains("box.yaml:19: warning: 'direct_shear.width_m': ") &&
+                   Contains("6.67 largest grain diameters across") &&
+                   Contains("30 mm for grains up to 4.5 mm") &&
+                   Contains("ASTM D3080 asks for at least 10"));
     // 45 mm is ten diameters: no warning.
     const auto wide =
         parseBox(replacedOnce(replacedOnce(kTinyShearBox, "length_m: 0.03", "length_m: 0.045"),
@@ -139,7 +140,8 @@ TEST_CASE("Direct shear: a box narrower than ten grain diameters is warned about
     const auto long_narrow =
         parseBox(replacedOnce(kTinyShearBox, "width_m: 0.03", "width_m: 0.06"));
     REQUIRE(long_narrow.warnings.size() == 1);
-    CHECK_THAT(long_narrow.warnings[0], Contains("box.yaml:18: warning: 'direct_shear.length_m'"));
+    CHECK(long_narrow.warnings[0].key == "direct_shear.length_m");
+    CHECK(long_narrow.warnings[0].line == 18);
 }
 
 TEST_CASE("Lab soil: keys a lab test would read and ignore are errors with their line",

@@ -21,6 +21,18 @@ public:
     using std::runtime_error::runtime_error;
 };
 
+/// Something about a key worth saying that is not an error (an old spelling, a box too narrow
+/// for its grains): where it was written kept apart from what is said, so that a caller can
+/// say it at another file's line (the gap's base model for the scenario made from it).
+struct KeyWarning {
+    std::string file;
+    int line = 0;
+    std::string key; ///< its path, e.g. direct_shear.width_m
+    std::string message;
+    /// `file:line: warning: 'key': message`
+    std::string text() const;
+};
+
 class ConfigNode {
 public:
     /// Loads a file; a YAML syntax error is reported with its line.
@@ -68,6 +80,8 @@ public:
     /// Throws on the first key of this mapping that was never read, suggesting a near match.
     void finish() const;
     [[noreturn]] void fail(const std::string &message) const;
+    /// This key's file, line and path with `message`: what `fail` says, as a warning.
+    KeyWarning warning(const std::string &message) const;
 
 private:
     /// Throws when `key` appears twice in this mapping, naming both lines.

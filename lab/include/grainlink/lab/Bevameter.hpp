@@ -1,6 +1,7 @@
 #pragma once
 // Virtual bevameter, pressure-sinkage: a circular plate pushed at constant speed into a settled
 // bed, p(z) per plate size, and Bekker's law fitted over the sizes (docs/lab.md).
+#include "grainlink/config/ConfigNode.hpp"
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/BekkerFit.hpp"
 #include "grainlink/lab/LabExperiment.hpp"
@@ -30,7 +31,7 @@ struct BevameterScenario {
     std::string name = "bevameter";
     dem::DemScenario soil;
     BevameterSpec test;
-    std::vector<std::string> warnings; ///< deprecated spellings read (file:line: what to write)
+    std::vector<config::KeyWarning> warnings; ///< deprecated spellings read
 };
 
 /// Reads `name`, `soil:` (the DEM soil keys of docs/scenario.md) and `bevameter:`.

@@ -42,7 +42,7 @@ struct DirectShearScenario {
     std::string name = "direct_shear";
     dem::DemScenario soil;
     DirectShearSpec test;
-    std::vector<std::string> warnings; ///< deprecated spellings read (file:line: what to write)
+    std::vector<config::KeyWarning> warnings; ///< deprecated spellings read, a box too narrow
 };
 
 /// Reads `name`, `soil:` (DEM soil keys of docs/scenario.md, without `walls`: the test builds

@@ -59,11 +59,11 @@ struct ServoKeys {
 /// `node` is a test section holding the servo under those older names: each key read adds a
 /// deprecation warning to `warnings` naming its `servo:` spelling.
 ServoSpec parseServo(const config::ConfigNode &node, const ServoSpec &defaults,
-                     std::vector<std::string> &warnings,
+                     std::vector<config::KeyWarning> &warnings,
                      const std::optional<ServoKeys> &old = std::nullopt);
 
-/// `file:line: warning: 'path' is deprecated; write 'spelling' instead` for a key read under an
+/// `file:line: warning: 'path': deprecated; write 'spelling' instead` for a key read under an
 /// old spelling.
-std::string deprecationWarning(const config::ConfigNode &node, const std::string &spelling);
+config::KeyWarning deprecationWarning(const config::ConfigNode &node, const std::string &spelling);
 
 } // namespace grainlink::lab

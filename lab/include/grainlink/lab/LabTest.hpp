@@ -33,8 +33,8 @@ std::string labTestName(const LabScenario &scenario);
 void requireLabTest(const std::string &test);
 /// The scenario's `name` (the default output directory is out/<name>).
 const std::string &labScenarioName(const LabScenario &scenario);
-/// Deprecated spellings its file used (file:line: warning: ...), to print.
-const std::vector<std::string> &labWarnings(const LabScenario &scenario);
+/// What its file is warned about (deprecated spellings, a direct shear box too narrow), to print.
+const std::vector<config::KeyWarning> &labWarnings(const LabScenario &scenario);
 
 /// Reads `path` as a scenario of `test`; throws std::invalid_argument naming the tests for an
 /// unknown one, config::ConfigError for a bad file.

@@ -1,6 +1,7 @@
 #pragma once
 // Angle of repose by the lifted-cylinder test: grains settle in an open tube standing on a rough
 // floor, the tube is lifted slowly, the heap that forms is measured (docs/lab.md).
+#include "grainlink/config/ConfigNode.hpp"
 #include "grainlink/dem/Scenario.hpp"
 #include "grainlink/lab/LabExperiment.hpp"
 
@@ -26,7 +27,7 @@ struct ReposeScenario {
     std::string name = "repose";
     dem::DemScenario soil;
     ReposeSpec test;
-    std::vector<std::string> warnings; ///< deprecated spellings read (file:line: what to write)
+    std::vector<config::KeyWarning> warnings; ///< deprecated spellings read
 };
 
 /// Reads `name`, `soil:` (DEM soil keys, docs/scenario.md, without `packing_cache_directory`:

@@ -56,7 +56,7 @@ struct ShearAnnulusScenario {
     std::string name = "bevameter_shear";
     dem::DemScenario soil;
     ShearAnnulusSpec test;
-    std::vector<std::string> warnings; ///< deprecated spellings read (file:line: what to write)
+    std::vector<config::KeyWarning> warnings; ///< deprecated spellings read
 };
 
 /// Reads `name`, `soil:` (the DEM soil keys of docs/scenario.md) and `bevameter_shear:`. The

@@ -67,7 +67,7 @@ struct WheelScenario {
     std::string name = "wheel";
     dem::DemScenario soil;
     WheelSpec test;
-    std::vector<std::string> warnings; ///< deprecated spellings read (none yet)
+    std::vector<config::KeyWarning> warnings; ///< deprecated spellings read (none yet)
 };
 
 /// Reads `name`, `soil:` (docs/scenario.md's soil keys, no walls' bodies) and `wheel:`.
