@@ -286,6 +286,9 @@ GapCommand::GapCommand(CLI::App &app) {
     import_csv_->add_option("--filter", csv_filter_,
                             "COLUMN=VALUE: only the rows holding it (one slip angle of a file "
                             "holding several)");
+    import_csv_->add_option("--trial", csv_trial_,
+                            "COLUMN telling apart trials written one after the other in a file "
+                            "(a run number): each value is one trial");
     import_csv_->add_option("--zero", csv_zero_,
                             "where x is zero: as_recorded, first_sample or "
                             "force_threshold=VALUE:UNIT");
@@ -407,6 +410,7 @@ int GapCommand::importCsv() const {
     csv.comment = csv_comment_;
     csv.columns = csv_columns_;
     csv.units_row = csv_units_row_;
+    csv.trial_column = csv_trial_;
     csv.id = csv_id_;
     csv.type = csv_type_;
     csv.scatter = csv_scatter_;

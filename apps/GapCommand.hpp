@@ -42,7 +42,7 @@ private:
     // selftest
     std::string scale_ = "ci", plan_;
     // import
-    std::string source_, sinkage_ = "synced", csv_id_, csv_type_, csv_x_, csv_zero_;
+    std::string source_, sinkage_ = "synced", csv_id_, csv_type_, csv_x_, csv_zero_, csv_trial_;
     std::vector<std::string> csv_files_, csv_y_, csv_conditions_, csv_columns_, csv_y_scale_,
         csv_filter_;
     double csv_x_scale_ = 1.0;

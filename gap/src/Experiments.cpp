@@ -286,6 +286,44 @@ void checkSigns(ExperimentType type, const Curve &curve, const ConfigNode &data,
                        signFix(type));
 }
 
+/// Refuses a file whose curve runs up its x, falls back to its start and runs up again: trials
+/// written one after the other (a stacked export, or a shear box reversed and sheared again),
+/// which read as one curve would bin each trial's start with the others' ends. `lines` holds
+/// each sample's file line. An unloading that ends the file is not a second trial.
+void refuseStackedTrials(const Experiment &e, const Curve &curve, const std::vector<int> &lines,
+                         const ConfigNode &data, const std::string &file) {
+    if (curve.x.size() < 4 || lines.size() != curve.x.size() ||
+        (e.type != ExperimentType::PlateSinkage && e.type != ExperimentType::DirectShear &&
+         e.type != ExperimentType::BevameterShear))
+        return;
+    const auto [lo, hi] = std::minmax_element(curve.x.begin(), curve.x.end());
+    const double range = *hi - *lo;
+    if (!(range > 0.0))
+        return;
+    // Past half the range, back within a tenth of the start, past half again: one restart.
+    std::vector<int> restarts;
+    bool risen = false;
+    int fell_at = 0;
+    for (std::size_t i = 0; i < curve.x.size(); ++i) {
+        const double u = (curve.x[i] - *lo) / range;
+        if (u >= 0.5) {
+            if (fell_at)
+                restarts.push_back(fell_at);
+            risen = true, fell_at = 0;
+        } else if (risen && u <= 0.1) {
+            risen = false, fell_at = lines[i];
+        }
+    }
+    if (restarts.empty())
+        return;
+    data["x"].fail(file + ":" + std::to_string(restarts.front()) + ": " + e.x_name +
+                   " falls back to its start here and runs up again (" +
+                   std::to_string(restarts.size()) +
+                   " time(s) in the file): " + std::to_string(restarts.size() + 1) +
+                   " trials one after the other? give data.trial: the column that tells them "
+                   "apart (import csv: --trial COLUMN), or one file per trial");
+}
+
 /// Refuses a wheel's sinkage given z up: every run's sinkage at or below zero, one below.
 void checkWheelSinkage(const Experiment &e, const ConfigNode &data) {
     bool below = false, above = false;
@@ -662,6 +700,10 @@ ExperimentSet loadExperiments(const std::string &directory) {
             std::replace(e.observables.begin(), e.observables.end(), std::string("force_N"),
                          std::string("pressure_Pa"));
             const auto filter = data.optional("filter");
+            // A file holding several trials one after the other, told apart by a column.
+            const auto trial_column = data.optional("trial");
+            if (trial_column && e.scatter)
+                trial_column->fail("a scatter's rows are its trials already: no trial column");
             const TableFormat format = parseTableFormat(data);
             const ConfigNode x_node = data["x"];
             // Every key of data: read by now: a misspelt one is said before a file that it
@@ -690,8 +732,27 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     for (const auto &key : filter->keys())
                         keep.emplace_back(columnOf(table, key, (*filter)[key]),
                                           (*filter)[key].number());
-                Trial whole;
-                whole.source = path.string();
+                const std::optional<std::size_t> tcol =
+                    trial_column ? std::optional<std::size_t>(
+                                       columnOf(table, trial_column->text(), *trial_column))
+                                 : std::nullopt;
+                // The file's trials: one, or one per value of the trial column, in file order;
+                // each with the line of every sample (its first observable's).
+                std::vector<std::pair<std::string, Trial>> wholes;
+                std::vector<std::vector<int>> sample_lines;
+                const auto trialOf = [&](const std::string &value) -> std::size_t {
+                    for (std::size_t i = 0; i < wholes.size(); ++i)
+                        if (wholes[i].first == value)
+                            return i;
+                    Trial t;
+                    t.source = path.string() +
+                               (tcol ? " (" + table.header[*tcol] + " " + value + ")" : "");
+                    wholes.emplace_back(value, std::move(t));
+                    sample_lines.emplace_back();
+                    return wholes.size() - 1;
+                };
+                if (!tcol)
+                    trialOf("");
                 // A value missing (empty, NaN) leaves that sample out, and is said: a sensor's
                 // dropout is no reason to refuse the file; a word where a number belongs is.
                 std::vector<int> gaps;
@@ -702,6 +763,11 @@ ExperimentSet loadExperiments(const std::string &directory) {
                                    std::abs(table.number(r, c) - v) <= 1e-9 * (1 + std::abs(v));
                     if (!selected)
                         continue;
+                    if (tcol && table.missing(r, *tcol)) {
+                        gaps.push_back(table.lines[r]);
+                        continue;
+                    }
+                    const std::size_t into = tcol ? trialOf(table.rows[r][*tcol]) : 0;
                     // No x: the row gives nothing; no y: that observable's sample is left out.
                     const bool no_x = table.missing(r, xcol);
                     bool gap = no_x;
@@ -723,9 +789,11 @@ ExperimentSet loadExperiments(const std::string &directory) {
                             gap = true;
                             continue;
                         }
-                        Curve &curve = e.scatter ? t.curves[o] : whole.curves[o];
+                        Curve &curve = e.scatter ? t.curves[o] : wholes[into].second.curves[o];
                         curve.x.push_back(x);
                         curve.y.push_back(table.number(r, c) * fac);
+                        if (o == std::get<0>(ycols.front()))
+                            sample_lines[into].push_back(table.lines[r]);
                     }
                     if (gap)
                         gaps.push_back(table.lines[r]);
@@ -742,7 +810,10 @@ ExperimentSet loadExperiments(const std::string &directory) {
                                         "those samples are left out (lines " +
                                         where + (gaps.size() > 5 ? ", ..." : "") + ")");
                 }
-                if (!e.scatter) {
+                if (wholes.empty() && !e.scatter)
+                    f.fail("no rows of " + path.string() + " pass the filter");
+                for (std::size_t w = 0; w < wholes.size() && !e.scatter; ++w) {
+                    Trial &whole = wholes[w].second;
                     // No row passed the filter: no curve was started at all.
                     if (whole.curves.empty() || whole.curves.begin()->second.empty())
                         f.fail("no rows of " + path.string() + " pass the filter");
@@ -751,7 +822,10 @@ ExperimentSet loadExperiments(const std::string &directory) {
                         if (curve.x.size() < 2)
                             f.fail(path.string() + ": '" + o + "' has " +
                                    std::to_string(curve.x.size()) + " sample(s) with " + e.x_name +
-                                   " and a value; a curve needs two or more");
+                                   " and a value" +
+                                   (tcol ? " in " + table.header[*tcol] + " " + wholes[w].first
+                                         : std::string()) +
+                                   "; a curve needs two or more");
                     // Every sample at one x: the wrong column, or the x of a constant.
                     for (const auto &[o, curve] : whole.curves) {
                         const double first = curve.x.front();
@@ -761,6 +835,9 @@ ExperimentSet loadExperiments(const std::string &directory) {
                                            e.x_name + " = " + std::to_string(first) +
                                            ": the x column does not vary (is it the right one?)");
                     }
+                    if (!tcol)
+                        refuseStackedTrials(e, whole.curves.begin()->second, sample_lines[w], data,
+                                            path.string());
                     // A plate or shear curve recorded in time order that runs back after its
                     // largest x (unloaded, reversed) keeps its loading branch: binned with it,
                     // the other branch would read low against a loading-only simulation.

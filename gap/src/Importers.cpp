@@ -330,6 +330,7 @@ std::string withImportOptions(std::string message) {
         {"data.units_row: true", "--units-row"},
         {"data.columns", "--columns"},
         {"data.skip_lines", "--skip-lines"},
+
         {"start it with data.comment", "start it with the mark of --comment"},
         {"data.comment", "--comment"}};
     for (const auto &[key, option] : keys)
@@ -446,6 +447,11 @@ std::vector<std::string> checkOptions(const CsvImport &csv, ExperimentType type,
                                         obs + "=COLUMN:UNIT to scale");
         checkScale("--y-scale " + obs + "=" + numberText(scale), scale);
     }
+    if (!csv.trial_column.empty() && (scalar || csv.scatter))
+        throw std::invalid_argument(
+            "--trial " + csv.trial_column + ": a " +
+            (scalar ? csv.type + "'s values" : std::string("scatter's rows")) +
+            " are its trials already");
     if (!csv.zero_method.empty()) {
         if (scalar)
             throw std::invalid_argument(zeroOption(csv) + ": a " + csv.type + " has no x to zero");
@@ -580,6 +586,8 @@ YAML::Node experimentNode(const CsvImport &csv, bool scalar, const std::vector<D
         data["files"] = flow(YAML::Node(copies));
         if (csv.scatter)
             data["scatter"] = true;
+        if (!csv.trial_column.empty())
+            data["trial"] = csv.trial_column;
         YAML::Node x;
         x["column"] = csv.x_column;
         x["unit"] = csv.x_unit;
@@ -643,7 +651,10 @@ std::string asImportInput(const std::string &message, const CsvImport &csv, cons
             text = (option.empty() ? "" : option + ": ") + rest;
     }
     const std::pair<std::string, std::string> keys[] = {
-        {"conditions.", "--condition "}, {"give unit: \"%\"", "give --x " + csv.x_column + ":%"}};
+        {"conditions.", "--condition "},
+        {"give unit: \"%\"", "give --x " + csv.x_column + ":%"},
+        {"data.trial: the column that tells them apart (import csv: --trial COLUMN)",
+         "--trial COLUMN, the column that tells them apart"}};
     for (const auto &[key, option] : keys)
         for (std::size_t at; (at = text.find(key)) != std::string::npos;)
             text.replace(at, key.size(), option);
@@ -705,11 +716,17 @@ std::vector<std::string> importCsv(const CsvImport &csv, const std::string &out)
         columns.push_back(csv.x_column);
     for (const auto &[obs, col] : csv.y)
         columns.push_back(col.first);
+    // What each copy keeps: the columns read, and the trial column (a run's name or number).
+    std::vector<std::string> copied = columns;
+    if (!csv.trial_column.empty())
+        copied.push_back(csv.trial_column);
     std::vector<DataTable> tables;
     for (const std::string &file : csv.files) {
         try {
             tables.push_back(filtered(readDataTable(file, format), csv.filter));
             const DataTable &c = tables.back();
+            if (!csv.trial_column.empty())
+                column(c, csv.trial_column);
             for (const std::string &name : columns) {
                 const std::size_t col = column(c, name);
                 for (std::size_t r = 0; r < c.rows.size(); ++r)
@@ -763,7 +780,7 @@ std::vector<std::string> importCsv(const CsvImport &csv, const std::string &out)
     fs::create_directories(dst / "data");
     try {
         for (std::size_t k = 0; k < copies.size(); ++k)
-            writeColumns(tables[k], columns, csv.files[k], copy_paths[k],
+            writeColumns(tables[k], copied, csv.files[k], copy_paths[k],
                          "imported by grainlink gap import csv" + rows);
         root["experiments"].push_back(e);
         save(root, yaml, "# Measurements for grainlink gap (docs/gap.md).\n");

@@ -95,6 +95,66 @@ TEST_CASE("experiments.yaml: repeats in SI, and their mean and scatter per bin",
     CHECK((sim - m.value).cwiseAbs().maxCoeff() < 1e-6);
 }
 
+TEST_CASE("experiments.yaml: trials written one after the other in a file are refused as one "
+          "curve, and read apart by their trial column",
+          "[gap][experiments]") {
+    // The three trials of the test above, stacked in one file as another code exports them,
+    // each with its run number; a comment line and the header come first (lines 1 and 2).
+    const fs::path dir = folder("stacked");
+    {
+        std::ofstream out(dir / "all.csv");
+        out << "# three runs\nrun,sinkage_mm,pressure_kPa\n";
+        for (int run = 1; run <= 3; ++run)
+            for (int i = 0; i <= 24; ++i)
+                out << run << ',' << 0.5 * i << ',' << run * 0.5 * i << '\n';
+    }
+    const std::string yaml = "name: test\nexperiments:\n"
+                             "  - id: p60\n    type: plate_sinkage\n"
+                             "    conditions: {plate_diameter_m: 0.06, box: large}\n"
+                             "    data:\n      files: [all.csv]\n"
+                             "      x: {column: sinkage_mm, unit: mm}\n"
+                             "      y: {pressure_Pa: {column: pressure_kPa, unit: kPa}}\n";
+    // Read as one curve, each bin would hold the three runs' samples: refused where the second
+    // run starts (file line 2 + 25 + 1 = 28), with the key that reads it apart.
+    checkRefused(dir, yaml,
+                 "all.csv:28: sinkage_m falls back to its start here and runs up "
+                 "again (2 time(s) in the file): 3 trials one after the other? give "
+                 "data.trial");
+    // By its trial column: the three trials of three files, the same mean and scatter.
+    write(dir / "experiments.yaml", yaml + "      trial: run\n");
+    const ExperimentSet set = loadExperiments(dir.string());
+    const Experiment &e = set.experiments.at(0);
+    REQUIRE(e.trials.size() == 3);
+    CHECK(e.trials[1].curves.at("pressure_Pa").y.back() == Approx(2.0 * 12.0 * 1000.0));
+    CHECK(e.trials[2].source.find("(run 3)") != std::string::npos);
+    const FeatureDesign d = designFeatures(set, 6);
+    const Measured m = measure(set, d);
+    CHECK(m.value[2] == Approx(10000.0)); // bin [4, 6] mm: 5, 10, 15 kPa, as above
+    CHECK(m.u_D[2] == Approx(5000.0 / std::sqrt(3.0)));
+    CHECK(m.trials[2] == 3);
+
+    // One trial unloaded to its start at the end is one trial, its loading branch kept.
+    {
+        std::ofstream out(dir / "all.csv");
+        out << "sinkage_mm,pressure_kPa\n";
+        for (int i = 0; i <= 24; ++i)
+            out << 0.5 * i << ',' << 0.5 * i << '\n';
+        for (int i = 23; i >= 0; --i)
+            out << 0.5 * i << ',' << 0.1 * i << '\n';
+    }
+    write(dir / "experiments.yaml", yaml);
+    CHECK(loadExperiments(dir.string()).experiments.at(0).trials.size() == 1);
+    // A trial column where each row is a trial already, or that is not in the file.
+    checkRefused(dir,
+                 "name: test\nexperiments:\n  - id: w\n    type: wheel_steady_state\n"
+                 "    data:\n      files: [all.csv]\n      scatter: true\n      trial: run\n"
+                 "      x: {column: sinkage_mm, unit: \"-\"}\n"
+                 "      y: {traction_N: {column: pressure_kPa, unit: N}}\n",
+                 "experiments.yaml:8: key 'experiments[0].data.trial': a scatter's rows are "
+                 "its trials already");
+    checkRefused(dir, yaml + "      trial: run\n", "'run'");
+}
+
 // The factors against NIST SP 811's table (B.9, to 7 digits) and by hand: a table entry
 // mistyped, or a unit taken for one of another kind, fails here.
 TEST_CASE("units as other tools and the older literature write them convert to SI",

@@ -391,3 +391,32 @@ TEST_CASE("import csv says a column that varies within a scatter, and --filter t
     CHECK_THROWS_WITH(importCsv(csv, out.string()),
                       "--filter beta_deg=30: no row of " + csv.files[0] + " holds it");
 }
+
+TEST_CASE("import csv reads trials written one after the other by their --trial column",
+          "[gap][import]") {
+    const fs::path out = scratch("csv-trial");
+    // Two runs in one file, the second starting on input line 6 (title, units, three rows).
+    CsvImport csv = plate(writeInput("trial", "\"Sinkage, mm\",\"Pressure, kPa\",Run\nmm,kPa,-\n"
+                                              "0.0,0.0,A\n1.0,12.0,A\n2.0,20.0,A\n"
+                                              "0.0,0.0,B\n1.0,14.0,B\n2.0,22.0,B\n"));
+    // Without --trial the runs would be one curve: refused at the input's line, by the option.
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      Catch::Contains(csv.files[0] + ":6: sinkage_m falls back to its start") &&
+                          Catch::Contains("give --trial COLUMN") && !Catch::Contains("data/"));
+    CHECK_FALSE(fs::exists(out));
+    csv.trial_column = "Run";
+    importCsv(csv, out.string());
+    const Experiment &e = loadExperiments(out.string()).find("p40");
+    REQUIRE(e.trials.size() == 2);
+    CHECK(e.trials[1].curves.at("pressure_Pa").y.back() == Approx(22000.0));
+    // A scatter's rows are its trials already; a trial column the file lacks is named.
+    CsvImport scatter = csv;
+    scatter.id = "w";
+    scatter.scatter = true;
+    CHECK_THROWS_WITH(importCsv(scatter, out.string()),
+                      Catch::StartsWith("--trial Run: a scatter's rows are its trials already"));
+    CsvImport missing = csv;
+    missing.id = "p41";
+    missing.trial_column = "run_no";
+    CHECK_THROWS_WITH(importCsv(missing, out.string()), Catch::Contains("'run_no'"));
+}

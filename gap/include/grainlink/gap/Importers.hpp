@@ -44,6 +44,9 @@ struct CsvImport {
     /// Only the rows holding these values (column -> value): one experiment of a file that
     /// holds several (a wheel's slip angles). The copy keeps just those rows.
     std::map<std::string, double> filter;
+    /// The column telling apart trials written one after the other in a file (a run number):
+    /// experiments.yaml's `data.trial`. Empty: each file is one trial.
+    std::string trial_column;
     /// experiments.yaml's `zero:`: "" (none written: as_recorded), "as_recorded",
     /// "first_sample" or "force_threshold" with its threshold in `zero_unit`.
     std::string zero_method;
