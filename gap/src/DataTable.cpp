@@ -1,5 +1,7 @@
 #include "DataTable.hpp"
 
+#include "grainlink/gap/Experiments.hpp"
+
 #include "grainlink/config/Number.hpp"
 
 #include "grainlink/config/ConfigNode.hpp"
@@ -215,6 +217,8 @@ DataTable readDataTable(const std::string &path, const TableFormat &format) {
         }
         if (units_row) {
             units_row = false;
+            t.units = std::move(cells);
+            t.units_line = number;
             continue;
         }
         // More cells than columns: a delimiter inside a number (0,5 in a comma-separated
@@ -260,6 +264,28 @@ DataTable readDataTable(const std::string &path, const TableFormat &format) {
     if (t.rows.empty())
         throw config::ConfigError("data file " + path + " has no data rows");
     return t;
+}
+
+std::string unitsRowDisagreement(const DataTable &table, std::size_t col, const std::string &unit,
+                                 const std::string &dimension) {
+    if (col >= table.units.size())
+        return "";
+    // "[mm]", "(kPa)", " mm ": the unit inside.
+    std::string cell = trimmed(table.units[col]);
+    if (cell.size() >= 2 && (cell.front() == '[' || cell.front() == '(') &&
+        (cell.back() == ']' || cell.back() == ')'))
+        cell = trimmed(cell.substr(1, cell.size() - 2));
+    double row = 0.0, given = 0.0;
+    try {
+        row = unitFactor(cell, dimension);
+        given = unitFactor(unit, dimension);
+    } catch (const std::invalid_argument &) {
+        return ""; // not a unit of this kind: the row says nothing to check
+    }
+    if (std::abs(row - given) <= 1e-9 * std::abs(given))
+        return "";
+    return table.file + ":" + std::to_string(table.units_line) + ": the units row gives column '" +
+           table.header[col] + "' in '" + cell + "', but it is read in '" + unit + "'";
 }
 
 } // namespace grainlink::gap

@@ -39,6 +39,9 @@ struct DataTable {
     bool header_given = false; ///< the names came from data.columns, not from the file
     /// The last comment line above the header: another code's column names (LIGGGHTS').
     std::string names_comment;
+    /// The row of units under the header (`units_row`), and its line; empty without one.
+    std::vector<std::string> units;
+    int units_line = 0;
 
     /// The column of that name; none when it is missing. Throws when two columns share it.
     std::optional<std::size_t> find(const std::string &name) const;
@@ -54,6 +57,12 @@ struct DataTable {
     /// file, line and column.
     double number(std::size_t row, std::size_t col) const;
 };
+
+/// Where the units row gives column `col` another unit than `unit` (of `dimension`): the
+/// file, the row's line and both units; "" where it agrees, is absent, or holds no unit of
+/// that kind ("-", a word): a column declared in m whose file says mm reads 1000 times too deep.
+std::string unitsRowDisagreement(const DataTable &table, std::size_t col, const std::string &unit,
+                                 const std::string &dimension);
 
 /// Names quoted and comma-separated ('Sinkage, mm', 'Pressure, kPa'): a name holding a comma
 /// or a blank reads as one name. Every list of columns in a message is written by it.

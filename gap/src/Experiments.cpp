@@ -10,6 +10,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -239,6 +240,9 @@ std::pair<std::size_t, double> axisColumn(const ConfigNode &node, const DataTabl
     } catch (const std::invalid_argument &e) {
         node["unit"].fail(e.what());
     }
+    if (const std::string why = unitsRowDisagreement(table, col, unit, dimensionOf(si_name));
+        !why.empty())
+        node["unit"].fail(why);
     // Another code's sign convention (z up: a sinkage and a plate force come out negative).
     const double scale = node.number("scale", 1.0);
     if (scale == 0.0 || !std::isfinite(scale))
@@ -322,6 +326,35 @@ void refuseStackedTrials(const Experiment &e, const Curve &curve, const std::vec
                    " time(s) in the file): " + std::to_string(restarts.size() + 1) +
                    " trials one after the other? give data.trial: the column that tells them "
                    "apart (import csv: --trial COLUMN), or one file per trial");
+}
+
+/// Says a shear test whose shear stress stands far outside a soil's friction against its normal
+/// stress (more than 5 times it, or under 1/20 of it: tan 79 deg, tan 3 deg): a stress in kPa
+/// read as Pa on one side gives 1000 times too much or too little. Said, not refused: a strongly
+/// cohesive soil under a light load may stand above 5.
+void sayUnlikelyStressRatio(const Experiment &e, std::vector<std::string> &notes) {
+    const char *normal = e.type == ExperimentType::DirectShear      ? "normal_stress_Pa"
+                         : e.type == ExperimentType::BevameterShear ? "normal_pressure_Pa"
+                                                                    : nullptr;
+    const auto sigma = normal ? e.numbers.find(normal) : e.numbers.end();
+    if (sigma == e.numbers.end() || !(sigma->second > 0.0))
+        return;
+    double tau = 0.0;
+    for (const Trial &t : e.trials)
+        if (const auto c = t.curves.find("shear_stress_Pa"); c != t.curves.end())
+            for (double y : c->second.y)
+                tau = std::max(tau, y);
+    if (!(tau > 0.0))
+        return;
+    const double ratio = tau / sigma->second;
+    if (ratio <= 5.0 && ratio >= 0.05)
+        return;
+    std::ostringstream m;
+    m << std::setprecision(3) << "experiment '" << e.id << "': shear stress up to " << tau
+      << " Pa under " << normal << " " << sigma->second << " (" << ratio
+      << " times it): is one of them in kPa? (conditions and columns read in Pa: "
+      << sigma->second * 1000.0 << " for " << sigma->second << " kPa)";
+    notes.push_back(m.str());
 }
 
 /// Refuses a wheel's sinkage given z up: every run's sinkage at or below zero, one below.
@@ -835,6 +868,22 @@ ExperimentSet loadExperiments(const std::string &directory) {
                                            e.x_name + " = " + std::to_string(first) +
                                            ": the x column does not vary (is it the right one?)");
                     }
+                    // A length beyond any lab test's (10 m of sinkage under a 20 mm plate): a
+                    // column in mm read in m.
+                    if (dimensionOf(e.x_name) == "length")
+                        for (const auto &[o, curve] : whole.curves) {
+                            double far = 0.0;
+                            for (double x : curve.x)
+                                far = std::max(far, std::abs(x));
+                            if (far > kLongestLabSize_m) {
+                                std::ostringstream m;
+                                m << path.string() << ": " << e.x_name << " reaches " << far
+                                  << " m, beyond a lab test's " << kLongestLabSize_m
+                                  << " m: is the column in mm? (read in '" << x_node["unit"].text()
+                                  << "')";
+                                x_node["unit"].fail(m.str());
+                            }
+                        }
                     if (!tcol)
                         refuseStackedTrials(e, whole.curves.begin()->second, sample_lines[w], data,
                                             path.string());
@@ -862,6 +911,7 @@ ExperimentSet loadExperiments(const std::string &directory) {
                 files.fail("no data: give at least one file (and rows that pass the filter)");
             if (y.has("sinkage_m"))
                 checkWheelSinkage(e, data);
+            sayUnlikelyStressRatio(e, set.notes);
             if (filter)
                 filter->finish();
         }

@@ -727,6 +727,17 @@ std::vector<std::string> importCsv(const CsvImport &csv, const std::string &out)
             const DataTable &c = tables.back();
             if (!csv.trial_column.empty())
                 column(c, csv.trial_column);
+            // The file's own units row against the options' units.
+            if (!scalar)
+                if (const std::string why = unitsRowDisagreement(
+                        c, column(c, csv.x_column), csv.x_unit, dimensionOf(xNameOf(type)));
+                    !why.empty())
+                    throw std::invalid_argument(xOption(csv) + ": " + why);
+            for (const auto &[obs, col] : csv.y)
+                if (const std::string why =
+                        unitsRowDisagreement(c, column(c, col.first), col.second, dimensionOf(obs));
+                    !why.empty())
+                    throw std::invalid_argument(yOption(csv, obs) + ": " + why);
             for (const std::string &name : columns) {
                 const std::size_t col = column(c, name);
                 for (std::size_t r = 0; r < c.rows.size(); ++r)

@@ -855,3 +855,54 @@ TEST_CASE("an unknown experiment id is named with the set's ids", "[gap][experim
     CHECK_THROWS_WITH(set.find("p6"), Catch::Contains("no experiment 'p6'") &&
                                           Catch::Contains("(its experiments: p60)"));
 }
+
+TEST_CASE("experiments.yaml: a unit the file's units row contradicts, a sinkage beyond a lab's "
+          "size and a shear stress 1000 times its normal stress are said",
+          "[gap][experiments]") {
+    const fs::path dir = folder("units-row");
+    write(dir / "a.csv", "depth;p\n[mm];(kPa)\n0;0\n5;10\n10;21\n");
+    const std::string plate = "name: test\nexperiments:\n"
+                              "  - id: p20\n    type: plate_sinkage\n"
+                              "    conditions: {plate_diameter_m: 0.02}\n"
+                              "    data:\n      files: [a.csv]\n      delimiter: \";\"\n"
+                              "      units_row: true\n";
+    // The row says mm, the key m: 10 m of sinkage. Named at the units row's line (2).
+    checkRefused(dir,
+                 plate + "      x: {column: depth, unit: m}\n"
+                         "      y: {pressure_Pa: {column: p, unit: kPa}}\n",
+                 "a.csv:2: the units row gives column 'depth' in 'mm', but it is read in 'm'");
+    checkRefused(dir,
+                 plate + "      x: {column: depth, unit: mm}\n"
+                         "      y: {pressure_Pa: {column: p, unit: Pa}}\n",
+                 "column 'p' in 'kPa', but it is read in 'Pa'");
+    write(dir / "experiments.yaml", plate + "      x: {column: depth, unit: mm}\n"
+                                            "      y: {pressure_Pa: {column: p, unit: kPa}}\n");
+    CHECK(loadExperiments(dir.string()).experiments.at(0).trials.size() == 1);
+    // Without a units row to say so, a sinkage in mm read in m reaches 10 m: refused.
+    write(dir / "b.csv", "depth,p\n0,0\n5,10\n10,21\n");
+    checkRefused(dir,
+                 "name: test\nexperiments:\n  - id: p20\n    type: plate_sinkage\n"
+                 "    conditions: {plate_diameter_m: 0.02}\n"
+                 "    data:\n      files: [b.csv]\n      x: {column: depth, unit: m}\n"
+                 "      y: {pressure_Pa: {column: p, unit: kPa}}\n",
+                 "b.csv: sinkage_m reaches 10 m, beyond a lab test's 2 m: is the column in mm?");
+
+    // A shear box at "4" Pa (4 kPa meant) shearing at up to 2.9 kPa: said, and read on.
+    write(dir / "s.csv", "d_mm,tau_kPa\n0,0\n1,2.1\n2,2.9\n");
+    const auto shear = [&](const std::string &sigma) {
+        write(dir / "experiments.yaml",
+              "name: test\nexperiments:\n  - id: s4\n    type: direct_shear\n"
+              "    conditions: {normal_stress_Pa: " +
+                  sigma +
+                  "}\n    data:\n      files: [s.csv]\n      x: {column: d_mm, unit: mm}\n"
+                  "      y: {shear_stress_Pa: {column: tau_kPa, unit: kPa}}\n");
+        return loadExperiments(dir.string()).notes;
+    };
+    const auto notes = shear("4");
+    REQUIRE(notes.size() == 1);
+    CHECK_THAT(notes[0], Catch::Contains("experiment 's4': shear stress up to 2.9e+03 Pa under "
+                                         "normal_stress_Pa 4 (725 times it): is one of them in "
+                                         "kPa?"));
+    CHECK(shear("4000").empty());        // tan 36 deg
+    CHECK(shear("4000000").size() == 1); // 1/1380 of it: the shear stress in Pa, read in kPa?
+}

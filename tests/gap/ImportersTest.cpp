@@ -420,3 +420,18 @@ TEST_CASE("import csv reads trials written one after the other by their --trial 
     missing.trial_column = "run_no";
     CHECK_THROWS_WITH(importCsv(missing, out.string()), Catch::Contains("'run_no'"));
 }
+
+TEST_CASE("import csv holds the options' units to the file's own units row", "[gap][import]") {
+    const fs::path out = scratch("csv-unitsrow");
+    CsvImport csv = plate(writeInput("unitsrow", kPlateRun)); // its units row: mm, kPa
+    csv.x_unit = "m";
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      Catch::StartsWith("--x Sinkage, mm:m: " + csv.files[0] +
+                                        ":2: the units row gives column 'Sinkage, mm' in 'mm', "
+                                        "but it is read in 'm'"));
+    csv.x_unit = "mm";
+    csv.y["pressure_Pa"].second = "Pa";
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      Catch::StartsWith("--y pressure_Pa=Pressure, kPa:Pa: "));
+    CHECK_FALSE(fs::exists(out));
+}
