@@ -1,5 +1,6 @@
 #include "grainlink/config/ConfigNode.hpp"
 
+#include <algorithm>
 #include <cctype>
 #include <cmath>
 #include <cstdlib>
@@ -34,6 +35,31 @@ bool otherUnit(const std::string &a, const std::string &b) {
     return a != b && stem(a) == stem(b) && units.count(suffix(a)) && units.count(suffix(b));
 }
 } // namespace
+
+bool misspelling(const std::string &a, const std::string &b) {
+    std::string x = a, y = b;
+    for (char &c : x)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    for (char &c : y)
+        c = char(std::tolower(static_cast<unsigned char>(c)));
+    if (x == y)
+        return a != b;
+    // Levenshtein distance, one row at a time.
+    std::vector<std::size_t> row(y.size() + 1);
+    for (std::size_t j = 0; j <= y.size(); ++j)
+        row[j] = j;
+    for (std::size_t i = 1; i <= x.size(); ++i) {
+        std::size_t diagonal = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= y.size(); ++j) {
+            const std::size_t up = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diagonal + (x[i - 1] != y[j - 1])});
+            diagonal = up;
+        }
+    }
+    const std::size_t d = row[y.size()], n = std::min(x.size(), y.size());
+    return (n >= 4 && d <= 1) || (n >= 8 && d <= 2);
+}
 
 ConfigNode::ConfigNode(YAML::Node node, std::shared_ptr<const std::string> file, std::string path)
     : node_(std::move(node)), file_(std::move(file)), path_(std::move(path)),
@@ -126,6 +152,13 @@ ConfigNode ConfigNode::operator[](const std::string &key) const {
         }
         std::ostringstream out;
         out << *file_ << ":" << line() << ": missing key '" << child_path << "'";
+        // Said as missing still (the other may be a key of its own), with the likely typo.
+        for (const auto &entry : node_)
+            if (const std::string other = keyText(entry.first); misspelling(other, key)) {
+                out << " ('" << other << "' at line " << entry.first.Mark().line + 1
+                    << " misspelt?)";
+                break;
+            }
         throw ConfigError(out.str());
     }
     return ConfigNode(child, file_, child_path);
@@ -325,6 +358,8 @@ void ConfigNode::finish() const {
         for (const std::string &known : *used_)
             if (otherUnit(known, key))
                 hint = " (wrong unit? this key is '" + known + "')";
+            else if (hint.empty() && misspelling(key, known))
+                hint = " (misspelt? a key read here is '" + known + "')";
         std::ostringstream out;
         out << *file_ << ":" << entry.first.Mark().line + 1 << ": unknown key '"
             << (path_.empty() ? key : path_ + "." + key) << "'" << hint;

@@ -398,6 +398,12 @@ std::vector<std::string> checkConditions(const CsvImport &csv, ExperimentType ty
                         " (" + numberText(v * unitFactor(unit, dimension)) + " for " + value + ")";
             } catch (const std::invalid_argument &) {
             }
+            // "0,02": a decimal comma (--decimal reads the files, not the options).
+            if (std::string point = value; point.find(',') != std::string::npos) {
+                std::replace(point.begin(), point.end(), ',', '.');
+                if (isNumberText(point))
+                    hint = " (" + point + " for " + value + ": a decimal point in options)";
+            }
             throw std::invalid_argument(option + ": give " + key + " as a number in " +
                                         unitOf(key) + ", the SI unit its name ends in" + hint);
         }
@@ -625,6 +631,7 @@ std::string asImportInput(const std::string &message, const CsvImport &csv, cons
                           const std::vector<DataTable> &tables) {
     std::string text = message;
     static const std::regex located(R"(^:\d+: key 'experiments\[\d+\]\.([^']*)': )");
+    static const std::regex at_line(R"(^:\d+: )");
     std::smatch m;
     const std::string tail =
         text.rfind(yaml.string(), 0) == 0 ? text.substr(yaml.string().size()) : std::string();
@@ -649,10 +656,18 @@ std::string asImportInput(const std::string &message, const CsvImport &csv, cons
         }
         if (!option.empty() || key.rfind("data.files", 0) == 0)
             text = (option.empty() ? "" : option + ": ") + rest;
+    } else if (std::regex_search(tail, m, at_line)) {
+        // Any other message at a line of the written file, which is rolled back and never
+        // seen: said without it, by the option where it names one (a zero's threshold).
+        text = m.suffix();
+        if (text.find("zero.") != std::string::npos)
+            text = zeroOption(csv) + ": " +
+                   std::regex_replace(text, std::regex("zero\\.threshold"), "its threshold");
     }
     const std::pair<std::string, std::string> keys[] = {
         {"conditions.", "--condition "},
         {"give unit: \"%\"", "give --x " + csv.x_column + ":%"},
+        {"add `scale: -1` to a column", "give --x-scale -1 or --y-scale OBS=-1 to a column"},
         {"data.trial: the column that tells them apart (import csv: --trial COLUMN)",
          "--trial COLUMN, the column that tells them apart"}};
     for (const auto &[key, option] : keys)
@@ -740,9 +755,23 @@ std::vector<std::string> importCsv(const CsvImport &csv, const std::string &out)
                     throw std::invalid_argument(yOption(csv, obs) + ": " + why);
             for (const std::string &name : columns) {
                 const std::size_t col = column(c, name);
+                std::vector<int> missing;
                 for (std::size_t r = 0; r < c.rows.size(); ++r)
                     if (!c.missing(r, col))
                         c.number(r, col);
+                    else
+                        missing.push_back(c.lines[r]);
+                // A curve's gaps stay in its copy, and the diagnosis says them as it reads
+                // it; a scalar's values are written inline, so they are said here.
+                if (scalar && !missing.empty()) {
+                    std::string where;
+                    for (std::size_t i = 0; i < missing.size() && i < 5; ++i)
+                        where += (i ? ", " : "") + std::to_string(missing[i]);
+                    warnings.push_back(file + ": " + std::to_string(missing.size()) + " of " +
+                                       std::to_string(c.rows.size()) + " rows miss a value in '" +
+                                       name + "' (empty or NaN); those are left out (lines " +
+                                       where + (missing.size() > 5 ? ", ..." : "") + ")");
+                }
             }
         } catch (const config::ConfigError &e) {
             throw config::ConfigError(withImportOptions(e.what()));

@@ -466,8 +466,17 @@ ExperimentSet simulable(const ExperimentSet &set, const BaseModel &base,
     }
     for (const auto &[condition, ids] : undescribed) {
         const auto &[key, value] = condition;
+        // The base's values for it, and the one this may be a typo of ('Narrow' for 'narrow').
+        std::string values, typo;
+        if (const auto d = base.conditions.find(key); d != base.conditions.end())
+            for (const auto &[v, soil] : d->second) {
+                values += (values.empty() ? "" : ", ") + v;
+                if (typo.empty() && config::misspelling(value, v))
+                    typo = "; '" + v + "' misspelt?";
+            }
         out.notes.push_back(key + " '" + value + "' has no soil in " + base.path + " (" +
                             (key == "box" ? "boxes" : "conditions." + key) +
+                            (values.empty() ? "" : ": " + values) + typo +
                             "): the base's own soil stands in " + listed(ids) + ")");
     }
     // Every one left out: said with why, as each was (a gravity of -9.81 is no missing test).

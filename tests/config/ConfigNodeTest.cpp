@@ -33,6 +33,27 @@ TEST_CASE("a missing key, an unknown key and a wrong unit name the file, key and
                       Contains("s.yaml:3: unknown key 'u.y_sigam'") && !Contains("wrong unit"));
 }
 
+TEST_CASE("a misspelt key is named with the key it may stand for", "[config]") {
+    // A required key written in another case: still missing (the other may be a key of its
+    // own), with the likely typo and its line.
+    const ConfigNode d = load("data:\n  files: [a]\n  X: {column: z}\n")["data"];
+    CHECK_THROWS_WITH(d["x"], Contains("s.yaml:2: missing key 'data.x' ('X' at line 3 misspelt?)"));
+    // One letter off an optional key that was read: the unknown key names it.
+    const ConfigNode u = load("u:\n  repeat: rebuilt_bed\n")["u"];
+    (void)u.optional("repeats");
+    CHECK_THROWS_WITH(u.finish(), Contains("s.yaml:2: unknown key 'u.repeat' (misspelt? a key "
+                                           "read here is 'repeats')"));
+    // Short or different words are no typos of each other.
+    const ConfigNode m = load("m:\n  y: 1\n")["m"];
+    CHECK_THROWS_WITH(m["x"], Contains("missing key 'm.x'") && !Contains("misspelt"));
+    using grainlink::config::misspelling;
+    CHECK(misspelling("plate_diamter_m", "plate_diameter_m"));
+    CHECK(misspelling("skip_line", "skip_lines"));
+    CHECK_FALSE(misspelling("width_m", "depth_m"));
+    CHECK(misspelling("x", "X"));       // case alone is a typo
+    CHECK_FALSE(misspelling("x", "x")); // the same key is none
+}
+
 TEST_CASE("a key given twice is refused with both lines, whichever way it is read",
           "[config]") {
     const std::string text = "a: 1\nb: 2\na: 3\n";

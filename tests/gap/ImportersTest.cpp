@@ -137,11 +137,16 @@ TEST_CASE("import csv reads a file as the diagnosis does, and a failed import le
 
     // A scalar: the column's values.
     CsvImport repose;
-    repose.files = {file("repose", "trial,angle\n1,29.5\n2,30.1\n")};
+    repose.files = {file("repose", "trial,angle\n1,29.5\n2,30.1\n3,\n4,NaN\n")};
     repose.id = "repose";
     repose.type = "angle_of_repose";
     repose.y["angle_deg"] = {"angle", "deg"};
-    importCsv(repose, out.string());
+    // Values missing: left out, and said (written inline, they could not be said later).
+    const auto said = importCsv(repose, out.string());
+    REQUIRE(said.size() == 1);
+    CHECK_THAT(said[0], Catch::StartsWith(repose.files[0] + ": 2 of 4 rows miss a value in "
+                                                            "'angle' (empty or NaN); those are "
+                                                            "left out (lines 4, 5)"));
     CHECK(loadExperiments(out.string()).find("repose").trials.size() == 2);
 
     // Refused before anything is written, naming the user's file and line: the folder reads as
@@ -300,6 +305,10 @@ TEST_CASE("import csv names the --condition or the input file of an error, never
 TEST_CASE("import csv checks condition names as the diagnosis reads them", "[gap][import]") {
     const fs::path out = scratch("csv-condname");
     CsvImport csv = plate(writeInput("condname", kPlateRun));
+    // A decimal comma in an option (--decimal reads the files only).
+    csv.conditions = {{"plate_diameter_m", "0,04"}};
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      Catch::Contains("(0.04 for 0,04: a decimal point in options)"));
     // The plate's size misspelt: its test could not be set up, so it is refused.
     csv.conditions = {{"plate_diam", "0.04"}};
     CHECK_THROWS_WITH(importCsv(csv, out.string()),
@@ -331,7 +340,9 @@ TEST_CASE("import csv reads another code's z-up output: skipped lines, scales an
     csv.conditions = {{"plate_diameter_m", "0.02"}};
     CHECK_THROWS_WITH(importCsv(csv, out.string()), Catch::Contains("--skip-lines"));
     csv.skip_lines = 1;
-    CHECK_THROWS(importCsv(csv, out.string())); // the other sign: refused
+    // The other sign: refused, with the options that turn it.
+    CHECK_THROWS_WITH(importCsv(csv, out.string()),
+                      Catch::Contains("give --x-scale -1 or --y-scale OBS=-1"));
     csv.x_scale = -1.0;
     csv.y_scale["force_N"] = -1.0;
     csv.zero_method = "force_threshold";
@@ -346,6 +357,14 @@ TEST_CASE("import csv reads another code's z-up output: skipped lines, scales an
     CHECK_THROWS_WITH(importCsv(bad_zero, out.string()),
                       Catch::StartsWith("--zero force_threshold=1:mm: ") &&
                           Catch::Contains("not a force"));
+    // A threshold no sample reaches: said by the option, not at a line of the folder's
+    // experiments.yaml, which the failed import leaves as it was.
+    CsvImport high_zero = csv;
+    high_zero.zero_threshold = 500.0;
+    CHECK_THROWS_WITH(importCsv(high_zero, out.string()),
+                      Catch::StartsWith("--zero force_threshold=500:N: ") &&
+                          Catch::Contains("check its threshold") &&
+                          !Catch::Contains("experiments.yaml"));
     importCsv(csv, out.string());
     const ExperimentSet set = loadExperiments(out.string());
     const Experiment &e = set.find("lig");

@@ -458,8 +458,15 @@ TEST_CASE("a text condition the base describes gives its experiments their soil:
     CHECK(left_out.empty());
     REQUIRE(kept.notes.size() == 1);
     CHECK_THAT(kept.notes[0], Catch::Contains("preparation 'loose' has no soil") &&
-                                  Catch::Contains("(conditions.preparation)") &&
-                                  Catch::Contains("in loose_plate (1 experiment"));
+                                  Catch::Contains("(conditions.preparation: dense)") &&
+                                  Catch::Contains("in loose_plate (1 experiment") &&
+                                  !Catch::Contains("misspelt"));
+    // A value that differs from one the base describes only by a typo says which.
+    ExperimentSet typo = set;
+    typo.experiments = {plateExperiment("typo_plate", {}, {{"preparation", "Dense"}})};
+    CHECK_THAT(simulable(typo, base, left_out).notes.at(0),
+               Catch::Contains("preparation 'Dense' has no soil") &&
+                   Catch::Contains("(conditions.preparation: dense; 'dense' misspelt?)"));
     const StudySimulator sim(base, (scratch / "sims").string(), {});
     CHECK(groupSet(sim, kept) ==
           std::set<std::vector<std::string>>{{"dense_plate"}, {"loose_plate", "plain_plate"}});

@@ -95,6 +95,10 @@ private:
     std::shared_ptr<std::set<std::string>> used_;
 };
 
+/// Whether `given` reads as a misspelling of `known`: the same but for case (X for x), or one
+/// letter off in a word of four or more (repeat for repeats), two in one of eight or more.
+bool misspelling(const std::string &given, const std::string &known);
+
 /// A dotted key's step as a list index ("3" in `walls.3.upper_m`): digits only, and short enough
 /// for any list (at most 9 digits); anything else, an overflowing number included, is none.
 std::optional<std::size_t> listIndex(const std::string &step);
