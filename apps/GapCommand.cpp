@@ -416,23 +416,32 @@ int GapCommand::importCsv() const {
     csv.scatter = csv_scatter_;
     csv.delimiter = csv_delimiter_;
     csv.decimal = csv_decimal_;
-    const auto split = [](const std::string &s, char c) {
-        const auto at = s.find(c);
-        if (at == std::string::npos)
-            throw std::invalid_argument("'" + s + "': expected '" + std::string(1, c) + "'");
-        return std::pair{s.substr(0, at), s.substr(at + 1)};
+    // An option's two parts, named by its form where one is missing. A unit never holds ':',
+    // so a column named "Sinkage: mm" splits at the last one; a name never holds '='.
+    const auto split = [](const std::string &option, const std::string &form, const std::string &s,
+                          char c) {
+        const auto at = c == ':' ? s.rfind(c) : s.find(c);
+        if (at == std::string::npos || at == 0 || at + 1 == s.size())
+            throw std::invalid_argument(option + " '" + s + "': give " + form);
+        std::string second = s.substr(at + 1);
+        if (c == ':') // "Sinkage: mm" for a column with no unit: the unit without its blank
+            second.erase(0, second.find_first_not_of(' '));
+        return std::pair{s.substr(0, at), second};
     };
     if (!csv_x_.empty()) {
-        const auto [col, unit] = split(csv_x_, ':');
+        const auto [col, unit] = split("--x", "COLUMN:UNIT (\"Sinkage [mm]:mm\")", csv_x_, ':');
         csv.x_column = col;
         csv.x_unit = unit;
     }
     for (const std::string &y : csv_y_) {
-        const auto [obs, rest] = split(y, '=');
-        csv.y[obs] = split(rest, ':');
+        const std::string form = "OBSERVABLE=COLUMN:UNIT (\"pressure_Pa=Pressure [kPa]:kPa\")";
+        const auto [obs, rest] = split("--y", form, y, '=');
+        if (rest.find(':') == std::string::npos)
+            split("--y", form, y, ':'); // no unit: said with the whole option
+        csv.y[obs] = split("--y", form, rest, ':');
     }
     for (const std::string &c : csv_conditions_) {
-        const auto [k, v] = split(c, '=');
+        const auto [k, v] = split("--condition", "KEY=VALUE (plate_diameter_m=0.02)", c, '=');
         csv.conditions[k] = v;
     }
     csv.skip_lines = csv_skip_lines_;
@@ -443,11 +452,11 @@ int GapCommand::importCsv() const {
         throw std::invalid_argument(option + ": '" + text + "' is not a number");
     };
     for (const std::string &s : csv_y_scale_) {
-        const auto [obs, factor] = split(s, '=');
+        const auto [obs, factor] = split("--y-scale", "OBSERVABLE=FACTOR", s, '=');
         csv.y_scale[obs] = numberOf("--y-scale " + s, factor);
     }
     for (const std::string &f : csv_filter_) {
-        const auto [column, value] = split(f, '=');
+        const auto [column, value] = split("--filter", "COLUMN=VALUE", f, '=');
         csv.filter[column] = numberOf("--filter " + f, value);
     }
     if (!csv_zero_.empty()) {
@@ -456,7 +465,8 @@ int GapCommand::importCsv() const {
             if (csv.zero_method != "force_threshold")
                 throw std::invalid_argument("--zero " + csv_zero_ +
                                             ": only force_threshold takes a value");
-            const auto [value, unit] = split(split(csv_zero_, '=').second, ':');
+            const auto [value, unit] = split("--zero", "force_threshold=VALUE:UNIT",
+                                             csv_zero_.substr(csv_zero_.find('=') + 1), ':');
             csv.zero_threshold = numberOf("--zero " + csv_zero_, value);
             csv.zero_unit = unit;
         } else if (csv.zero_method == "force_threshold") {
