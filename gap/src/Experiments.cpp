@@ -357,6 +357,46 @@ void sayUnlikelyStressRatio(const Experiment &e, std::vector<std::string> &notes
     notes.push_back(m.str());
 }
 
+/// Says an experiment whose largest value lies 100 times or more off the median of the others
+/// of its kind (three or more): plates of other sizes or boxes differ by a few times, a column
+/// in kPa read as Pa by a thousand. Only loads every test of the kind builds up: a wheel's side
+/// force at no slip angle is near zero by rights.
+void sayLevelsApart(ExperimentSet &set) {
+    static const std::set<std::string> loads = {"pressure_Pa", "shear_stress_Pa", "vertical_load_N",
+                                                "angle_deg"};
+    std::map<std::string, std::vector<std::pair<std::string, double>>> levels;
+    for (const Experiment &e : set.experiments)
+        for (const std::string &o : e.observables) {
+            if (!loads.count(o))
+                continue;
+            double level = 0.0;
+            for (const Trial &t : e.trials)
+                if (const auto c = t.curves.find(o); c != t.curves.end())
+                    for (double y : c->second.y)
+                        level = std::max(level, std::abs(y));
+            if (level > 0.0)
+                levels[e.kind(o)].emplace_back(e.id, level);
+        }
+    for (const auto &[kind, list] : levels) {
+        if (list.size() < 3)
+            continue;
+        std::vector<double> values;
+        for (const auto &[id, level] : list)
+            values.push_back(level);
+        std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+        const double median = values[values.size() / 2];
+        for (const auto &[id, level] : list)
+            if (level > 100.0 * median || level < 0.01 * median) {
+                std::ostringstream m;
+                m << std::setprecision(3) << "experiment '" << id << "': " << kind << " reaches "
+                  << level << ", " << level / median << " times the median of its kind's "
+                  << list.size() << " experiments (" << median
+                  << "): its unit? (kPa read as Pa is 1000 times)";
+                set.notes.push_back(m.str());
+            }
+    }
+}
+
 /// Refuses a wheel's sinkage given z up: every run's sinkage at or below zero, one below.
 void checkWheelSinkage(const Experiment &e, const ConfigNode &data) {
     bool below = false, above = false;
@@ -991,6 +1031,7 @@ ExperimentSet loadExperiments(const std::string &directory) {
     root.finish();
     if (set.experiments.empty())
         list.fail("no experiments");
+    sayLevelsApart(set);
     return set;
 }
 

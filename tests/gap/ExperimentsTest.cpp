@@ -906,3 +906,32 @@ TEST_CASE("experiments.yaml: a unit the file's units row contradicts, a sinkage 
     CHECK(shear("4000").empty());        // tan 36 deg
     CHECK(shear("4000000").size() == 1); // 1/1380 of it: the shear stress in Pa, read in kPa?
 }
+
+TEST_CASE("experiments.yaml: an experiment 1000 times off the others of its kind is said",
+          "[gap][experiments]") {
+    const fs::path dir = folder("levels");
+    linearTrial(dir / "a1.csv", 1.0);
+    linearTrial(dir / "a2.csv", 2.0);
+    linearTrial(dir / "a3.csv", 3.0);
+    const auto plate = [](const std::string &id, const std::string &file, const std::string &unit) {
+        return "  - id: " + id + "\n    type: plate_sinkage\n" +
+               "    conditions: {plate_diameter_m: 0.06}\n    data:\n      files: [" + file +
+               "]\n      x: {column: sinkage_mm, unit: mm}\n" +
+               "      y: {pressure_Pa: {column: pressure_kPa, unit: " + unit + "}}\n";
+    };
+    const std::string head = "name: test\nexperiments:\n";
+    // Three plates within three times of each other: nothing to say.
+    write(dir / "experiments.yaml", head + plate("p1", "a1.csv", "kPa") +
+                                        plate("p2", "a2.csv", "kPa") +
+                                        plate("p3", "a3.csv", "kPa"));
+    CHECK(loadExperiments(dir.string()).notes.empty());
+    // The third's kPa column read as Pa: 36 Pa against the median 12 kPa (of 12 kPa, 24 kPa and
+    // 36 Pa), said with its ratio.
+    write(dir / "experiments.yaml", head + plate("p1", "a1.csv", "kPa") +
+                                        plate("p2", "a2.csv", "kPa") + plate("p3", "a3.csv", "Pa"));
+    const auto notes = loadExperiments(dir.string()).notes;
+    REQUIRE(notes.size() == 1);
+    CHECK_THAT(notes[0], Catch::Contains("experiment 'p3': plate_sinkage/pressure_Pa reaches 36, "
+                                         "0.003 times the median of its kind's 3 experiments "
+                                         "(1.2e+04): its unit?"));
+}
