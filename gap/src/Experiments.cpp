@@ -5,6 +5,7 @@
 #include "grainlink/gap/Comparison.hpp"
 
 #include "grainlink/config/ConfigNode.hpp"
+#include "grainlink/config/Number.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -328,10 +329,11 @@ void refuseStackedTrials(const Experiment &e, const Curve &curve, const std::vec
                    "apart (import csv: --trial COLUMN), or one file per trial");
 }
 
-/// Says a shear test whose shear stress stands far outside a soil's friction against its normal
-/// stress (more than 5 times it, or under 1/20 of it: tan 79 deg, tan 3 deg): a stress in kPa
-/// read as Pa on one side gives 1000 times too much or too little. Said, not refused: a strongly
-/// cohesive soil under a light load may stand above 5.
+/// Says a shear test whose shear stress stands far outside a soil's strength against its normal
+/// stress (more than 50 times it, or under 1/50 of it): a stress in kPa read as Pa on one side
+/// gives 1000 times too much or too little. Said, not refused. Not nearer: stiff grains jammed
+/// in a narrow box reached 6 times their normal stress, and a cohesive soil under a light load
+/// may reach 20.
 void sayUnlikelyStressRatio(const Experiment &e, std::vector<std::string> &notes) {
     const char *normal = e.type == ExperimentType::DirectShear      ? "normal_stress_Pa"
                          : e.type == ExperimentType::BevameterShear ? "normal_pressure_Pa"
@@ -347,13 +349,17 @@ void sayUnlikelyStressRatio(const Experiment &e, std::vector<std::string> &notes
     if (!(tau > 0.0))
         return;
     const double ratio = tau / sigma->second;
-    if (ratio <= 5.0 && ratio >= 0.05)
+    if (ratio <= 50.0 && ratio >= 0.02)
         return;
     std::ostringstream m;
-    m << std::setprecision(3) << "experiment '" << e.id << "': shear stress up to " << tau
-      << " Pa under " << normal << " " << sigma->second << " (" << ratio
-      << " times it): is one of them in kPa? (conditions and columns read in Pa: "
-      << sigma->second * 1000.0 << " for " << sigma->second << " kPa)";
+    m << std::setprecision(6) << "experiment '" << e.id << "': shear stress up to " << tau
+      << " Pa under " << normal << " " << sigma->second << " (" << std::setprecision(3) << ratio
+      << " times it): "
+      << (ratio > 1.0 ? std::string(normal) + " given in kPa? (conditions are in Pa: " +
+                            config::significant(sigma->second * 1000.0, 6) + " for " +
+                            config::significant(sigma->second, 6) + " kPa)"
+                      : std::string("is the shear stress column's unit right (kPa read as "
+                                    "Pa?), or the normal stress 1000 times too large?"));
     notes.push_back(m.str());
 }
 

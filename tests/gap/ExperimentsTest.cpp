@@ -900,11 +900,14 @@ TEST_CASE("experiments.yaml: a unit the file's units row contradicts, a sinkage 
     };
     const auto notes = shear("4");
     REQUIRE(notes.size() == 1);
-    CHECK_THAT(notes[0], Catch::Contains("experiment 's4': shear stress up to 2.9e+03 Pa under "
-                                         "normal_stress_Pa 4 (725 times it): is one of them in "
-                                         "kPa?"));
-    CHECK(shear("4000").empty());        // tan 36 deg
-    CHECK(shear("4000000").size() == 1); // 1/1380 of it: the shear stress in Pa, read in kPa?
+    CHECK_THAT(notes[0], Catch::Contains("experiment 's4': shear stress up to 2900 Pa under "
+                                         "normal_stress_Pa 4 (725 times it): normal_stress_Pa "
+                                         "given in kPa? (conditions are in Pa: 4000 for 4 kPa)"));
+    CHECK(shear("4000").empty());      // tan 36 deg
+    CHECK(shear("100").empty());       // 29 times: a cohesive soil under a light load, maybe
+    const auto low = shear("4000000"); // 1/1380 of it: the shear stress in Pa, read in kPa?
+    REQUIRE(low.size() == 1);
+    CHECK_THAT(low[0], Catch::Contains("is the shear stress column's unit right"));
 }
 
 TEST_CASE("experiments.yaml: an experiment 1000 times off the others of its kind is said",
