@@ -49,6 +49,14 @@ def axis_of(kind):
     return "", 1.0
 
 
+def quantity_of(observable):
+    """pressure_Pa -> 'pressure [Pa]': the SI name's unit as an axis label."""
+    for unit in ("Pa", "N_m", "N", "m", "deg"):
+        if observable.endswith("_" + unit):
+            return f"{observable[:-len(unit) - 1].replace('_', ' ')} [{unit.replace('_', ' ')}]"
+    return observable
+
+
 def curves_plot(rows, diag):
     """One panel per experiment and observable: measured +- 2 u_D, simulated +- 2 u_val, the
     best model and (held out) the null model."""
@@ -72,17 +80,21 @@ def curves_plot(rows, diag):
         s = [number(r["simulated"]) for r in rs]
         uv = [2 * number(r["u_val"]) for r in rs]
         ax.errorbar(x, m, yerr=ud, fmt="o", color="k", ms=4, label="measured ±2u_D")
-        ax.plot(x, s, "-", color="tab:blue", label="base model")
+        # A marker on every line: a scalar (an angle of repose) is one point.
+        ax.plot(x, s, "-", marker=".", color="tab:blue", label="base model")
         ax.fill_between(x, [a - b for a, b in zip(s, uv)], [a + b for a, b in zip(s, uv)],
                         color="tab:blue", alpha=0.2, label="±2u_val")
         best = [number(r["best_model_mean"]) for r in rs]
         if any(math.isfinite(b) for b in best):
-            ax.plot(x, best, "--", color="tab:red", label=rs[0]["best_model"] or "best model")
+            ax.plot(x, best, "--", marker=".", color="tab:red",
+                    label=rs[0]["best_model"] or "best model")
         nm = [number(r["null_mean"]) for r in rs]
         if any(math.isfinite(v) for v in nm):
-            ax.plot(x, nm, ":", color="tab:green", label="null model")
-        ax.set_title(exp + (" (held out)" if exp in held else "") + "\n" + obs, fontsize=9)
+            ax.plot(x, nm, ":", marker=".", color="tab:green", label="null model")
+        ax.set_title(exp + (" (held out)" if exp in held else " (calibration)") + "\n" + obs,
+                     fontsize=9)
         ax.set_xlabel(label, fontsize=8)
+        ax.set_ylabel(quantity_of(obs), fontsize=8)
         ax.tick_params(labelsize=7)
     for ax in list(axes.flat)[n:]:
         ax.axis("off")
@@ -106,7 +118,7 @@ def residual_map(rows):
     ax.set_yticks(range(len(exps)))
     ax.set_yticklabels([f"{e} {o}" for e, o in exps], fontsize=7)
     ax.set_xlabel("bin (increasing x)", fontsize=8)
-    fig.colorbar(im, ax=ax, label="z = (measured - simulated) / u_val")
+    fig.colorbar(im, ax=ax, label="z = (meas. - sim.) / u_val")
     ax.set_title("standardised residuals (|z| > 2: outside the validation uncertainty)", fontsize=9)
     return png(fig)
 
@@ -140,8 +152,15 @@ def before_after(diag):
             labels.append(" + ".join(p["effects"]))
             values.append(p["held_out"]["gap_beyond_uncertainty"])
     values = [100 * (v if v is not None else math.nan) for v in values]
+    # The claimed model red, every other candidate blue: a short bar is no claim by itself.
+    claimed = diag["verdict"]["model"] if diag["verdict"]["model_is"] == "claimed" else None
+    colors = ["0.5", "tab:green"] + ["tab:red" if name == claimed else "tab:blue"
+                                     for name in labels[2:]]
     fig, ax = plt.subplots(figsize=(1.5 + 0.8 * len(labels), 3))
-    ax.bar(range(len(labels)), values, color=["0.5", "tab:green"] + ["tab:red"] * (len(labels) - 2))
+    ax.bar(range(len(labels)), values, color=colors)
+    for i, v in enumerate(values):
+        if math.isfinite(v):
+            ax.annotate(f"{v:.0f} %", (i, v), ha="center", va="bottom", fontsize=7)
     ax.set_xticks(range(len(labels)))
     ax.set_xticklabels(labels, rotation=30, ha="right", fontsize=7)
     ax.set_ylabel("held-out gap beyond u_val [%]", fontsize=8)
@@ -156,22 +175,39 @@ def main(directory):
         rows = list(csv.DictReader(f))
     with open(f"{directory}/report.txt") as f:
         text = f.read()
-    figures = [("Measured against simulated", curves_plot(rows, diag)),
-               ("Where the gap lies", residual_map(rows)),
-               ("Held-out gap", before_after(diag)),
-               ("Which effects this design can tell apart", overlap_plot(diag))]
+    figures = [("Measured against simulated", curves_plot(rows, diag),
+                "Each panel is one experiment: the measured mean with twice its measurement "
+                "uncertainty (points), the base model with twice the validation uncertainty u_val "
+                "(blue band), the model the verdict names (red dashes) and, on held-out "
+                "experiments, the null model: the base plus a generic correction fitted on the "
+                "calibration experiments (green dots)."),
+               ("Where the gap lies", residual_map(rows),
+                "Each row is one experiment, each cell one bin of its x (sinkage, shear "
+                "displacement, slip) from left to right; red and blue cells lie more than 2 u_val "
+                "off the measurement, one way or the other."),
+               ("Held-out gap", before_after(diag),
+                "How far the held-out experiments lie beyond their validation uncertainty with "
+                "the base, the null model and each re-simulated candidate. A shorter bar than the "
+                "null model's is not a claim by itself: the claim also needs the held-out "
+                "prediction to beat the null model's at the level (see the verdict)."),
+               ("Which effects this design can tell apart", overlap_plot(diag),
+                "The share of each row effect's signature that the column effect reproduces at "
+                "its best strength: near 1, these experiments cannot tell the two apart.")]
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>grainlink gap: "
              f"{html.escape(diag['measurements'])}</title><style>body{{font-family:sans-serif;"
              "max-width:1100px;margin:auto}} pre{{background:#f4f4f4;padding:8px;white-space:"
              "pre-wrap}} img{{max-width:100%}}</style></head><body>",
              f"<h1>Sim-to-real diagnosis: {html.escape(diag['measurements'])}</h1>",
-             f"<p><b>{html.escape(diag['outcome'])}</b>: {html.escape(diag['claim'])}</p>",
+             f"<p style='font-size:120%'><b>{html.escape(diag['verdict']['text'])}</b></p>",
+             f"<p>{html.escape(diag['claim'])}</p>",
              (f"<p style='color:#a00'><b>Warning</b>: {html.escape(diag['numerical_warning'])}</p>"
               if diag.get("numerical_warning") else ""),
+             "<h3>Where the base model differs from the measurements</h3>",
              "<ul>" + "".join(f"<li>{html.escape(w['text'])}</li>" for w in diag["where"]) + "</ul>"]
-    for title, fig in figures:
+    for title, fig, caption in figures:
         if fig:
-            parts.append(f"<h2>{title}</h2><img src='data:image/png;base64,{fig}'>")
+            parts.append(f"<h2>{title}</h2><img src='data:image/png;base64,{fig}' "
+                         f"alt='{html.escape(title)}'><p><i>{html.escape(caption)}</i></p>")
     parts.append(f"<h2>Report</h2><pre>{html.escape(text)}</pre></body></html>")
     with open(f"{directory}/report.html.tmp", "w") as f:
         f.write("\n".join(parts))

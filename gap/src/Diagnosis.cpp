@@ -20,6 +20,17 @@ std::string fmt(double v, int digits = 3) {
     return config::significant(v, digits);
 }
 
+/// A fraction as a percentage's number: two significant digits, whole from 10 on (116, not
+/// 1.2e+02).
+std::string percentOf(double fraction) {
+    const double v = 100.0 * fraction;
+    if (!(std::abs(v) >= 10.0))
+        return fmt(v, 2);
+    char b[32];
+    std::snprintf(b, sizeof b, "%.0f", v);
+    return b;
+}
+
 /// The spread a fitted strength's 95 % interval gives its prediction, ((m(hi) - m(lo))/3.92)^2
 /// per feature (0 where the table has no value): a model predicts with what it knows. The
 /// interval with the beds' luck at the normal quantile (`StrengthFit::spread_lo`).
@@ -273,6 +284,69 @@ ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidat
             c.by_p_value = &R;
     }
     return c;
+}
+
+std::string standing(const CandidateResult &c) {
+    return c.explains ? "explains"
+           : c.beats_null && c.fit.at_prior_edge
+               ? "beats the null model but only at its prior's edge"
+           : c.beats_null && c.after.gap ? "beats the null model but leaves a gap"
+           : c.beats_null && !c.strengths_agree
+               ? "beats the null model but its kinds of observable ask for different strengths"
+           : c.beats_null ? "beats the null model but is not claimable"
+                          : "does not beat the null model";
+}
+
+std::string headline(const Diagnosis &d) {
+    const auto strength = [](const Effect &e, const StrengthFit &f) {
+        return e.parameter + " = " + fmt(f.strength) + " [" + fmt(f.lo) + ", " + fmt(f.hi) + "]" +
+               (e.unit == "-" ? std::string() : " " + e.unit) +
+               (f.at_prior_edge ? " (at its prior's edge)" : "");
+    };
+    const auto heldOut = [&](double model, double p, double level, const std::string &why,
+                             const GapVerdict &after) {
+        return "; held-out gap " + percentOf(d.held_out_base.gap) + " % -> " + percentOf(model) +
+               " % with it (null model " + percentOf(d.held_out_null.gap) +
+               " %); p = " + fmt(p, 2) + " against the level " + fmt(level, 2) + ": " + why +
+               (after.gap ? " (" + std::to_string(after.flagged) + " of " +
+                                std::to_string(after.features) + " features beyond 2 u_val)"
+                          : std::string());
+    };
+    switch (d.outcome) {
+    case Diagnosis::Outcome::NoGap:
+        return "NO GAP: the base model agrees with the measurements within their validation "
+               "uncertainty";
+    case Diagnosis::Outcome::Unresolved:
+        return "UNRESOLVED: a numerical check moves the base model too far to tell";
+    default:
+        break;
+    }
+    const bool claimed = !d.explained_by.empty();
+    std::string out = claimed ? "EXPLAINED by " : "UNEXPLAINED";
+    for (const CandidateResult &c : d.candidates)
+        if (c.name == d.best_model && c.confirmed)
+            return out + (claimed ? "" : "; closest: ") + c.name + ", " +
+                   strength(c.effect, c.fit) +
+                   heldOut(c.held_out.gap, c.versus_null.p_value, d.single_level, standing(c),
+                           c.after);
+    for (const PairResult &p : d.pairs)
+        if (p.a + " + " + p.b == d.best_model && p.confirmed) {
+            std::string strengths;
+            for (const CandidateResult &c : d.candidates)
+                if (c.name == p.a || c.name == p.b)
+                    strengths += (strengths.empty() ? "" : ", ") +
+                                 strength(c.effect, c.name == p.a ? p.fit.a : p.fit.b);
+            const bool beats =
+                p.versus_null.mean_gain > 0.0 && p.versus_null.p_value < d.pair_level;
+            const std::string why = p.explains    ? "explains"
+                                    : !beats      ? "does not beat the null model"
+                                    : p.after.gap ? "beats the null model but leaves a gap"
+                                                  : "beats the null model but is not claimable";
+            return out + (claimed ? "the pair " : "; closest: the pair ") + d.best_model + ", " +
+                   strengths +
+                   heldOut(p.held_out.gap, p.versus_null.p_value, d.pair_level, why, p.after);
+        }
+    return out + ": no catalogued effect was confirmed against held-out experiments";
 }
 
 const char *outcomeName(Diagnosis::Outcome outcome) {
@@ -1178,11 +1252,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         claim << "explained by " << e.name << " (" << e.description
               << "): " << strengthText(e, winner->fit.strength) << " [" << fmt(winner->fit.lo)
               << ", " << fmt(winner->fit.hi) << "] (base " << fmt(e.prior.off) << "); held-out gap "
-              << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
-              << fmt(100.0 * winner->held_out.gap, 2) << " % ("
-              << fmt(reduction(winner->held_out), 2) << " % smaller; null model "
-              << fmt(100.0 * D.held_out_null.gap, 2)
-              << " %, p = " << fmt(winner->versus_null.p_value, 2) << ")";
+              << percentOf(D.held_out_base.gap) << " % -> " << percentOf(winner->held_out.gap)
+              << " % (" << fmt(reduction(winner->held_out), 2) << " % smaller; null model "
+              << percentOf(D.held_out_null.gap) << " %, p = " << fmt(winner->versus_null.p_value, 2)
+              << ")";
         // Its rivals: every other confirmed candidate that leaves no gap, at its prior's edge
         // too (on the CMU plates softer grains at the softest allowed predicted the small box
         // as well as the claimed grain shape), and short of the level too (on the full
@@ -1220,8 +1293,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             claim << "explained by " << pair->a << " + " << pair->b << ": " << pair->a << " "
                   << fmt(pair->fit.a.strength) << ", " << pair->b << " "
                   << fmt(pair->fit.b.strength) << "; held-out gap "
-                  << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
-                  << fmt(100.0 * pair->held_out.gap, 2)
+                  << percentOf(D.held_out_base.gap) << " % -> " << percentOf(pair->held_out.gap)
                   << " % (p = " << fmt(pair->versus_null.p_value, 2) << ")";
             D.best_model = pair->a + " + " + pair->b;
             D.best_model_mean = pair->confirmed_mean;
@@ -1246,7 +1318,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                     if (R.explains)
                         which += (explaining++ ? ", " : "") + R.name + " (" +
                                  strengthText(R.effect, R.fit.strength) + ", held-out gap " +
-                                 fmt(100.0 * R.held_out.gap, 2) +
+                                 percentOf(R.held_out.gap) +
                                  " %, p = " + fmt(R.versus_null.p_value, 2) + ")";
                 const char *verb_s = explaining == 1 ? "s" : "";
                 claim << which << " beat" << verb_s << " the null model and leave" << verb_s
@@ -1260,7 +1332,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             } else if (const CandidateResult *torn = disagreeing(D.candidates)) {
                 claim << "unexplained: " << torn->name << " ("
                       << strengthText(torn->effect, torn->fit.strength) << ", held-out gap "
-                      << fmt(100.0 * torn->held_out.gap, 2)
+                      << percentOf(torn->held_out.gap)
                       << " %, p = " << fmt(torn->versus_null.p_value, 2)
                       << ") beats the null model and leaves no gap, but the kinds of observable "
                          "ask for different strengths of it (";
@@ -1302,11 +1374,13 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                       << ")";
             else if (best)
                 claim << "; closest: " << best->name << " at "
-                      << strengthText(best->effect, best->fit.strength) << " (held-out gap "
-                      << fmt(100.0 * D.held_out_base.gap, 2) << " % -> "
-                      << fmt(100.0 * best->held_out.gap, 2) << " %, " << best->after.flagged
-                      << " features still beyond " << fmt(opt.flag_at, 2)
+                      << strengthText(best->effect, best->fit.strength) << " [" << fmt(best->fit.lo)
+                      << ", " << fmt(best->fit.hi) << "] (held-out gap "
+                      << percentOf(D.held_out_base.gap) << " % -> " << percentOf(best->held_out.gap)
+                      << " %, " << best->after.flagged << " of " << best->after.features
+                      << " features, calibration and held out, still beyond " << fmt(opt.flag_at, 2)
                       << " u_val, p = " << fmt(best->versus_null.p_value, 2)
+                      << " against the level " << fmt(level, 3)
                       << (best->fit.beyond_prior ? ", pinned at its prior's edge: the data ask for "
                                                    "more of it than is plausible"
                           : best->fit.at_prior_edge ? ", at its prior's edge: not claimed"
@@ -1322,9 +1396,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 D.nearest_to_claim = nearest->name;
                 claim << "; nearest to a claim: " << nearest->name << " at "
                       << strengthText(nearest->effect, nearest->fit.strength) << " (held-out gap "
-                      << fmt(100.0 * nearest->held_out.gap, 2)
+                      << percentOf(nearest->held_out.gap)
                       << " %, p = " << fmt(nearest->versus_null.p_value, 3) << " against the level "
-                      << fmt(level, 3) << ")";
+                      << fmt(level, 3)
+                      << (nearest->fit.at_prior_edge ? ", at its prior's edge: never claimed" : "")
+                      << ")";
             }
         }
     }

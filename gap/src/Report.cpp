@@ -1,5 +1,6 @@
 #include "grainlink/gap/Report.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -80,6 +81,45 @@ std::string pct(double v) {
     return b;
 }
 
+/// The verdict for a script: the outcome, the model it names and its strengths, the held-out
+/// gaps and the test, without reading `claim`. null where there is none.
+Json verdictJson(const Diagnosis &d) {
+    Json v{{"outcome", outcomeName(d.outcome)}, {"text", headline(d)}};
+    v["model"] = d.best_model.empty() ? Json(nullptr) : Json(d.best_model);
+    v["model_is"] = d.best_model.empty()     ? Json(nullptr)
+                    : d.explained_by.empty() ? Json("closest, not claimed")
+                                             : Json("claimed");
+    v["strengths"] = Json::array();
+    v["held_out_gap"] = {{"base", number(d.held_out_base.gap)},
+                         {"null_model", number(d.held_out_null.gap)},
+                         {"with_model", nullptr}};
+    v["p_value_against_null"] = nullptr;
+    v["level"] = nullptr;
+    const auto add = [&](const Effect &e, const StrengthFit &f) {
+        Json s = strength(e, f);
+        s["effect"] = e.name;
+        v["strengths"].push_back(s);
+    };
+    for (const CandidateResult &c : d.candidates)
+        if (c.name == d.best_model && c.confirmed) {
+            add(c.effect, c.fit);
+            v["held_out_gap"]["with_model"] = number(c.held_out.gap);
+            v["p_value_against_null"] = number(c.versus_null.p_value);
+            v["level"] = number(d.single_level);
+        }
+    for (const PairResult &p : d.pairs)
+        if (p.a + " + " + p.b == d.best_model && p.confirmed) {
+            for (const CandidateResult &c : d.candidates)
+                if (c.name == p.a || c.name == p.b)
+                    add(c.effect, c.name == p.a ? p.fit.a : p.fit.b);
+            v["held_out_gap"]["with_model"] = number(p.held_out.gap);
+            v["p_value_against_null"] = number(p.versus_null.p_value);
+            v["level"] = number(d.pair_level);
+        }
+    v["gap_test"] = {{"flagged_features", d.verdict.flagged}, {"features", d.verdict.features}};
+    return v;
+}
+
 } // namespace
 
 Json toJson(const Diagnosis &d, const ExperimentSet &set) {
@@ -91,6 +131,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     j["not_compared"] = d.not_compared;
     j["partly_compared"] = d.partly_compared;
     j["outcome"] = outcomeName(d.outcome);
+    j["verdict"] = verdictJson(d);
     j["claim"] = d.claim;
     j["numerical_warning"] = d.numerical_warning;
     // The parts of u_val, each a median share of the simulated value (null where undefined).
@@ -190,7 +231,14 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
 std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
     std::ostringstream r;
     r << "grainlink gap diagnose: " << set.name << "\n\n";
-    r << "Result: " << d.claim << "\n\n";
+    r << "Verdict: " << headline(d) << "\n";
+    if (d.outcome != Diagnosis::Outcome::NoGap && d.outcome != Diagnosis::Outcome::Unresolved)
+        r << "  (held-out gap: how far the held-out experiments lie beyond their validation "
+             "uncertainty u_val, as a share of the measured value; the null model is the base "
+             "plus a generic correction fitted on the calibration experiments; an effect is "
+             "claimed only where it predicts the held-out experiments better than the null "
+             "model, p below the level, and leaves no gap)\n";
+    r << "\nResult: " << d.claim << "\n\n";
     if (!d.numerical_warning.empty())
         r << "Warning: " << d.numerical_warning << "\n\n";
     for (const std::string &note : set.notes)
@@ -207,10 +255,15 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
                 continue;
             char pct[32];
             std::snprintf(pct, sizeof pct, share < 0.01 ? "%.1f %%" : "%.0f %%", 100.0 * share);
+            // A check whose every run failed somewhere counts as none there: not a measured 0.
+            const bool failed =
+                std::any_of(d.validation.check_failures.begin(), d.validation.check_failures.end(),
+                            [&](const auto &f) { return f.first == part; });
             if (part == "u_val")
                 total = pct;
             else
-                parts << (parts.tellp() > 0 ? ", " : "") << part << ' ' << pct;
+                parts << (parts.tellp() > 0 ? ", " : "") << part << ' ' << pct
+                      << (failed ? " (its runs failed on some experiments: unknown there)" : "");
         }
         r << "Validation uncertainty by part (median share of the simulated value): " << parts.str()
           << "; u_val " << total << "\n";
@@ -240,16 +293,9 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
         r << c.effect.parameter << " = " << c.fit.strength << " [" << c.fit.lo << ", " << c.fit.hi
           << "] " << c.effect.unit << ", chi^2 " << c.fit.chi2 << " (off: " << c.fit.chi2_off << ")";
         if (c.confirmed)
-            r << "; confirmed: held-out gap " << pct(c.held_out.gap)
-              << ", p = " << c.versus_null.p_value
-              << (c.explains ? ", EXPLAINS"
-                  : c.beats_null && c.fit.at_prior_edge
-                      ? ", beats the null but only at its prior's edge"
-                  : c.beats_null && c.after.gap ? ", beats the null but leaves a gap"
-                  : c.beats_null && !c.strengths_agree
-                      ? ", beats the null but its kinds of observable ask for different strengths"
-                  : c.beats_null ? ", beats the null but is not claimable"
-                                 : ", does not beat the null");
+            r << "; re-simulated at it: held-out gap " << pct(c.held_out.gap)
+              << ", p = " << c.versus_null.p_value << ", "
+              << (c.explains ? std::string("EXPLAINS") : standing(c));
         if (c.confirmed && c.agreement.dof > 0) {
             r << "\n      by kind:";
             for (const auto &[kind, fit] : c.by_kind)

@@ -449,10 +449,28 @@ TEST_CASE("the diagnosis writes diagnosis.json, features.csv, report.txt and a s
         const std::string text((std::istreambuf_iterator<char>(page)),
                                std::istreambuf_iterator<char>());
         CHECK(text.find("data:image/png;base64,") != std::string::npos);
-        CHECK(text.find("explained") != std::string::npos);
+        CHECK(text.find("EXPLAINED by cohesion") != std::string::npos);
+        CHECK(text.find("<i>Each panel is one experiment") != std::string::npos); // captions
     } else {
         WARN("report.html not made: /usr/bin/python3 with matplotlib missing");
     }
+    // The verdict for a script, read against the claimed candidate's own record.
+    const nlohmann::json &v = j["verdict"];
+    CHECK(v["outcome"] == "explained");
+    CHECK(v["model"] == "cohesion");
+    CHECK(v["model_is"] == "claimed");
+    REQUIRE(v["strengths"].size() == 1);
+    for (const auto &c : j["candidates"])
+        if (c["effect"] == "cohesion") {
+            CHECK(v["strengths"][0]["value"] == c["strength"]["value"]);
+            CHECK(v["strengths"][0]["ci95"] == c["strength"]["ci95"]);
+            CHECK(v["held_out_gap"]["with_model"] == c["held_out"]["gap_beyond_uncertainty"]);
+            CHECK(v["p_value_against_null"] == c["p_value_against_null"]);
+        }
+    CHECK(v["held_out_gap"]["base"] == j["held_out"]["base"]["gap_beyond_uncertainty"]);
+    CHECK(v["level"] == j["claim_level"]["single"]);
+    CHECK(report_text.find("Verdict: EXPLAINED by cohesion, cohesion_energy_density = ") !=
+          std::string::npos);
 }
 
 TEST_CASE("diagnosis against another code's soil: a difference outside the catalogue is not "
@@ -1009,6 +1027,60 @@ TEST_CASE("diagnosis: a fitted strength the design cannot run is confirmed at th
     CHECK(box.fit.strength >= 0.74);
     CHECK(box.fit.strength == Approx(0.74).epsilon(1e-3));
     CHECK(std::isfinite(box.held_out.log_density)); // its runs ran: not taken as failed
+}
+
+TEST_CASE("the verdict line names the outcome, the model, its strength and why it is or is not "
+          "claimed",
+          "[gap][diagnosis][report]") {
+    Diagnosis d;
+    CHECK(headline(d) == "NO GAP: the base model agrees with the measurements within their "
+                         "validation uncertainty");
+    // The closest, beating the null but leaving a gap: said so, not "does not beat the null".
+    CandidateResult c;
+    c.name = "grain_stiffness";
+    c.effect.name = "grain_stiffness";
+    c.effect.parameter = "stiffness_factor";
+    c.effect.unit = "-";
+    c.fit.strength = 4.04;
+    c.fit.lo = 3.62;
+    c.fit.hi = 4.51;
+    c.confirmed = true;
+    c.held_out.gap = 0.0;
+    c.versus_null.p_value = 0.046;
+    c.beats_null = true;
+    c.strengths_agree = true;
+    c.after.gap = true;
+    c.after.flagged = 5;
+    c.after.features = 115;
+    d.outcome = Diagnosis::Outcome::Unexplained;
+    d.best_model = "grain_stiffness";
+    d.candidates = {c};
+    d.held_out_base.gap = 1.16; // 116 %, not 1.2e+02
+    d.held_out_null.gap = 0.398;
+    d.single_level = 0.05;
+    CHECK(headline(d) == "UNEXPLAINED; closest: grain_stiffness, stiffness_factor = 4.04 [3.62, "
+                         "4.51]; held-out gap 116 % -> 0 % with it (null model 40 %); p = 0.046 "
+                         "against the level 0.05: beats the null model but leaves a gap (5 of "
+                         "115 features beyond 2 u_val)");
+    // Claimed, with a unit.
+    c.effect.parameter = "zero_offset";
+    c.effect.unit = "m";
+    c.name = c.effect.name = "sensor_zero_offset";
+    c.explains = true;
+    c.after.gap = false;
+    d.candidates = {c};
+    d.best_model = d.explained_by = "sensor_zero_offset";
+    d.outcome = Diagnosis::Outcome::Explained;
+    CHECK(headline(d).rfind("EXPLAINED by sensor_zero_offset, zero_offset = 4.04 [3.62, 4.51] m; "
+                            "held-out gap 116 % -> 0 % with it (null model 40 %); p = 0.046 "
+                            "against the level 0.05: explains",
+                            0) == 0);
+    // Nothing confirmed.
+    d.candidates.clear();
+    d.best_model = d.explained_by = "";
+    d.outcome = Diagnosis::Outcome::Unexplained;
+    CHECK(headline(d) == "UNEXPLAINED: no catalogued effect was confirmed against held-out "
+                         "experiments");
 }
 
 TEST_CASE("when nothing is claimed the closest by held-out gap and the nearest to a claim are "

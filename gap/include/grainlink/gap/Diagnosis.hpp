@@ -208,6 +208,16 @@ struct Diagnosis {
 };
 const char *outcomeName(Diagnosis::Outcome outcome);
 
+/// Where a confirmed candidate stands, in words: "explains", or why it is not claimed ("does
+/// not beat the null model", "beats the null model but leaves a gap", ...).
+std::string standing(const CandidateResult &c);
+
+/// The verdict in one fixed form, the first line of the report: the outcome in capitals; the
+/// model it names (claimed, or the closest when unexplained) with each strength and its 95 %
+/// interval; the held-out gap with the base, with the model and with the null model; p against
+/// the level. `claim` says the same at length, with what it rests on.
+std::string headline(const Diagnosis &d);
+
 /// When nothing is claimed, two confirmed candidates come closest: the one whose added effect
 /// leaves the smallest held-out gap (of equal gaps, the best held-out density), and the one
 /// nearest to a claim (the smallest p against the
