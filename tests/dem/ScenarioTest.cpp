@@ -73,7 +73,9 @@ TEST_CASE("scenario errors name the file, the key and the line", "[dem][scenario
     SECTION("unknown key") {
         const std::string msg =
             errorOf(replaced(kValid, "gravity: mars", "gravity: mars\n  gravty: 3"));
-        CHECK(msg == "bad.yaml:5: unknown key 'simulation.gravty'");
+        // ... with the key it may be a typo of, one letter off one read beside it.
+        CHECK(msg == "bad.yaml:5: unknown key 'simulation.gravty' (misspelt? a key read here is "
+                     "'gravity')");
     }
     SECTION("wrong unit is recognised as such") {
         const std::string msg = errorOf(replaced(kValid, "time_step_s", "time_step_ms"));
