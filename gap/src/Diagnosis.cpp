@@ -299,9 +299,14 @@ std::string standing(const CandidateResult &c) {
 
 std::string headline(const Diagnosis &d) {
     const auto strength = [](const Effect &e, const StrengthFit &f) {
+        // An interval that ends where the prior does says less than it seems: the data may
+        // ask for more.
+        const bool cut = f.lo <= e.prior.lo || f.hi >= e.prior.hi;
         return e.parameter + " = " + fmt(f.strength) + " [" + fmt(f.lo) + ", " + fmt(f.hi) + "]" +
                (e.unit == "-" ? std::string() : " " + e.unit) +
-               (f.at_prior_edge ? " (at its prior's edge)" : "");
+               (f.at_prior_edge ? " (at its prior's edge)"
+                : cut           ? " (its interval cut at the prior's edge)"
+                                : "");
     };
     const auto heldOut = [&](double model, double p, double level, const std::string &why,
                              const GapVerdict &after) {

@@ -349,7 +349,7 @@ std::vector<std::string> writeDiagnosis(const Diagnosis &d, const ExperimentSet 
     std::ostringstream csv;
     csv.precision(10);
     csv << "experiment,observable,kind,x_lo,x_hi,held_out,measured,u_D,simulated,u_seed,u_bed,"
-           "u_num,u_val,dof,z,ratio,null_mean,null_sd,best_model,best_model_mean";
+           "u_num,u_val,dof,z,ratio,null_mean,null_sd,best_model,best_model_mean,best_model_z";
     for (const auto &[name, u] : d.validation.u_checks)
         csv << ",u_check_" << name;
     csv << '\n';
@@ -372,7 +372,8 @@ std::vector<std::string> writeDiagnosis(const Diagnosis &d, const ExperimentSet 
             << num(v.dof[k]) << ',' << num(v.z[k]) << ',' << num(v.ratio[k]) << ','
             << (held.count(k) && d.null_mean.size() ? num(d.null_mean[k]) : "") << ','
             << (held.count(k) && d.null_variance.size() ? num(std::sqrt(d.null_variance[k])) : "")
-            << ',' << best_name << ',' << (best ? num((*best)[k]) : "");
+            << ',' << best_name << ',' << (best ? num((*best)[k]) : "") << ','
+            << (best && d.best_model_z.size() == best->size() ? num(d.best_model_z[k]) : "");
         for (const auto &[name, u] : v.u_checks)
             csv << ',' << num(u[k]);
         csv << '\n';

@@ -1041,6 +1041,8 @@ TEST_CASE("the verdict line names the outcome, the model, its strength and why i
     c.effect.name = "grain_stiffness";
     c.effect.parameter = "stiffness_factor";
     c.effect.unit = "-";
+    c.effect.prior.lo = 0.2;
+    c.effect.prior.hi = 5.0;
     c.fit.strength = 4.04;
     c.fit.lo = 3.62;
     c.fit.hi = 4.51;
@@ -1065,6 +1067,7 @@ TEST_CASE("the verdict line names the outcome, the model, its strength and why i
     // Claimed, with a unit.
     c.effect.parameter = "zero_offset";
     c.effect.unit = "m";
+    c.effect.prior.lo = -2.0; // (the strengths are kept from above: only the words matter)
     c.name = c.effect.name = "sensor_zero_offset";
     c.explains = true;
     c.after.gap = false;
@@ -1075,6 +1078,10 @@ TEST_CASE("the verdict line names the outcome, the model, its strength and why i
                             "held-out gap 116 % -> 0 % with it (null model 40 %); p = 0.046 "
                             "against the level 0.05: explains",
                             0) == 0);
+    // An interval that ends at the prior's edge is said to.
+    d.candidates[0].fit.hi = 5.0;
+    CHECK(headline(d).find("zero_offset = 4.04 [3.62, 5] m (its interval cut at the prior's "
+                           "edge)") != std::string::npos);
     // Nothing confirmed.
     d.candidates.clear();
     d.best_model = d.explained_by = "";
