@@ -151,6 +151,8 @@ int printPlan(const gap::DiagnosisPlan &plan, const gap::ExperimentSet &set,
                     "claim needs two or more held-out experiments: two or more of a type, or "
                     "--hold-out)\n",
                     plan.held_out.empty() ? "no experiment is" : "one experiment is");
+    for (const std::string &note : gap::splitNotes(set, plan.held_out))
+        std::printf("note: %s\n", note.c_str());
     std::string checks;
     for (const std::string &c : sim.checks())
         checks += (checks.empty() ? "" : ", ") + c;
@@ -333,6 +335,12 @@ int GapCommand::diagnose() const {
     set.notes.insert(set.notes.end(), sim.labWarnings().begin(), sim.labWarnings().end());
     gap::DiagnosisOptions options = diagnosisOptions(base);
     options.held_out = checkedHeldOut(held_out_, set, left_out);
+    if (!dry_run_) // said in the report too (its Read: lines); the dry run prints its own
+        for (const std::string &note : gap::splitNotes(
+                 set, options.held_out.empty() ? gap::defaultHeldOut(set) : options.held_out)) {
+            std::fprintf(stderr, "[gap] split: %s\n", note.c_str());
+            set.notes.push_back(note);
+        }
     if (dry_run_)
         return printPlan(gap::planDiagnosis(set, effects, sim, options), set, sim, options);
     const gap::Diagnosis d = gap::diagnose(set, effects, sim, options);

@@ -370,6 +370,22 @@ const char *outcomeName(Diagnosis::Outcome outcome) {
     return "?";
 }
 
+std::vector<std::string> splitNotes(const ExperimentSet &set,
+                                    const std::vector<std::string> &held_out) {
+    std::map<ExperimentType, std::vector<std::string>> calibration, held;
+    for (const Experiment &e : set.experiments)
+        (std::find(held_out.begin(), held_out.end(), e.id) != held_out.end() ? held
+                                                                             : calibration)[e.type]
+            .push_back(e.id);
+    std::vector<std::string> notes;
+    for (const auto &[type, ids] : calibration)
+        if (ids.size() == 1 && held[type].size() >= 2)
+            notes.push_back(std::string(typeName(type)) + " is calibrated on one experiment (" +
+                            ids.front() + ") and held out on " + std::to_string(held[type].size()) +
+                            ": its fitted strengths rest on that one (--hold-out to choose)");
+    return notes;
+}
+
 std::vector<std::string> defaultHeldOut(const ExperimentSet &set) {
     std::map<ExperimentType, std::vector<const Experiment *>> by_type;
     for (const Experiment &e : set.experiments)

@@ -1179,6 +1179,13 @@ TEST_CASE("the default held-out experiments: the last box, else the last half of
     CHECK(defaultHeldOut(set(5, true)) == std::vector<std::string>{"p2", "p3", "p4"});
     // Two boxes, the last with one plate: the fuller box is held out instead.
     CHECK(defaultHeldOut(set(3, true)) == std::vector<std::string>{"p0", "p1"});
+    // What the split leaves thin is said: plates calibrated on one, three held out (the
+    // LIGGGHTS design's 1 + 3); the shear box alone of its type is calibration, not thin.
+    const std::vector<std::string> thin = splitNotes(set(4, false), {"p1", "p2", "p3"});
+    REQUIRE(thin.size() == 1);
+    CHECK(thin[0] == "plate_sinkage is calibrated on one experiment (p0) and held out on 3: its "
+                     "fitted strengths rest on that one (--hold-out to choose)");
+    CHECK(splitNotes(set(4, false), defaultHeldOut(set(4, false))).empty());
 }
 
 TEST_CASE("the self-test scores each twin against its key: claims, weak twins, nulls, effects "

@@ -237,6 +237,11 @@ ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidat
 /// down).
 std::vector<std::string> defaultHeldOut(const ExperimentSet &set);
 
+/// What the split leaves thin, in words: each type calibrated on a single experiment while
+/// two or more of it are held out (its strengths then rest on that one experiment).
+std::vector<std::string> splitNotes(const ExperimentSet &set,
+                                    const std::vector<std::string> &held_out);
+
 /// What a diagnosis will simulate before its first result, worked out without simulating
 /// (`grainlink gap diagnose --dry-run`): its features, its split, the base's runs and numerical
 /// checks, and every applicable effect's signature runs (needed once a gap shows).
