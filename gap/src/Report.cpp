@@ -256,9 +256,11 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
             char pct[32];
             std::snprintf(pct, sizeof pct, share < 0.01 ? "%.1f %%" : "%.0f %%", 100.0 * share);
             // A check whose every run failed somewhere counts as none there: not a measured 0.
+            // (a copy: C++17 lambdas cannot capture a structured binding)
+            const std::string name = part;
             const bool failed =
                 std::any_of(d.validation.check_failures.begin(), d.validation.check_failures.end(),
-                            [&](const auto &f) { return f.first == part; });
+                            [&](const auto &f) { return f.first == name; });
             if (part == "u_val")
                 total = pct;
             else
