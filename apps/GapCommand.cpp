@@ -335,14 +335,14 @@ int GapCommand::diagnose() const {
     set.notes.insert(set.notes.end(), sim.labWarnings().begin(), sim.labWarnings().end());
     gap::DiagnosisOptions options = diagnosisOptions(base);
     options.held_out = checkedHeldOut(held_out_, set, left_out);
-    if (!dry_run_) // said in the report too (its Read: lines); the dry run prints its own
-        for (const std::string &note : gap::splitNotes(
-                 set, options.held_out.empty() ? gap::defaultHeldOut(set) : options.held_out)) {
-            std::fprintf(stderr, "[gap] split: %s\n", note.c_str());
-            set.notes.push_back(note);
-        }
     if (dry_run_)
         return printPlan(gap::planDiagnosis(set, effects, sim, options), set, sim, options);
+    // Said in the report too, among its Read: lines.
+    for (const std::string &note : gap::splitNotes(
+             set, options.held_out.empty() ? gap::defaultHeldOut(set) : options.held_out)) {
+        std::fprintf(stderr, "[gap] split: %s\n", note.c_str());
+        set.notes.push_back(note);
+    }
     const gap::Diagnosis d = gap::diagnose(set, effects, sim, options);
     const auto files = gap::writeDiagnosis(d, set, out, shipped("tools/gap_report.py"));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -444,8 +444,8 @@ int GapCommand::importCsv() const {
     for (const std::string &y : csv_y_) {
         const std::string form = "OBSERVABLE=COLUMN:UNIT (\"pressure_Pa=Pressure [kPa]:kPa\")";
         const auto [obs, rest] = split("--y", form, y, '=');
-        if (rest.find(':') == std::string::npos)
-            split("--y", form, y, ':'); // no unit: said with the whole option
+        if (rest.find(':') == std::string::npos) // no unit: said with the whole option
+            throw std::invalid_argument("--y '" + y + "': give " + form);
         csv.y[obs] = split("--y", form, rest, ':');
     }
     for (const std::string &c : csv_conditions_) {

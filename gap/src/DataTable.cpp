@@ -288,4 +288,11 @@ std::string unitsRowDisagreement(const DataTable &table, std::size_t col, const 
            table.header[col] + "' in '" + cell + "', but it is read in '" + unit + "'";
 }
 
+std::string lineList(const std::vector<int> &lines) {
+    std::string list;
+    for (std::size_t i = 0; i < lines.size() && i < 5; ++i)
+        list += (i ? ", " : "") + std::to_string(lines[i]);
+    return list + (lines.size() > 5 ? ", ..." : "");
+}
+
 } // namespace grainlink::gap

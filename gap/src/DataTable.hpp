@@ -64,6 +64,9 @@ struct DataTable {
 std::string unitsRowDisagreement(const DataTable &table, std::size_t col, const std::string &unit,
                                  const std::string &dimension);
 
+/// File lines for a message: the first five, comma-separated, then ", ..." ("6, 7, 9").
+std::string lineList(const std::vector<int> &lines);
+
 /// Names quoted and comma-separated ('Sinkage, mm', 'Pressure, kPa'): a name holding a comma
 /// or a blank reads as one name. Every list of columns in a message is written by it.
 std::string quotedNames(const std::vector<std::string> &names);

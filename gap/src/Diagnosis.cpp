@@ -297,6 +297,23 @@ std::string standing(const CandidateResult &c) {
                           : "does not beat the null model";
 }
 
+NamedModel namedModel(const Diagnosis &d) {
+    NamedModel m;
+    for (const CandidateResult &c : d.candidates)
+        if (c.name == d.best_model && c.confirmed) {
+            m.single = &c;
+            m.strengths.emplace_back(&c.effect, c.fit);
+        }
+    for (const PairResult &p : d.pairs)
+        if (p.a + " + " + p.b == d.best_model && p.confirmed) {
+            m.pair = &p;
+            for (const CandidateResult &c : d.candidates)
+                if (c.name == p.a || c.name == p.b)
+                    m.strengths.emplace_back(&c.effect, c.name == p.a ? p.fit.a : p.fit.b);
+        }
+    return m;
+}
+
 std::string headline(const Diagnosis &d) {
     const auto strength = [](const Effect &e, const StrengthFit &f) {
         // An interval that ends where the prior does says less than it seems: the data may
@@ -327,30 +344,26 @@ std::string headline(const Diagnosis &d) {
         break;
     }
     const bool claimed = !d.explained_by.empty();
-    std::string out = claimed ? "EXPLAINED by " : "UNEXPLAINED";
-    for (const CandidateResult &c : d.candidates)
-        if (c.name == d.best_model && c.confirmed)
-            return out + (claimed ? "" : "; closest: ") + c.name + ", " +
-                   strength(c.effect, c.fit) +
-                   heldOut(c.held_out.gap, c.versus_null.p_value, d.single_level, standing(c),
-                           c.after);
-    for (const PairResult &p : d.pairs)
-        if (p.a + " + " + p.b == d.best_model && p.confirmed) {
-            std::string strengths;
-            for (const CandidateResult &c : d.candidates)
-                if (c.name == p.a || c.name == p.b)
-                    strengths += (strengths.empty() ? "" : ", ") +
-                                 strength(c.effect, c.name == p.a ? p.fit.a : p.fit.b);
-            const bool beats =
-                p.versus_null.mean_gain > 0.0 && p.versus_null.p_value < d.pair_level;
-            const std::string why = p.explains    ? "explains"
-                                    : !beats      ? "does not beat the null model"
-                                    : p.after.gap ? "beats the null model but leaves a gap"
-                                                  : "beats the null model but is not claimable";
-            return out + (claimed ? "the pair " : "; closest: the pair ") + d.best_model + ", " +
-                   strengths +
-                   heldOut(p.held_out.gap, p.versus_null.p_value, d.pair_level, why, p.after);
-        }
+    const std::string out = claimed ? "EXPLAINED by " : "UNEXPLAINED";
+    const NamedModel m = namedModel(d);
+    std::string strengths;
+    for (const auto &[effect, fit] : m.strengths)
+        strengths += (strengths.empty() ? "" : ", ") + strength(*effect, fit);
+    if (const CandidateResult *c = m.single)
+        return out + (claimed ? "" : "; closest: ") + c->name + ", " + strengths +
+               heldOut(c->held_out.gap, c->versus_null.p_value, d.single_level, standing(*c),
+                       c->after);
+    if (const PairResult *pp = m.pair) {
+        const PairResult &p = *pp;
+        const bool beats = p.versus_null.mean_gain > 0.0 && p.versus_null.p_value < d.pair_level;
+        const std::string why = p.explains    ? "explains"
+                                : !beats      ? "does not beat the null model"
+                                : p.after.gap ? "beats the null model but leaves a gap"
+                                              : "beats the null model but is not claimable";
+        return out + (claimed ? "the pair " : "; closest: the pair ") + d.best_model + ", " +
+               strengths +
+               heldOut(p.held_out.gap, p.versus_null.p_value, d.pair_level, why, p.after);
+    }
     return out + ": no catalogued effect was confirmed against held-out experiments";
 }
 

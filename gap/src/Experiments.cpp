@@ -879,16 +879,12 @@ ExperimentSet loadExperiments(const std::string &directory) {
                     if (e.scatter && !t.curves.empty())
                         e.trials.push_back(std::move(t));
                 }
-                if (!gaps.empty()) {
-                    std::string where;
-                    for (std::size_t i = 0; i < gaps.size() && i < 5; ++i)
-                        where += (i ? ", " : "") + std::to_string(gaps[i]);
+                if (!gaps.empty())
                     set.notes.push_back(path.string() + ": " + std::to_string(gaps.size()) +
                                         " of " + std::to_string(table.rows.size()) +
                                         " rows miss a value (empty or NaN) in a column read; "
                                         "those samples are left out (lines " +
-                                        where + (gaps.size() > 5 ? ", ..." : "") + ")");
-                }
+                                        lineList(gaps) + ")");
                 if (wholes.empty() && !e.scatter)
                     f.fail("no rows of " + path.string() + " pass the filter");
                 for (std::size_t w = 0; w < wholes.size() && !e.scatter; ++w) {

@@ -330,7 +330,6 @@ std::string withImportOptions(std::string message) {
         {"data.units_row: true", "--units-row"},
         {"data.columns", "--columns"},
         {"data.skip_lines", "--skip-lines"},
-
         {"start it with data.comment", "start it with the mark of --comment"},
         {"data.comment", "--comment"}};
     for (const auto &[key, option] : keys)
@@ -763,15 +762,11 @@ std::vector<std::string> importCsv(const CsvImport &csv, const std::string &out)
                         missing.push_back(c.lines[r]);
                 // A curve's gaps stay in its copy, and the diagnosis says them as it reads
                 // it; a scalar's values are written inline, so they are said here.
-                if (scalar && !missing.empty()) {
-                    std::string where;
-                    for (std::size_t i = 0; i < missing.size() && i < 5; ++i)
-                        where += (i ? ", " : "") + std::to_string(missing[i]);
+                if (scalar && !missing.empty())
                     warnings.push_back(file + ": " + std::to_string(missing.size()) + " of " +
                                        std::to_string(c.rows.size()) + " rows miss a value in '" +
                                        name + "' (empty or NaN); those are left out (lines " +
-                                       where + (missing.size() > 5 ? ", ..." : "") + ")");
-                }
+                                       lineList(missing) + ")");
             }
         } catch (const config::ConfigError &e) {
             throw config::ConfigError(withImportOptions(e.what()));

@@ -95,27 +95,23 @@ Json verdictJson(const Diagnosis &d) {
                          {"with_model", nullptr}};
     v["p_value_against_null"] = nullptr;
     v["level"] = nullptr;
-    const auto add = [&](const Effect &e, const StrengthFit &f) {
-        Json s = strength(e, f);
-        s["effect"] = e.name;
+    const NamedModel m = namedModel(d);
+    for (const auto &[effect, fit] : m.strengths) {
+        Json s = strength(*effect, fit);
+        s["effect"] = effect->name;
         v["strengths"].push_back(s);
-    };
-    for (const CandidateResult &c : d.candidates)
-        if (c.name == d.best_model && c.confirmed) {
-            add(c.effect, c.fit);
-            v["held_out_gap"]["with_model"] = number(c.held_out.gap);
-            v["p_value_against_null"] = number(c.versus_null.p_value);
-            v["level"] = number(d.single_level);
-        }
-    for (const PairResult &p : d.pairs)
-        if (p.a + " + " + p.b == d.best_model && p.confirmed) {
-            for (const CandidateResult &c : d.candidates)
-                if (c.name == p.a || c.name == p.b)
-                    add(c.effect, c.name == p.a ? p.fit.a : p.fit.b);
-            v["held_out_gap"]["with_model"] = number(p.held_out.gap);
-            v["p_value_against_null"] = number(p.versus_null.p_value);
-            v["level"] = number(d.pair_level);
-        }
+    }
+    const HeldOutScore *held = m.single ? &m.single->held_out
+                               : m.pair ? &m.pair->held_out
+                                        : nullptr;
+    const DensityComparison *test = m.single ? &m.single->versus_null
+                                    : m.pair ? &m.pair->versus_null
+                                             : nullptr;
+    if (held) {
+        v["held_out_gap"]["with_model"] = number(held->gap);
+        v["p_value_against_null"] = number(test->p_value);
+        v["level"] = number(m.single ? d.single_level : d.pair_level);
+    }
     v["gap_test"] = {{"flagged_features", d.verdict.flagged}, {"features", d.verdict.features}};
     return v;
 }

@@ -212,6 +212,15 @@ const char *outcomeName(Diagnosis::Outcome outcome);
 /// not beat the null model", "beats the null model but leaves a gap", ...).
 std::string standing(const CandidateResult &c);
 
+/// The confirmed candidate or pair that `best_model` names, with each of its effects and
+/// fitted strengths; neither when nothing confirmed is named.
+struct NamedModel {
+    const CandidateResult *single = nullptr;
+    const PairResult *pair = nullptr;
+    std::vector<std::pair<const Effect *, StrengthFit>> strengths;
+};
+NamedModel namedModel(const Diagnosis &d);
+
 /// The verdict in one fixed form, the first line of the report: the outcome in capitals; the
 /// model it names (claimed, or the closest when unexplained) with each strength and its 95 %
 /// interval; the held-out gap with the base, with the model and with the null model; p against
