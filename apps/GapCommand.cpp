@@ -338,8 +338,7 @@ int GapCommand::diagnose() const {
     if (dry_run_)
         return printPlan(gap::planDiagnosis(set, effects, sim, options), set, sim, options);
     // Said in the report too, among its Read: lines.
-    for (const std::string &note : gap::splitNotes(
-             set, options.held_out.empty() ? gap::defaultHeldOut(set) : options.held_out)) {
+    for (const std::string &note : gap::splitNotes(set, gap::heldOutIds(set, options))) {
         std::fprintf(stderr, "[gap] split: %s\n", note.c_str());
         set.notes.push_back(note);
     }

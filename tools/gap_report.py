@@ -14,12 +14,14 @@ import html
 import io
 import json
 import math
+import os
 import sys
 from collections import OrderedDict
 
 import matplotlib
 
 matplotlib.use("Agg")
+import matplotlib.colors  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 
 
@@ -103,23 +105,44 @@ def curves_plot(rows, diag):
     return png(fig)
 
 
-def residual_map(rows):
-    exps = list(OrderedDict.fromkeys((r["experiment"], r["observable"]) for r in rows))
-    width = max(sum(1 for r in rows if (r["experiment"], r["observable"]) == e) for e in exps)
-    grid = [[math.nan] * width for _ in exps]
-    for i, e in enumerate(exps):
-        k = 0
-        for r in rows:
-            if (r["experiment"], r["observable"]) == e:
-                grid[i][k] = number(r["z"])
-                k += 1
-    fig, ax = plt.subplots(figsize=(1.0 + 0.6 * width, 0.8 + 0.35 * len(exps)))
-    im = ax.imshow(grid, cmap="RdBu", vmin=-6, vmax=6, aspect="auto")
-    ax.set_yticks(range(len(exps)))
-    ax.set_yticklabels([f"{e} {o}" for e, o in exps], fontsize=7)
-    ax.set_xlabel("bin (increasing x)", fontsize=8)
-    fig.colorbar(im, ax=ax, label="z = (meas. - sim.) / u_val")
-    ax.set_title("standardised residuals (|z| > 2: outside the validation uncertainty)", fontsize=9)
+def residual_map(rows, diag):
+    """One panel per kind of observable, one row per experiment, each bin drawn over its own x
+    range in the kind's unit: z = (measured - simulated) / u_val."""
+    kinds = OrderedDict()
+    for r in rows:
+        kinds.setdefault(r["kind"], OrderedDict()).setdefault(r["experiment"], []).append(r)
+    if not kinds:
+        return None
+    held = set(diag.get("held_out_experiments", []))
+    cmap, norm = plt.get_cmap("RdBu"), matplotlib.colors.Normalize(vmin=-6, vmax=6)
+    heights = [max(1, len(exps)) for exps in kinds.values()]
+    fig, axes = plt.subplots(len(kinds), 1, squeeze=False, layout="constrained",
+                             figsize=(8.0, 1.0 + 0.3 * sum(heights) + 0.6 * len(kinds)),
+                             gridspec_kw={"height_ratios": heights})
+    for ax, (kind, exps) in zip(axes[:, 0], kinds.items()):
+        label, scale = axis_of(kind)
+        scalar = all(number(r["x_lo"]) == number(r["x_hi"]) for rs in exps.values() for r in rs)
+        for i, rs in enumerate(exps.values()):
+            for j, r in enumerate(rs):
+                lo, hi = (j, j + 1) if scalar else (number(r["x_lo"]) * scale,
+                                                    number(r["x_hi"]) * scale)
+                z = number(r["z"])
+                ax.barh(i, hi - lo, left=lo, height=0.9,
+                        color=cmap(norm(z)) if math.isfinite(z) else "lightgrey",
+                        edgecolor="k" if math.isfinite(z) and abs(z) > 2 else "none",
+                        linewidth=0.6)
+        ax.set_yticks(range(len(exps)))
+        ax.set_yticklabels([e + (" (held out)" if e in held else "") for e in exps], fontsize=7)
+        ax.invert_yaxis()
+        ax.set_title(kind, fontsize=8)
+        ax.set_xlabel("(one value)" if scalar else label, fontsize=8)
+        if scalar:
+            ax.set_xticks([])
+        ax.tick_params(labelsize=7)
+    fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=list(axes[:, 0]),
+                 label="z = (meas. - sim.) / u_val")
+    axes[0, 0].set_title("standardised residuals (outlined: |z| > 2, outside the validation "
+                         "uncertainty)\n" + axes[0, 0].get_title(), fontsize=9)
     return png(fig)
 
 
@@ -171,6 +194,10 @@ def before_after(diag):
 def main(directory):
     with open(f"{directory}/diagnosis.json") as f:
         diag = json.load(f)
+    if "verdict" not in diag:
+        sys.exit(f"{directory}/diagnosis.json has no 'verdict': it was written by an older "
+                 "grainlink; run `grainlink gap diagnose` again with its --sims cache (no "
+                 "simulation is repeated)")
     with open(f"{directory}/features.csv") as f:
         rows = list(csv.DictReader(f))
     with open(f"{directory}/report.txt") as f:
@@ -181,10 +208,11 @@ def main(directory):
                 "(blue band), the model the verdict names (red dashes) and, on held-out "
                 "experiments, the null model: the base plus a generic correction fitted on the "
                 "calibration experiments (green dots)."),
-               ("Where the gap lies", residual_map(rows),
-                "Each row is one experiment, each cell one bin of its x (sinkage, shear "
-                "displacement, slip) from left to right; red and blue cells lie more than 2 u_val "
-                "off the measurement, one way or the other."),
+               ("Where the gap lies", residual_map(rows, diag),
+                "One panel per kind of observable, one row per experiment, each cell one bin "
+                "drawn over its own range of x (sinkage, shear displacement, slip) in the axis's "
+                "unit; red: the simulation is too high there, blue: too low; outlined cells lie "
+                "more than 2 u_val off the measurement."),
                ("Held-out gap", before_after(diag),
                 "How far the held-out experiments lie beyond their validation uncertainty with "
                 "the base, the null model and each re-simulated candidate. A shorter bar than the "
@@ -211,7 +239,6 @@ def main(directory):
     parts.append(f"<h2>Report</h2><pre>{html.escape(text)}</pre></body></html>")
     with open(f"{directory}/report.html.tmp", "w") as f:
         f.write("\n".join(parts))
-    import os
     os.replace(f"{directory}/report.html.tmp", f"{directory}/report.html")
 
 

@@ -449,14 +449,13 @@ std::vector<std::string> defaultHeldOut(const ExperimentSet &set) {
     return held;
 }
 
-namespace {
-
-/// The held-out experiments: the user's, each checked to exist, or the default split.
 std::vector<std::string> heldOutIds(const ExperimentSet &set, const DiagnosisOptions &opt) {
     for (const std::string &id : opt.held_out)
         set.find(id); // throws naming an unknown id
     return opt.held_out.empty() ? defaultHeldOut(set) : opt.held_out;
 }
+
+namespace {
 
 /// Step 1's runs: the base over its seeds, and each numerical check.
 std::vector<VariantRequest> firstRequests(const Simulator &simulator, const DiagnosisOptions &opt) {

@@ -246,6 +246,10 @@ ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidat
 /// down).
 std::vector<std::string> defaultHeldOut(const ExperimentSet &set);
 
+/// The held-out experiments of a diagnosis: `opt.held_out`, each checked to exist, or else
+/// `defaultHeldOut`.
+std::vector<std::string> heldOutIds(const ExperimentSet &set, const DiagnosisOptions &opt);
+
 /// What the split leaves thin, in words: each type calibrated on a single experiment while
 /// two or more of it are held out (its strengths then rest on that one experiment).
 std::vector<std::string> splitNotes(const ExperimentSet &set,
