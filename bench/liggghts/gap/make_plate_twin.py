@@ -8,11 +8,15 @@ damping. The laws differ from grainlink's (its linear tangential spring with sti
 angles, viscous normal damping), so even the unaltered soil is not grainlink's base: every
 twin carries a code difference besides its hidden effect, as real data would.
 
-    make_plate_twin.py --out MEAS [--set coh=2e5] [--seeds 3] [--label NAME]
+    make_plate_twin.py --out MEAS [--set coh=2e5] [--zero-offset M] [--compliance M_PER_N]
+                       [--seeds 3] [--label NAME]
 
 writes MEAS/experiments.yaml and MEAS/data/*.csv (three plates in the 50 mm box, one in the
 35 mm box, one bed per seed and box, every plate on a copy of it) and the key (what was
-changed) to MEAS.key.json, outside the folder the diagnosis reads.
+changed) to MEAS.key.json, outside the folder the diagnosis reads. `--zero-offset` and
+`--compliance` hide an error of the measuring chain instead of the soil's: every written
+sinkage reads M more (a zero picked early), or c F more (a rig deflecting under the plate's
+force F).
 """
 import argparse
 import json
@@ -132,6 +136,10 @@ def main():
     parser.add_argument("--out", required=True)
     parser.add_argument("--set", action="append", default=[],
                         help="NAME=VALUE over the base soil: E, e, mu, mur, coh, rho, dt")
+    parser.add_argument("--zero-offset", type=float, default=0.0, metavar="M",
+                        help="add M metres to every written sinkage")
+    parser.add_argument("--compliance", type=float, default=0.0, metavar="M_PER_N",
+                        help="add c times the plate's force to every written sinkage")
     parser.add_argument("--seeds", type=int, default=3)
     parser.add_argument("--first-seed", type=int, default=0)
     parser.add_argument("--label", default="")
@@ -163,8 +171,10 @@ def main():
                 with open(os.path.join(opts.out, name), "w") as f:
                     f.write(f"# LIGGGHTS 3.8 plate sinkage, bench/liggghts/gap ({opts.label})\n")
                     f.write("sinkage_mm,pressure_kPa\n")
+                    area = math.pi * diameter ** 2 / 4
                     for z, p in curve:
-                        f.write(f"{z * 1000:.4f},{p / 1000:.5f}\n")
+                        read = z + opts.zero_offset + opts.compliance * p * area
+                        f.write(f"{read * 1000:.4f},{p / 1000:.5f}\n")
                 files[exp_id].append(name)
                 print(f"{exp_id} seed {rep + 1}: {len(curve)} samples, "
                       f"p({z * 1000:.1f} mm) = {p / 1000:.2f} kPa", flush=True)
@@ -182,8 +192,11 @@ def main():
             f.write("      y:\n        pressure_Pa: {column: pressure_kPa, unit: kPa}\n")
             f.write("    zero: {method: as_recorded}\n")
             f.write("    uncertainty: {y_relative: 0.01, repeats: rebuilt_bed}\n")
-    key = {"code": "LIGGGHTS 3.8", "label": opts.label, "changed": {
-        k: soil[k] for k in soil if soil[k] != BASE[k]}, "soil": soil}
+    changed = {k: soil[k] for k in soil if soil[k] != BASE[k]}
+    for name in ("zero_offset", "compliance"):
+        if getattr(opts, name):
+            changed[name] = getattr(opts, name)
+    key = {"code": "LIGGGHTS 3.8", "label": opts.label, "changed": changed, "soil": soil}
     with open(os.path.normpath(opts.out) + ".key.json", "w") as f:
         json.dump(key, f, indent=2)
     shutil.rmtree(workdir)
