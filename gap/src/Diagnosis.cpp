@@ -899,6 +899,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         if (!L.response)
             continue;
         L.result.fit = fitEffect(L);
+        L.result.ranking_chi2 = L.result.fit.chi2;
         L.result.calibration_gain = L.result.fit.chi2_off - L.result.fit.chi2;
         const Eigen::VectorXd m = L.response->mean(L.result.fit.strength);
         L.result.predicted = scoreHeldOut(meas.value, m,

@@ -162,6 +162,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
             cj["acts_on_design"] = c.actsOnDesign();
             cj["strength"] = strength(c.effect, c.fit);
             cj["calibration_chi2"] = number(c.fit.chi2);
+            cj["ranking_chi2"] = number(c.ranking_chi2); // on the signatures alone
             cj["calibration_chi2_gain"] = number(c.calibration_gain);
             cj["confirmed"] = c.confirmed;
             if (c.confirmed) {
@@ -276,7 +277,9 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
     for (const auto &e : d.held_out_experiments)
         r << e << ' ';
     r << "\nHeld-out gap beyond uncertainty: base " << pct(d.held_out_base.gap) << ", null model "
-      << pct(d.held_out_null.gap) << "\n\nCandidates (by calibration chi^2):\n";
+      << pct(d.held_out_null.gap)
+      << "\n\nCandidates (by calibration chi^2 on their signatures, which chose those "
+         "re-simulated):\n";
     for (const CandidateResult &c : d.candidates) {
         r << "  " << c.name << ": ";
         if (!c.applicability.empty()) {
@@ -290,6 +293,9 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
         }
         r << c.effect.parameter << " = " << c.fit.strength << " [" << c.fit.lo << ", " << c.fit.hi
           << "] " << c.effect.unit << ", chi^2 " << c.fit.chi2 << " (off: " << c.fit.chi2_off << ")";
+        // Refitted once its confirming runs joined the table: say what ranked it too.
+        if (std::abs(c.fit.chi2 - c.ranking_chi2) > 1e-6 * (1.0 + c.ranking_chi2))
+            r << " with its confirming runs (" << c.ranking_chi2 << " on the signatures alone)";
         if (c.confirmed)
             r << "; re-simulated at it: held-out gap " << pct(c.held_out.gap)
               << ", p = " << c.versus_null.p_value << ", "

@@ -99,6 +99,9 @@ struct CandidateResult {
     std::string applicability; ///< empty: applicable; else why not
     Effect effect;             ///< resolved against the base
     StrengthFit fit;           ///< on the calibration features
+    /// chi^2 of the fit on the signatures alone, which ranks the candidates and chose those
+    /// re-simulated (`fit.chi2` is refitted once a confirming run joins the table)
+    double ranking_chi2 = 0.0;
     double signature_chi2 = 0.0; ///< its largest simulated change of the design, in chi^2 (u_val);
                                  ///< below 1 the effect does not act on these experiments
     /// Whether its strongest simulated change moves the design by a unit of u_val or more: one
