@@ -455,25 +455,6 @@ std::vector<std::string> heldOutIds(const ExperimentSet &set, const DiagnosisOpt
     return opt.held_out.empty() ? defaultHeldOut(set) : opt.held_out;
 }
 
-std::vector<double> coveringSignature(const Prior &prior, std::vector<double> signature) {
-    const double t_off = prior.toScale(prior.off);
-    for (const double end : {prior.lo, prior.hi}) {
-        const double t_end = prior.toScale(end), side = t_end > t_off ? 1.0 : -1.0;
-        if (std::abs(t_end - t_off) <= 1e-12 * (1.0 + std::abs(t_off)))
-            continue; // off at this end: nothing beyond it
-        // The signature strength nearest this end, on its side of off (off itself if none).
-        double t_near = t_off;
-        for (double s : signature)
-            if ((prior.toScale(s) - t_off) * side > (t_near - t_off) * side)
-                t_near = prior.toScale(s);
-        // Farther from the end than from off: half the way out is simulated too.
-        if (std::abs(t_end - t_near) > std::abs(t_near - t_off) + 1e-12)
-            signature.push_back(prior.fromScale(0.5 * (t_near + t_end)));
-    }
-    std::sort(signature.begin(), signature.end());
-    return signature;
-}
-
 namespace {
 
 /// Step 1's runs: the base over its seeds, and each numerical check.
@@ -512,7 +493,7 @@ std::vector<VariantRequest> signatureRequests(const Effect &raw, const Effect &e
                                   (e.prior.toScale(e.prior.hi) - e.prior.toScale(e.prior.lo)) * i /
                                       (opt.measurement_grid - 1.0)));
     else
-        strengths = coveringSignature(e.prior, e.signature);
+        strengths = e.signature;
     std::vector<VariantRequest> out;
     for (double s : strengths) {
         if (std::abs(s - e.prior.off) <= 1e-12 * (1.0 + std::abs(s)))

@@ -1188,38 +1188,6 @@ TEST_CASE("the default held-out experiments: the last box, else the last half of
     CHECK(splitNotes(set(4, false), defaultHeldOut(set(4, false))).empty());
 }
 
-TEST_CASE("a signature reaches towards each prior end that lies far beyond its strengths",
-          "[gap][diagnosis]") {
-    // The shipped rolling resistance (prior 0-0.6, signature 0.2 and 0.5) on a base whose own
-    // coefficient is 0.3: 0 to 0.2 lies twice as far as 0.2 from 0.3, so 0.1 is simulated too;
-    // 0.6 lies nearer 0.5 than 0.3 does, so nothing more above.
-    Prior rolling{0.0, 0.6, 0.3, false};
-    const std::vector<double> base_03 = coveringSignature(rolling, {0.2, 0.5});
-    REQUIRE(base_03.size() == 3);
-    CHECK(base_03[0] == Approx(0.1));
-    CHECK(base_03[1] == 0.2);
-    CHECK(base_03[2] == 0.5);
-    // Off at the prior's lower end (no rolling in the base): the shipped strengths cover it.
-    rolling.off = 0.0;
-    CHECK(coveringSignature(rolling, {0.2, 0.5}) == std::vector<double>{0.2, 0.5});
-    // Off equal to a signature strength (which the diagnosis skips as the base itself): the
-    // side above has none, and gets the point halfway from 0.5 to 0.6.
-    rolling.off = 0.5;
-    const std::vector<double> base_05 = coveringSignature(rolling, {0.2, 0.5});
-    REQUIRE(base_05.size() == 3);
-    CHECK(base_05[2] == Approx(0.55));
-    // On a log scale the distances are ratios: grain stiffness 0.33 and 3 around 1 within
-    // 0.2-5 need nothing (ln 5/3 = 0.51 < ln 3 = 1.10). A base at 2 needs one above only
-    // (ln 5/3 = 0.51 > ln 3/2 = 0.41; below, ln 0.33/0.2 = 0.50 < ln 2/0.33 = 1.80): the
-    // geometric midpoint sqrt(3 x 5).
-    Prior stiffness{0.2, 5.0, 1.0, true};
-    CHECK(coveringSignature(stiffness, {0.33, 3.0}) == std::vector<double>{0.33, 3.0});
-    stiffness.off = 2.0;
-    const std::vector<double> stiff_2 = coveringSignature(stiffness, {0.33, 3.0});
-    REQUIRE(stiff_2.size() == 3);
-    CHECK(stiff_2[2] == Approx(std::sqrt(15.0)));
-}
-
 TEST_CASE("the self-test scores each twin against its key: claims, weak twins, nulls, effects "
           "outside the catalogue, and the hidden effect named without a claim",
           "[gap][selftest]") {

@@ -249,15 +249,6 @@ ClosestCandidates closestCandidates(const std::vector<CandidateResult> &candidat
 /// down).
 std::vector<std::string> defaultHeldOut(const ExperimentSet &set);
 
-/// The strengths an effect's signature simulates: its catalogue `signature`, and on each side
-/// of the base's value (`prior.off`, which the catalogue does not know: a base's own rolling
-/// coefficient) whose prior end lies farther from the nearest of them than that one lies from
-/// off, one more halfway to that end. A fit is searched over the whole prior, and beyond its
-/// table the response is extrapolated straight: a base with rolling 0.3 and signatures 0.2 and
-/// 0.5 had a third of the prior (0 to 0.2) extrapolated, and a hidden 0.09 was fitted at 0.18
-/// with chi^2 445 against 107 for a wrong effect.
-std::vector<double> coveringSignature(const Prior &prior, std::vector<double> signature);
-
 /// The held-out experiments of a diagnosis: `opt.held_out`, each checked to exist, or else
 /// `defaultHeldOut`.
 std::vector<std::string> heldOutIds(const ExperimentSet &set, const DiagnosisOptions &opt);
