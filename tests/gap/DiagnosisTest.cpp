@@ -428,6 +428,15 @@ TEST_CASE("the diagnosis writes diagnosis.json, features.csv, report.txt and a s
             CHECK(c["held_out_gain"]["features"] == 32);
             CHECK(c["held_out_gain"]["mean_per_feature"].get<double>() > 0.0);
         }
+    // The candidates are listed as the report's heading says, by the chi^2 on their signatures
+    // that chose those re-simulated (a confirmed one's calibration_chi2 is refitted after).
+    double ranked = -1.0;
+    for (const auto &c : j["candidates"])
+        if (c.contains("ranking_chi2")) {
+            CHECK(c["ranking_chi2"].get<double>() >= ranked);
+            ranked = c["ranking_chi2"].get<double>();
+        }
+    CHECK(ranked >= 0.0);
     // The budget of u_val: the analytic simulator's one check, the seeds, the measurement.
     CHECK(j["uncertainty_budget"].contains("resolution"));
     CHECK(j["uncertainty_budget"]["u_val"].get<double>() >=
@@ -451,6 +460,7 @@ TEST_CASE("the diagnosis writes diagnosis.json, features.csv, report.txt and a s
         CHECK(text.find("data:image/png;base64,") != std::string::npos);
         CHECK(text.find("EXPLAINED by cohesion") != std::string::npos);
         CHECK(text.find("<i>Each panel is one experiment") != std::string::npos); // captions
+        CHECK(text.find("<i>One panel per kind of observable") != std::string::npos);
     } else {
         WARN("report.html not made: /usr/bin/python3 with matplotlib missing");
     }
