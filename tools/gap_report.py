@@ -21,7 +21,6 @@ from collections import OrderedDict
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.colors  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 
 
@@ -51,6 +50,11 @@ def axis_of(kind):
     return "", 1.0
 
 
+def is_scalar(rows):
+    """A scalar observable (an angle of repose): every feature at one x."""
+    return all(number(r["x_lo"]) == number(r["x_hi"]) for r in rows)
+
+
 def quantity_of(observable):
     """pressure_Pa -> 'pressure [Pa]': the SI name's unit as an axis label."""
     for unit in ("Pa", "N_m", "N", "m", "deg"):
@@ -75,7 +79,7 @@ def curves_plot(rows, diag):
     for ax, ((exp, obs), rs) in zip(axes.flat, panels.items()):
         label, scale = axis_of(rs[0]["kind"])
         x = [0.5 * (number(r["x_lo"]) + number(r["x_hi"])) * scale for r in rs]
-        if all(number(r["x_lo"]) == number(r["x_hi"]) for r in rs):
+        if is_scalar(rs):
             x = list(range(len(rs)))
         m = [number(r["measured"]) for r in rs]
         ud = [2 * number(r["u_D"]) for r in rs]
@@ -114,14 +118,14 @@ def residual_map(rows, diag):
     if not kinds:
         return None
     held = set(diag.get("held_out_experiments", []))
-    cmap, norm = plt.get_cmap("RdBu"), matplotlib.colors.Normalize(vmin=-6, vmax=6)
+    cmap, norm = plt.get_cmap("RdBu"), plt.Normalize(vmin=-6, vmax=6)
     heights = [max(1, len(exps)) for exps in kinds.values()]
     fig, axes = plt.subplots(len(kinds), 1, squeeze=False, layout="constrained",
                              figsize=(8.0, 1.0 + 0.3 * sum(heights) + 0.6 * len(kinds)),
                              gridspec_kw={"height_ratios": heights})
     for ax, (kind, exps) in zip(axes[:, 0], kinds.items()):
         label, scale = axis_of(kind)
-        scalar = all(number(r["x_lo"]) == number(r["x_hi"]) for rs in exps.values() for r in rs)
+        scalar = is_scalar([r for rs in exps.values() for r in rs])
         for i, rs in enumerate(exps.values()):
             for j, r in enumerate(rs):
                 lo, hi = (j, j + 1) if scalar else (number(r["x_lo"]) * scale,
@@ -139,7 +143,7 @@ def residual_map(rows, diag):
         if scalar:
             ax.set_xticks([])
         ax.tick_params(labelsize=7)
-    fig.colorbar(matplotlib.cm.ScalarMappable(norm=norm, cmap=cmap), ax=list(axes[:, 0]),
+    fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=list(axes[:, 0]),
                  label="z = (meas. - sim.) / u_val")
     axes[0, 0].set_title("standardised residuals (outlined: |z| > 2, outside the validation "
                          "uncertainty)\n" + axes[0, 0].get_title(), fontsize=9)

@@ -303,6 +303,9 @@ NamedModel namedModel(const Diagnosis &d) {
         if (c.name == d.best_model && c.confirmed) {
             m.single = &c;
             m.strengths.emplace_back(&c.effect, c.fit);
+            m.held_out = &c.held_out;
+            m.versus_null = &c.versus_null;
+            m.level = d.single_level;
         }
     for (const PairResult &p : d.pairs)
         if (p.a + " + " + p.b == d.best_model && p.confirmed) {
@@ -310,6 +313,9 @@ NamedModel namedModel(const Diagnosis &d) {
             for (const CandidateResult &c : d.candidates)
                 if (c.name == p.a || c.name == p.b)
                     m.strengths.emplace_back(&c.effect, c.name == p.a ? p.fit.a : p.fit.b);
+            m.held_out = &p.held_out;
+            m.versus_null = &p.versus_null;
+            m.level = d.pair_level;
         }
     return m;
 }
@@ -351,18 +357,15 @@ std::string headline(const Diagnosis &d) {
         strengths += (strengths.empty() ? "" : ", ") + strength(*effect, fit);
     if (const CandidateResult *c = m.single)
         return out + (claimed ? "" : "; closest: ") + c->name + ", " + strengths +
-               heldOut(c->held_out.gap, c->versus_null.p_value, d.single_level, standing(*c),
-                       c->after);
-    if (const PairResult *pp = m.pair) {
-        const PairResult &p = *pp;
-        const bool beats = p.versus_null.mean_gain > 0.0 && p.versus_null.p_value < d.pair_level;
-        const std::string why = p.explains    ? "explains"
-                                : !beats      ? "does not beat the null model"
-                                : p.after.gap ? "beats the null model but leaves a gap"
-                                              : "beats the null model but is not claimable";
+               heldOut(m.held_out->gap, m.versus_null->p_value, m.level, standing(*c), c->after);
+    if (const PairResult *p = m.pair) {
+        const bool beats = p->versus_null.mean_gain > 0.0 && p->versus_null.p_value < m.level;
+        const std::string why = p->explains    ? "explains"
+                                : !beats       ? "does not beat the null model"
+                                : p->after.gap ? "beats the null model but leaves a gap"
+                                               : "beats the null model but is not claimable";
         return out + (claimed ? "the pair " : "; closest: the pair ") + d.best_model + ", " +
-               strengths +
-               heldOut(p.held_out.gap, p.versus_null.p_value, d.pair_level, why, p.after);
+               strengths + heldOut(m.held_out->gap, m.versus_null->p_value, m.level, why, p->after);
     }
     return out + ": no catalogued effect was confirmed against held-out experiments";
 }

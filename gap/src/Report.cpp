@@ -101,16 +101,10 @@ Json verdictJson(const Diagnosis &d) {
         s["effect"] = effect->name;
         v["strengths"].push_back(s);
     }
-    const HeldOutScore *held = m.single ? &m.single->held_out
-                               : m.pair ? &m.pair->held_out
-                                        : nullptr;
-    const DensityComparison *test = m.single ? &m.single->versus_null
-                                    : m.pair ? &m.pair->versus_null
-                                             : nullptr;
-    if (held) {
-        v["held_out_gap"]["with_model"] = number(held->gap);
-        v["p_value_against_null"] = number(test->p_value);
-        v["level"] = number(m.single ? d.single_level : d.pair_level);
+    if (m.held_out) {
+        v["held_out_gap"]["with_model"] = number(m.held_out->gap);
+        v["p_value_against_null"] = number(m.versus_null->p_value);
+        v["level"] = number(m.level);
     }
     v["gap_test"] = {{"flagged_features", d.verdict.flagged}, {"features", d.verdict.features}};
     return v;

@@ -216,11 +216,15 @@ const char *outcomeName(Diagnosis::Outcome outcome);
 std::string standing(const CandidateResult &c);
 
 /// The confirmed candidate or pair that `best_model` names, with each of its effects and
-/// fitted strengths; neither when nothing confirmed is named.
+/// fitted strengths, its held-out score and test, and the level it was judged at; neither
+/// (null pointers) when nothing confirmed is named.
 struct NamedModel {
     const CandidateResult *single = nullptr;
     const PairResult *pair = nullptr;
     std::vector<std::pair<const Effect *, StrengthFit>> strengths;
+    const HeldOutScore *held_out = nullptr;
+    const DensityComparison *versus_null = nullptr;
+    double level = 0.0;
 };
 NamedModel namedModel(const Diagnosis &d);
 
