@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -481,6 +482,24 @@ TEST_CASE("the diagnosis writes diagnosis.json, features.csv, report.txt and a s
     CHECK(v["level"] == j["claim_level"]["single"]);
     CHECK(report_text.find("Verdict: EXPLAINED by cohesion, cohesion_energy_density = ") !=
           std::string::npos);
+    // A diagnosis.json from an older grainlink (no verdict) is refused by name, with the fix,
+    // not with a Python traceback.
+    if (std::find(files.begin(), files.end(), "report.html") != files.end()) {
+        nlohmann::json old = j;
+        old.erase("verdict");
+        std::ofstream(dir / "diagnosis.json") << old.dump();
+        const auto said = dir / "said.txt";
+        const std::string cmd = "/usr/bin/python3 '" GRAINLINK_SOURCE_DIR
+                                "/tools/gap_report.py' '" +
+                                dir.string() + "' 2> '" + said.string() + "'";
+        CHECK(std::system(cmd.c_str()) != 0);
+        std::ifstream err(said);
+        const std::string text((std::istreambuf_iterator<char>(err)),
+                               std::istreambuf_iterator<char>());
+        CHECK(text.find("diagnosis.json has no 'verdict': it was written by an older grainlink; "
+                        "run `grainlink gap diagnose` again") != std::string::npos);
+        CHECK(text.find("Traceback") == std::string::npos);
+    }
 }
 
 TEST_CASE("diagnosis against another code's soil: a difference outside the catalogue is not "
@@ -1092,8 +1111,49 @@ TEST_CASE("the verdict line names the outcome, the model, its strength and why i
     d.candidates[0].fit.hi = 5.0;
     CHECK(headline(d).find("zero_offset = 4.04 [3.62, 5] m (its interval cut at the prior's "
                            "edge)") != std::string::npos);
+    // A pair: both strengths, in the pair's order (each at the other's best value, not at its
+    // single fit), judged at the pair's level, not the singles'.
+    CandidateResult w;
+    w.name = w.effect.name = "wall_friction";
+    w.effect.parameter = "wall_friction";
+    w.effect.unit = "-";
+    w.effect.prior.lo = 0.0;
+    w.effect.prior.hi = 1.0;
+    w.fit.strength = 0.9; // its single fit: must not be the one named
+    d.candidates = {c, w};
+    d.candidates[0].explains = false;
+    PairResult p;
+    p.a = "sensor_zero_offset";
+    p.b = "wall_friction";
+    p.fit.a = c.fit;
+    p.fit.b.strength = 0.18;
+    p.fit.b.lo = 0.1;
+    p.fit.b.hi = 0.26;
+    p.confirmed = true;
+    p.held_out.gap = 0.05;
+    p.versus_null.mean_gain = 0.4;
+    p.versus_null.p_value = 0.02;
+    d.pairs = {p};
+    d.pair_level = 0.01;
+    d.best_model = "sensor_zero_offset + wall_friction";
+    d.explained_by = "";
+    d.outcome = Diagnosis::Outcome::Unexplained;
+    CHECK(headline(d) == "UNEXPLAINED; closest: the pair sensor_zero_offset + wall_friction, "
+                         "zero_offset = 4.04 [3.62, 4.51] m, wall_friction = 0.18 [0.1, 0.26]; "
+                         "held-out gap 116 % -> 5 % with it (null model 40 %); p = 0.02 against "
+                         "the level 0.01: does not beat the null model");
+    d.pairs[0].versus_null.p_value = 0.004;
+    d.pairs[0].explains = true;
+    d.explained_by = d.best_model;
+    d.outcome = Diagnosis::Outcome::ExplainedByPair;
+    CHECK(headline(d).rfind("EXPLAINED by the pair sensor_zero_offset + wall_friction, "
+                            "zero_offset = 4.04 [3.62, 4.51] m, wall_friction = 0.18 [0.1, 0.26]; "
+                            "held-out gap 116 % -> 5 % with it (null model 40 %); p = 0.004 "
+                            "against the level 0.01: explains",
+                            0) == 0);
     // Nothing confirmed.
     d.candidates.clear();
+    d.pairs.clear();
     d.best_model = d.explained_by = "";
     d.outcome = Diagnosis::Outcome::Unexplained;
     CHECK(headline(d) == "UNEXPLAINED: no catalogued effect was confirmed against held-out "
