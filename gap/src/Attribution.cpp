@@ -506,17 +506,24 @@ compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_m
         for (double x : left_out)
             spread += (x - centre) * (x - centre);
         c.seed_variance = spread * double(seeds - 1) / double(seeds);
-        // The measured beds' luck, one shift per group of beds: d gain / d y times its scatter.
-        std::map<std::string, double> shift;
+        // The measured beds' luck, one shift per group of beds: d gain / d y times its scatter,
+        // each feature at its weight in the mean (its experiment's share, 1 / m, over its
+        // experiment's features).
+        std::map<std::string, double> shift, size;
+        for (Eigen::Index k : scored)
+            size[experiment_keys[std::size_t(k)].experiment] += 1.0;
         if (shared.measured_sd.size() == measured.size())
             for (Eigen::Index k : scored) {
+                const double weight =
+                    1.0 / (double(size.size()) * size[experiment_keys[std::size_t(k)].experiment]);
                 const double d_gain = (measured[k] - null_mean[k]) / null_variance[k] -
                                       (measured[k] - model_mean[k]) / model_variance[k];
                 if (std::isfinite(shared.measured_sd[k]))
-                    shift[bed_keys[std::size_t(k)].experiment] += d_gain * shared.measured_sd[k];
+                    shift[bed_keys[std::size_t(k)].experiment] +=
+                        weight * d_gain * shared.measured_sd[k];
             }
         for (const auto &[group, s] : shift)
-            c.measured_variance += s * s / (double(g.values) * double(g.values));
+            c.measured_variance += s * s;
         const double a = g.variance, b = c.seed_variance, m = c.measured_variance;
         variance = a + b + m;
         const double den = (g.dof > 0.0 ? a * a / g.dof : 0.0) + b * b / double(seeds - 1) +

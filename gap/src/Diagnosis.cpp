@@ -297,6 +297,17 @@ std::string standing(const CandidateResult &c) {
                           : "does not beat the null model";
 }
 
+template <class Model> const Model *bestWithoutGap(const std::vector<Model> &models) {
+    const Model *best = nullptr;
+    for (const Model &M : models)
+        if (M.confirmed && !M.after.gap && std::isfinite(M.held_out.log_density) &&
+            (!best || M.held_out.log_density > best->held_out.log_density))
+            best = &M;
+    return best;
+}
+template const CandidateResult *bestWithoutGap(const std::vector<CandidateResult> &);
+template const PairResult *bestWithoutGap(const std::vector<PairResult> &);
+
 NamedModel namedModel(const Diagnosis &d) {
     NamedModel m;
     for (const CandidateResult &c : d.candidates)
@@ -817,6 +828,17 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     for (const FeatureKey &key : meas.keys)
         experiment_of.push_back(key.experiment);
     const Eigen::VectorXd bed_sd = pool.sd(V.seed_sd, V.simulated, experiment_of, 10);
+    // The null model's own seed noise as every model's is taken, from that pooled scatter: with
+    // u_val's (the base's few seeds' own sd, which swings by factors of ten) a null predicting
+    // with a wrong spread at random lost log density to any model on average, and no better
+    // model beat it by luck alone (a review's simulation: twice the level).
+    {
+        const Eigen::VectorXd pooled = meanAndVariance(base_rows, bed_sd).second;
+        for (Eigen::Index k : D.held_out)
+            null_var[k] += u2_fixed[k] + pooled[k] - u2_val[k];
+        D.held_out_null = scoreHeldOut(meas.value, null_mean, null_var, u2_val, D.held_out);
+        D.null_variance = null_var;
+    }
     for (std::size_t li = 0; li < live.size(); ++li) {
         Live &L = live[li];
         if (!L.result.applicability.empty())
@@ -1177,14 +1199,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // the full self-test's cohesion twin: both left no gap, cohesion predicted better (mean gain
     // 0.61 against 0.49 per feature) but missed the level on a t of one degree of freedom, while
     // stiffness's gains happened to agree between the two groups of beds (p = 9e-5).
-    const CandidateResult *best_no_gap = nullptr, *winner = nullptr;
-    bool any_explains = false;
-    for (const CandidateResult &R : D.candidates) {
-        any_explains = any_explains || R.explains;
-        if (R.confirmed && !R.after.gap && std::isfinite(R.held_out.log_density) &&
-            (!best_no_gap || R.held_out.log_density > best_no_gap->held_out.log_density))
-            best_no_gap = &R;
-    }
+    const CandidateResult *best_no_gap = bestWithoutGap(D.candidates), *winner = nullptr;
+    const bool any_explains = std::any_of(D.candidates.begin(), D.candidates.end(),
+                                          [](const CandidateResult &R) { return R.explains; });
     if (best_no_gap && best_no_gap->explains)
         winner = best_no_gap;
 
@@ -1198,10 +1215,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     const bool claim_possible =
         canCarryClaim(D.held_out, bed_keys, meas.keys,
                       std::size_t(std::min<Eigen::Index>(base_rows.rows(), opt.seeds)));
+    // At its prior's edge too: such a single predicts the held-out experiments without a gap,
+    // and a pair would be judged where it could not be told from it (a single there is never
+    // claimed either).
     const bool single_leaves_no_gap =
         std::any_of(D.candidates.begin(), D.candidates.end(), [](const CandidateResult &R) {
-            return R.confirmed && !R.after.gap && !R.fit.at_prior_edge &&
-                   std::isfinite(R.held_out.log_density);
+            return R.confirmed && !R.after.gap && std::isfinite(R.held_out.log_density);
         });
     if (!any_explains && !single_leaves_no_gap && resolved && claim_possible) {
         std::vector<std::size_t> pool;
@@ -1321,10 +1340,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         D.best_model_mean = winner->confirmed_mean;
         D.best_model_z = winner->confirmed_z;
     } else {
-        const PairResult *pair = nullptr;
-        for (const PairResult &P : D.pairs)
-            if (P.explains && (!pair || P.held_out.log_density > pair->held_out.log_density))
-                pair = &P;
+        // As for the singles: the best held-out prediction among the pairs that leave no gap,
+        // and only if that one explains (until 2026-12-07 the best of those that explain: a
+        // pair predicting better but not claimable was not told apart).
+        const PairResult *pair = bestWithoutGap(D.pairs);
+        if (pair && !pair->explains)
+            pair = nullptr;
         if (pair) {
             D.outcome = Diagnosis::Outcome::ExplainedByPair;
             claim << "explained by " << pair->a << " + " << pair->b << ": " << pair->a << " "

@@ -1634,3 +1634,31 @@ TEST_CASE("selftest: a drawn strength whose twin cannot be simulated is drawn ag
         CHECK_THAT(failures[0], Catch::StartsWith(" at 0.15: twin: no repeat"));
     }
 }
+
+TEST_CASE("a claim goes to the best held-out prediction among the models that leave no gap, "
+          "singles and pairs alike, and only if that one explains",
+          "[gap][diagnosis]") {
+    // Until 2026-12-07 a pair was claimed as the best of the pairs that explain, while a single
+    // had to be the best of those that leave no gap: a better pair that missed the level did
+    // not stop a worse one from being claimed.
+    std::vector<PairResult> pairs(3);
+    for (PairResult &p : pairs)
+        p.confirmed = true;
+    pairs[0].held_out.log_density = -10.0; // explains
+    pairs[0].explains = true;
+    pairs[1].held_out.log_density = -5.0; // predicts better, short of the level
+    pairs[2].held_out.log_density = 0.0;  // best of all, but leaves a gap
+    pairs[2].after.gap = true;
+    CHECK(bestWithoutGap(pairs) == &pairs[1]); // not claimable: nothing is claimed
+    pairs[1].after.gap = true;
+    CHECK(bestWithoutGap(pairs) == &pairs[0]);
+    pairs[0].confirmed = false; // its runs never ran
+    CHECK(bestWithoutGap(pairs) == nullptr);
+
+    std::vector<CandidateResult> singles(2);
+    for (CandidateResult &c : singles)
+        c.confirmed = true;
+    singles[0].held_out.log_density = -3.0;
+    singles[1].held_out.log_density = -std::numeric_limits<double>::infinity(); // runs failed
+    CHECK(bestWithoutGap(singles) == &singles[0]);
+}

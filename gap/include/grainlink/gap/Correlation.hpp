@@ -35,10 +35,11 @@ private:
 
 /// The mean of `values` over `use` when each experiment's values may share an error (a model's
 /// gain over another moves with the experiment's systematic error, which the beds' correlation
-/// does not see): one-way random-effects ANOVA over the experiments, Var(mean) = s_w^2 / N +
-/// s_b^2 sum k_E^2 / N^2, with m - 1 degrees of freedom when the experiments differ beyond
-/// their values' scatter (s_b^2 > 0), else N - m. One experiment of several values gives no
-/// between-experiment scatter: its variance is unknown (infinite).
+/// does not see): the experiments are the units, each weighted equally whatever its number of
+/// values, and Var(mean) = s_means^2 / m with m - 1 degrees of freedom (the t test of the
+/// experiments' means). One experiment gives no between-experiment scatter: its variance is
+/// unknown (infinite). `icc` is the one-way ANOVA's share of the values' variance between
+/// experiments, for the report.
 struct ClusteredMean {
     double mean = 0.0, variance = 0.0, dof = 0.0;
     double icc = 0.0; ///< s_b^2 / (s_b^2 + s_w^2)

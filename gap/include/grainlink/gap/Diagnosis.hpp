@@ -215,6 +215,12 @@ const char *outcomeName(Diagnosis::Outcome outcome);
 /// not beat the null model", "beats the null model but leaves a gap", ...).
 std::string standing(const CandidateResult &c);
 
+/// The confirmed candidate (or pair) that predicts the held-out experiments best (log density)
+/// among those that leave no gap: the one a claim may go to, and only if it explains; where it
+/// does not, the others that explain are not told apart from it and nothing is claimed. Null
+/// where none leaves no gap.
+template <class Model> const Model *bestWithoutGap(const std::vector<Model> &models);
+
 /// The confirmed candidate or pair that `best_model` names, with each of its effects and
 /// fitted strengths, its held-out score and test, and the level it was judged at; neither
 /// (null pointers) when nothing confirmed is named.
