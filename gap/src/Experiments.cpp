@@ -48,10 +48,12 @@ const std::vector<TypeInfo> &types() {
          "shear_displacement_m",
          {"shear_stress_Pa"},
          {{"normal_pressure_Pa", "gravity_m_s2", "bed_depth_m"}, "normal_pressure_Pa", {}}},
+        // The top plate's rise from the start of shearing (dilation positive), as a direct
+        // shear test's vertical gauge reads it.
         {ExperimentType::DirectShear,
          "direct_shear",
          "shear_displacement_m",
-         {"shear_stress_Pa"},
+         {"shear_stress_Pa", "vertical_displacement_m"},
          {{"normal_stress_Pa", "gravity_m_s2"}, "normal_stress_Pa", {}}},
         {ExperimentType::AngleOfRepose,
          "angle_of_repose",

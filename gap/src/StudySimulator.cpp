@@ -1061,48 +1061,51 @@ std::vector<SimulatedCurves> StudySimulator::curves(const ExperimentSet &design,
                             c[id][o] = wheelCurve(sum, o);
                         continue;
                     }
-                    Curve curve;
-                    const auto pick = [&](const char *value_key, double want, const char *x,
-                                          const char *y) {
-                        for (const auto &run : sum.runs)
-                            if (close(run.value(value_key), want)) {
-                                curve.x = run.curve(x);
-                                curve.y = run.curve(y);
-                            }
-                    };
-                    switch (e.type) {
-                    case ExperimentType::PlateSinkage:
-                        pick("plate_radius_m", 0.5 * e.numbers.at("plate_diameter_m"), "sinkage_m",
-                             "pressure_Pa");
-                        break;
-                    case ExperimentType::DirectShear:
-                        pick("target_normal_stress_Pa", e.numbers.at("normal_stress_Pa"),
-                             "displacement_m", "shear_stress_Pa");
-                        break;
-                    case ExperimentType::BevameterShear:
-                        pick("target_pressure_Pa", e.numbers.at("normal_pressure_Pa"),
-                             "shear_displacement_m", "shear_stress_Pa");
-                        break;
-                    case ExperimentType::AngleOfRepose:
-                        for (const auto &fit : sum.fits)
-                            if (fit.law == "repose")
-                                curve = Curve{{0.0}, {sum.fitted("repose", "angle").value}};
-                        // The grains spread flat: no heap, a slope of zero. A missing value
-                        // would drop the bed, and a model whose beds mostly spread would be
-                        // judged by the one that kept a heap.
-                        if (curve.empty())
-                            curve = Curve{{0.0}, {0.0}};
-                        break;
-                    default:
-                        break;
+                    for (const std::string &obs : e.observables) {
+                        Curve curve;
+                        const auto pick = [&](const char *value_key, double want, const char *x,
+                                              const char *y) {
+                            for (const auto &run : sum.runs)
+                                if (close(run.value(value_key), want)) {
+                                    curve.x = run.curve(x);
+                                    curve.y = run.curve(y);
+                                }
+                        };
+                        switch (e.type) {
+                        case ExperimentType::PlateSinkage:
+                            pick("plate_radius_m", 0.5 * e.numbers.at("plate_diameter_m"),
+                                 "sinkage_m", "pressure_Pa");
+                            break;
+                        case ExperimentType::DirectShear:
+                            pick("target_normal_stress_Pa", e.numbers.at("normal_stress_Pa"),
+                                 "displacement_m",
+                                 obs == "vertical_displacement_m" ? "plate_height_m"
+                                                                  : "shear_stress_Pa");
+                            break;
+                        case ExperimentType::BevameterShear:
+                            pick("target_pressure_Pa", e.numbers.at("normal_pressure_Pa"),
+                                 "shear_displacement_m", "shear_stress_Pa");
+                            break;
+                        case ExperimentType::AngleOfRepose:
+                            for (const auto &fit : sum.fits)
+                                if (fit.law == "repose")
+                                    curve = Curve{{0.0}, {sum.fitted("repose", "angle").value}};
+                            // The grains spread flat: no heap, a slope of zero. A missing value
+                            // would drop the bed, and a model whose beds mostly spread would be
+                            // judged by the one that kept a heap.
+                            if (curve.empty())
+                                curve = Curve{{0.0}, {0.0}};
+                            break;
+                        default:
+                            break;
+                        }
+                        for (auto [effect, strength] :
+                             {std::pair{requests[r].effect, requests[r].strength},
+                              std::pair{requests[r].second, requests[r].second_strength}})
+                            if (effect && effect->kind == Effect::Kind::Measurement)
+                                curve = applyMeasurementEffect(*effect, strength, e, obs, curve);
+                        c[id][obs] = curve;
                     }
-                    const std::string &obs = e.observables.front();
-                    for (auto [effect, strength] :
-                         {std::pair{requests[r].effect, requests[r].strength},
-                          std::pair{requests[r].second, requests[r].second_strength}})
-                        if (effect && effect->kind == Effect::Kind::Measurement)
-                            curve = applyMeasurementEffect(*effect, strength, e, obs, curve);
-                    c[id][obs] = curve;
                 }
             }
             out.push_back(std::move(c));

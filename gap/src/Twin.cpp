@@ -18,16 +18,21 @@ using config::ConfigNode;
 
 namespace {
 
-/// A wheel design's observables: its `observables` list, or what the lab's wheel test reports.
-std::vector<std::string> wheelObservables(const ConfigNode &n) {
+/// A design experiment's observables: its `observables` list, or by default a wheel's
+/// traction, sinkage and torque and every other test's first (a shear box's stress).
+std::vector<std::string> designObservables(const ConfigNode &n, ExperimentType type) {
     const auto list = n.optional("observables");
+    const auto &allowed = observablesOf(type);
     if (!list)
-        return {"traction_N", "sinkage_m", "torque_N_m"};
-    const auto &allowed = observablesOf(ExperimentType::WheelSteadyState);
+        return type == ExperimentType::WheelSteadyState
+                   ? std::vector<std::string>{"traction_N", "sinkage_m", "torque_N_m"}
+                   : std::vector<std::string>{allowed.front()};
     std::vector<std::string> out;
     for (const ConfigNode &o : list->items()) {
-        if (std::find(allowed.begin(), allowed.end(), o.text()) == allowed.end())
-            o.fail("'" + o.text() + "' is not an observable of wheel_steady_state");
+        // A plate's force is read into its pressure: a design names the pressure.
+        if (std::find(allowed.begin(), allowed.end(), o.text()) == allowed.end() ||
+            o.text() == "force_N")
+            o.fail("'" + o.text() + "' is not an observable of " + typeName(type));
         out.push_back(o.text());
     }
     if (out.empty())
@@ -54,10 +59,7 @@ Design loadDesign(const std::string &path) {
         } catch (const std::invalid_argument &ex) {
             n["type"].fail(ex.what());
         }
-        // A wheel reports several observables; every other test one.
-        e.observables = e.type == ExperimentType::WheelSteadyState
-                            ? wheelObservables(n)
-                            : std::vector<std::string>{observablesOf(e.type).front()};
+        e.observables = designObservables(n, e.type);
         e.x_name = xNameOf(e.type);
         if (const auto c = n.optional("conditions")) {
             for (const auto &key : c->keys()) {
@@ -85,12 +87,10 @@ Design loadDesign(const std::string &path) {
                 slips.fail("give at least one slip");
         } else {
             Trial stand_in;
-            if (e.x_name.empty()) {
-                stand_in.curves[e.observables[0]] = Curve{{0.0}, {0.0}};
-            } else {
-                const double reach = n["reach"].positive();
-                stand_in.curves[e.observables[0]] = Curve{{0.0, reach}, {0.0, 0.0}};
-            }
+            const double reach = e.x_name.empty() ? 0.0 : n["reach"].positive();
+            for (const std::string &o : e.observables)
+                stand_in.curves[o] =
+                    e.x_name.empty() ? Curve{{0.0}, {0.0}} : Curve{{0.0, reach}, {0.0, 0.0}};
             e.trials.push_back(stand_in);
         }
         d.repeats[e.id] = int(n.integer("repeats", 1, 32, 2));
@@ -233,10 +233,21 @@ void writeTwin(const Design &design, const std::vector<SimulatedCurves> &curves,
                 }
             } else {
                 // Only as far as the design reaches: the diagnosis then simulates the same tests.
+                // Every observable of a curve test is sampled with its first (one run's
+                // samples: a shear box's stress and its plate's rise).
                 const double reach = e.trials.front().curves.at(obs).x.back();
+                for (const std::string &o : e.observables)
+                    if (it->second.count(o) == 0 || it->second.at(o).x != c.x)
+                        throw std::runtime_error("twin: experiment '" + e.id + "', repeat " +
+                                                 std::to_string(r + 1) + ": its '" + o +
+                                                 "' was not sampled with its '" + obs + "'");
                 for (std::size_t i = 0; i < c.x.size(); ++i)
-                    if (c.x[i] <= reach)
-                        f << c.x[i] << ',' << c.y[i] * level * (1.0 + key.noise * z(rng)) << '\n';
+                    if (c.x[i] <= reach) {
+                        f << c.x[i];
+                        for (const std::string &o : e.observables)
+                            f << ',' << it->second.at(o).y[i] * level * (1.0 + key.noise * z(rng));
+                        f << '\n';
+                    }
             }
             files.push_back(file);
         }

@@ -938,3 +938,43 @@ TEST_CASE("experiments.yaml: an experiment 1000 times off the others of its kind
                                          "0.003 times the median of its kind's 3 experiments "
                                          "(1.2e+04): its unit?"));
 }
+
+TEST_CASE("experiments.yaml: a direct shear test's vertical displacement (dilation) is read as an "
+          "observable of its own, in SI, with bins of its own kind",
+          "[gap][experiments]") {
+    const fs::path dir = folder("dilation");
+    // A dense sand: the plate settles by 0.04 mm, then rises 0.1 mm per mm of shear.
+    {
+        std::ofstream out(dir / "s.csv");
+        out << "d_mm,tau_kPa,dy_mm\n";
+        for (int i = 0; i <= 12; ++i) {
+            const double d = 0.5 * i;
+            out << d << ',' << 5.0 + d << ',' << (d < 1.0 ? -0.04 * d : 0.1 * (d - 1.0) - 0.04)
+                << '\n';
+        }
+    }
+    const std::string head = "experiments:\n  - id: s4\n    type: direct_shear\n"
+                             "    conditions: {normal_stress_Pa: 4000}\n"
+                             "    data:\n      files: [s.csv]\n"
+                             "      x: {column: d_mm, unit: mm}\n";
+    write(dir / "experiments.yaml",
+          head + "      y:\n        shear_stress_Pa: {column: tau_kPa, unit: kPa}\n"
+                 "        vertical_displacement_m: {column: dy_mm, unit: mm}\n");
+    const ExperimentSet set = loadExperiments(dir.string());
+    const Experiment &e = set.experiments.at(0);
+    REQUIRE(e.observables.size() == 2);
+    const Curve &rise = e.trials.at(0).curves.at("vertical_displacement_m");
+    CHECK(rise.x.back() == Approx(0.006));
+    CHECK(rise.y.back() == Approx(0.46e-3)); // 0.1 x 5 mm - 0.04 mm
+    CHECK(rise.y[1] == Approx(-0.02e-3));
+    const FeatureDesign d = designFeatures(set, 6);
+    int rises = 0;
+    for (const FeatureKey &k : d.keys)
+        rises += k.kind == "direct_shear/vertical_displacement_m";
+    CHECK(rises == 6);
+    CHECK(d.keys.size() == 12);
+    // A rise given in a unit of stress is refused with its key.
+    checkRefused(dir,
+                 head + "      y:\n        vertical_displacement_m: {column: dy_mm, unit: kPa}\n",
+                 "vertical_displacement_m");
+}

@@ -869,3 +869,63 @@ TEST_CASE("a lab test refused for one experiment of its group names every experi
                                       "scenario") &&
                           Catch::Contains("reaches past the bed"));
 }
+
+// The shear box's vertical gauge: the lab's plate rise is the direct shear experiment's
+// vertical displacement, and a twin writes it beside the stress, sampled with it.
+TEST_CASE("a direct shear test's vertical displacement is the lab's plate rise: the bed settles, "
+          "then dilates, less under more normal stress, and a twin writes it beside the stress",
+          "[gap][simulator][twin]") {
+    const std::string dir = std::string(GRAINLINK_SOURCE_DIR) + "/scenarios/gap/selftest-ci";
+    const fs::path scratch = freshScratch("grainlink-gap-dilation");
+    std::ofstream(scratch / "design.yaml")
+        << "experiments:\n"
+           "  - {id: s4, type: direct_shear, conditions: {normal_stress_Pa: 4000}, reach: 0.005,\n"
+           "     observables: [shear_stress_Pa, vertical_displacement_m], repeats: 1}\n"
+           "  - {id: s12, type: direct_shear, conditions: {normal_stress_Pa: 12000}, reach: "
+           "0.005,\n"
+           "     observables: [shear_stress_Pa, vertical_displacement_m], repeats: 1}\n";
+    const Design design = loadDesign((scratch / "design.yaml").string());
+    grainlink::study::ExecutorOptions run;
+    run.grainlink = GRAINLINK_EXECUTABLE;
+    run.progress_interval_s = 1e9;
+    StudySimulator sim(loadBaseModel(dir + "/base.yaml"), (scratch / "sims").string(), run);
+    VariantRequest plain;
+    plain.label = "base";
+    std::vector<int> seeds_of;
+    const auto curves = sim.curves(design.set, {plain}, seeds_of);
+    REQUIRE(curves.size() == 1);
+    const auto rise = [&](const std::string &id) {
+        return curves[0].at(id).at("vertical_displacement_m");
+    };
+    for (const std::string id : {"s4", "s12"}) {
+        const Curve &tau = curves[0].at(id).at("shear_stress_Pa");
+        REQUIRE(rise(id).x == tau.x);
+        REQUIRE(rise(id).x.back() >= 0.005);
+        INFO(id << ": the plate's lowest "
+                << *std::min_element(rise(id).y.begin(), rise(id).y.end()) << " m, at the end "
+                << rise(id).y.back() << " m");
+        // A poured bed is first compacted by the shear, then dilates (Reynolds): by 5 mm of
+        // shear a bed of 2 mm grains has risen by tens of micrometres at least.
+        CHECK(*std::min_element(rise(id).y.begin(), rise(id).y.end()) < 0.0);
+        CHECK(rise(id).y.back() > 2e-5);
+    }
+    // Stress-dilatancy (Bolton 1986): a higher normal stress suppresses dilation.
+    CHECK(rise("s12").y.back() < rise("s4").y.back());
+
+    TwinKey key;
+    key.seed = 1;
+    key.noise = key.level_noise = 0.0;
+    writeTwin(design, curves, key, (scratch / "twin").string(),
+              (scratch / "twin.key.json").string());
+    const ExperimentSet twin = loadExperiments((scratch / "twin").string());
+    const Experiment &read = twin.find("s4");
+    REQUIRE(read.trials.size() == 1);
+    const Curve &back = read.trials[0].curves.at("vertical_displacement_m");
+    REQUIRE(!back.x.empty());
+    CHECK(back.x.back() <= 0.005);
+    const Curve &sim4 = rise("s4");
+    const auto at = std::find(sim4.x.begin(), sim4.x.end(), back.x.back());
+    REQUIRE(at != sim4.x.end());
+    CHECK(back.y.back() == Approx(sim4.y[std::size_t(at - sim4.x.begin())]).epsilon(1e-8));
+    fs::remove_all(scratch);
+}
