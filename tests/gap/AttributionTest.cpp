@@ -679,7 +679,7 @@ TEST_CASE("strengthAgreement: parts that ask for one strength agree, parts that 
     const double z = 1.959963984540054; // the normal's 97.5 % quantile
     const auto part = [](double s, double below, double above) {
         StrengthFit f;
-        f.strength = s, f.lo = s - below, f.hi = s + above;
+        f.strength = s, f.lo = f.spread_lo = s - below, f.hi = f.spread_hi = s + above;
         return f;
     };
     // 0.2 +- 0.05 and 0.5 +- 0.1 (sd): z = 0.3 / sqrt(0.05^2 + 0.1^2) = 2.683, two-sided
@@ -708,7 +708,17 @@ TEST_CASE("strengthAgreement: parts that ask for one strength agree, parts that 
     const Prior log_prior{0.1, 10.0, 1.0, true};
     const double f95 = std::exp(z * std::log(2.0));
     StrengthFit a, b;
-    a.strength = 2.0, a.lo = 2.0 / f95, a.hi = 2.0 * f95;
-    b.strength = 8.0, b.lo = 8.0 / f95, b.hi = 8.0 * f95;
+    a.strength = 2.0, a.spread_lo = 2.0 / f95, a.spread_hi = 2.0 * f95;
+    b.strength = 8.0, b.spread_lo = 8.0 / f95, b.spread_hi = 8.0 * f95;
     CHECK(strengthAgreement({a, b}, log_prior).chi2 == Approx(2.0).epsilon(1e-9));
+    // The beds' luck is read at the quantile it was added at: the 95 % interval widens it by
+    // Student's t of three beds (4.30), which read at 1.96 made the first case's z 1.2 instead
+    // of 2.7. A profile of sd 0.02 and a luck of sd 0.04 (the second part's 0.08).
+    StrengthFit c = part(0.2, z * 0.02, z * 0.02), d = part(0.5, z * 0.02, z * 0.02);
+    widenInterval(c, linear, 0.04, 2.0);
+    widenInterval(d, linear, 0.08, 2.0);
+    CHECK(c.hi - c.lo > 2.0 * (c.spread_hi - c.spread_lo) * 0.95);
+    const StrengthAgreement luck = strengthAgreement({c, d}, linear);
+    // sd sqrt(0.02^2 + 0.04^2) and sqrt(0.02^2 + 0.08^2): chi^2 = 0.09 / (0.002 + 0.0068).
+    CHECK(luck.chi2 == Approx(0.09 / 0.0088).epsilon(1e-6));
 }
