@@ -1662,3 +1662,29 @@ TEST_CASE("a claim goes to the best held-out prediction among the models that le
     singles[1].held_out.log_density = -std::numeric_limits<double>::infinity(); // runs failed
     CHECK(bestWithoutGap(singles) == &singles[0]);
 }
+
+TEST_CASE("diagnosis: two effects that each explain and that the held-out experiments cannot tell "
+          "apart are both named, and neither is claimed",
+          "[gap][diagnosis]") {
+    // cohesion_twin is cohesion's physics under another name: it passes every test cohesion
+    // passes. Claiming the one that predicts a little better would be a coin's toss between
+    // them; until 2026-12-07 it was claimed, the other named beside it.
+    EffectCatalogue c = shippedEffects();
+    Effect twin = c.find("cohesion");
+    twin.name = "cohesion_twin";
+    twin.signature = {1.2e4, 2.5e4}; // other table points: not the very same fit
+    c.effects.push_back(twin);
+    AnalyticSimulator sim;
+    sim.alias["cohesion_twin"] = "cohesion";
+    const Diagnosis d =
+        diagnose(measuredSet({"cohesion", 4.0e4}, 7), c.diagnosable(), sim, analyticOptions());
+    INFO(d.claim);
+    REQUIRE(candidate(d, "cohesion").explains);
+    REQUIRE(candidate(d, "cohesion_twin").explains);
+    CHECK(d.outcome == Diagnosis::Outcome::Unexplained);
+    CHECK(d.explained_by.empty());
+    CHECK_THAT(d.claim, Catch::Contains("each beat the null model and leave no gap, and these "
+                                        "experiments do not tell them apart"));
+    CHECK(d.indistinguishable.size() == 1);
+    CHECK((d.best_model == "cohesion" || d.best_model == "cohesion_twin"));
+}
