@@ -1214,6 +1214,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // coin's toss between two effects that each pass every test (found by a review; named
     // beside the claim until 2026-12-07).
     const CandidateResult *twin_rival = nullptr;
+    double twin_rival_p = 1.0; // the winner against it
     if (winner) {
         const Live *W = nullptr;
         for (const Live &L : live)
@@ -1229,8 +1230,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 L.predictive_variance, D.held_out, bed_keys, meas.keys,
                 leaveOneSeedOut(W->confirmed_rows, L.confirmed_rows, rival, rival, measured_luck));
             D.rivals.push_back({R.name, c.p_value, R.fit.at_prior_edge, R.beats_null});
-            if (!(c.p_value < opt.alpha) && R.explains && !twin_rival)
+            if (!(c.p_value < opt.alpha) && R.explains && !twin_rival) {
                 twin_rival = &R;
+                twin_rival_p = c.p_value;
+            }
         }
         if (twin_rival)
             winner = nullptr;
@@ -1240,8 +1243,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                     D.indistinguishable.push_back(r.name);
     }
 
-    // Pairs, where no single effect explains the gap, none within its prior leaves the design
-    // without a gap, and a claim is possible at all (a resolved base; two or more held-out
+    // Pairs, where no single effect explains the gap, none leaves the design without a gap,
+    // and a claim is possible at all (a resolved base; two or more held-out
     // groups of beds, or one group of two or more experiments simulated on two or more beds:
     // `compareDensities`). A single that leaves no gap but misses the level lacks power, not a
     // second effect: a pair then adds one nothing asks for, and on a design with five seeds a
@@ -1253,10 +1256,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // At its prior's edge too: such a single predicts the held-out experiments without a gap,
     // and a pair would be judged where it could not be told from it (a single there is never
     // claimed either).
-    const bool single_leaves_no_gap =
-        std::any_of(D.candidates.begin(), D.candidates.end(), [](const CandidateResult &R) {
-            return R.confirmed && !R.after.gap && std::isfinite(R.held_out.log_density);
-        });
+    const bool single_leaves_no_gap = best_no_gap != nullptr;
     if (!any_explains && !single_leaves_no_gap && resolved && claim_possible) {
         std::vector<std::size_t> pool;
         for (std::size_t i : applicable)
@@ -1378,10 +1378,6 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                          "needs experiments it was not fitted to: give two or more experiments "
                          "of a type, or name them with --hold-out)";
             else if (twin_rival) {
-                double p_apart = 1.0;
-                for (const Diagnosis::Rival &r : D.rivals)
-                    if (r.name == twin_rival->name)
-                        p_apart = r.p_value;
                 const auto told = [&](const CandidateResult &R) {
                     return R.name + " (" + strengthText(R.effect, R.fit.strength) +
                            ", held-out gap " + percentOf(R.held_out.gap) +
@@ -1390,7 +1386,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 claim << "unexplained: " << told(*best_no_gap) << " and " << told(*twin_rival)
                       << " each beat the null model and leave no gap, and these experiments do "
                          "not tell them apart (p = "
-                      << fmt(p_apart, 2) << " for the first against the second): either may be "
+                      << fmt(twin_rival_p, 2)
+                      << " for the first against the second): either may be "
                       << "the cause";
             } else if (any_explains) {
                 // Some candidate beats the null and leaves no gap, but another predicts the

@@ -219,8 +219,8 @@ struct SharedLuck {
 /// degree of freedom, under which no gain could be claimed at the levels used. p = 1 with one
 /// held-out experiment, one group and no jackknife, or gains without spread.
 struct DensityComparison {
-    double mean_gain =
-        0.0; ///< mean log-density gain per feature (model - null), each experiment weighted equally
+    /// mean log-density gain per feature (model - null), each experiment weighted equally
+    double mean_gain = 0.0;
     double p_value = 1.0;
     int features = 0;
     int experiments = 0; ///< held-out experiments (or groups of beds, without a jackknife)
