@@ -894,7 +894,7 @@ TEST_CASE("a direct shear test's vertical displacement is the lab's plate rise: 
     std::vector<int> seeds_of;
     const auto curves = sim.curves(design.set, {plain}, seeds_of);
     REQUIRE(curves.size() == 1);
-    const auto rise = [&](const std::string &id) {
+    const auto rise = [&](const std::string &id) -> const Curve & {
         return curves[0].at(id).at("vertical_displacement_m");
     };
     for (const std::string id : {"s4", "s12"}) {
