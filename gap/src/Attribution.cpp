@@ -6,11 +6,13 @@
 #include <boost/math/distributions/students_t.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <set>
 #include <stdexcept>
+#include <tuple>
 
 namespace grainlink::gap {
 
@@ -33,6 +35,53 @@ template <class F> double goldenMinimum(F f, double a, double b) {
         }
     }
     return 0.5 * (a + b);
+}
+
+/// The minimum of f(x, y) within [x0, x1] x [y0, y1] by Nelder and Mead's simplex from
+/// (x, y), its first steps dx and dy.
+template <class F>
+std::pair<double, double> simplexMinimum(F f, double x, double y, double dx, double dy, double x0,
+                                         double x1, double y0, double y1) {
+    using P = Eigen::Vector2d;
+    const auto clamp = [&](P p) { return P(std::clamp(p[0], x0, x1), std::clamp(p[1], y0, y1)); };
+    const auto value = [&](const P &p) { return f(p[0], p[1]); };
+    std::array<P, 3> v{P(x, y), clamp(P(x + dx, y)), clamp(P(x, y + dy))};
+    if (v[1] == v[0])
+        v[1] = clamp(P(x - dx, y));
+    if (v[2] == v[0])
+        v[2] = clamp(P(x, y - dy));
+    std::array<double, 3> c{value(v[0]), value(v[1]), value(v[2])};
+    for (int it = 0; it < 400; ++it) {
+        std::array<int, 3> o{0, 1, 2};
+        std::sort(o.begin(), o.end(), [&](int i, int j) { return c[i] < c[j]; });
+        const P best = v[o[0]], good = v[o[1]], worst = v[o[2]];
+        if (std::abs((best - worst)[0]) < 1e-9 * (x1 - x0) &&
+            std::abs((best - worst)[1]) < 1e-9 * (y1 - y0))
+            break;
+        const P mid = 0.5 * (best + good);
+        const P r = clamp(mid + (mid - worst));
+        const double cr = value(r);
+        if (cr < c[o[0]]) {
+            const P e = clamp(mid + 2.0 * (mid - worst));
+            const double ce = value(e);
+            v[o[2]] = ce < cr ? e : r, c[o[2]] = std::min(ce, cr);
+        } else if (cr < c[o[1]]) {
+            v[o[2]] = r, c[o[2]] = cr;
+        } else {
+            const P k = 0.5 * (mid + (cr < c[o[2]] ? r : worst));
+            const double ck = value(k);
+            if (ck < std::min(cr, c[o[2]])) {
+                v[o[2]] = k, c[o[2]] = ck;
+            } else { // shrink towards the best
+                for (int i : {o[1], o[2]}) {
+                    v[i] = 0.5 * (v[i] + best);
+                    c[i] = value(v[i]);
+                }
+            }
+        }
+    }
+    const int b = int(std::min_element(c.begin(), c.end()) - c.begin());
+    return {v[b][0], v[b][1]};
 }
 
 /// Best point of f on a grid over [t0, t1], refined by golden section; the profile's interval.
@@ -346,20 +395,50 @@ Eigen::VectorXd PairResponse::variance(double sa, double sb) const {
     return (a_.variance(sa) + b_.variance(sb) - base_var_).cwiseMax(0.0);
 }
 
-PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Prior &pb,
+ChainOnSoilResponse::ChainOnSoilResponse(const Prior &soil, std::vector<double> strengths,
+                                         std::vector<TabulatedResponse> rows, bool soil_is_a)
+    : soil_(soil), strengths_(std::move(strengths)), rows_(std::move(rows)), soil_is_a_(soil_is_a) {
+    if (strengths_.size() < 2 || rows_.size() != strengths_.size())
+        throw std::invalid_argument("ChainOnSoilResponse: need >= 2 soil strengths, each with "
+                                    "the chain's response");
+}
+
+TabulatedResponse ChainOnSoilResponse::soilTable(double s_chain) const {
+    std::vector<Eigen::VectorXd> means, variances;
+    for (const TabulatedResponse &row : rows_) {
+        means.push_back(row.mean(s_chain));
+        variances.push_back(row.variance(s_chain));
+    }
+    return TabulatedResponse(soil_, strengths_, std::move(means), std::move(variances));
+}
+
+Eigen::VectorXd ChainOnSoilResponse::mean(double sa, double sb) const {
+    const double soil = soil_is_a_ ? sa : sb, chain = soil_is_a_ ? sb : sa;
+    return soilTable(chain).mean(soil);
+}
+
+Eigen::VectorXd ChainOnSoilResponse::variance(double sa, double sb) const {
+    const double soil = soil_is_a_ ? sa : sb, chain = soil_is_a_ ? sb : sa;
+    return soilTable(chain).variance(soil);
+}
+
+PairFit fitPair(const PairModel &pair, const Prior &pa, const Prior &pb,
                 const Eigen::VectorXd &base_mean, const Eigen::VectorXd &base_variance,
                 const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
                 const FeatureSet &use, const BlockCorrelation &correlation) {
-    PairResponse pair(a, b, base_mean, base_variance);
     const double a0 = pa.toScale(pa.lo), a1 = pa.toScale(pa.hi);
     const double b0 = pb.toScale(pb.lo), b1 = pb.toScale(pb.hi);
     constexpr int n = 41;
-    // A pair's mean is the sum of its two responses' changes: its features are those both
-    // have; the others are taken at the base, as for one effect.
-    std::vector<bool> has = hasEverywhere(a, pa, measured.size());
-    const std::vector<bool> has_b = hasEverywhere(b, pb, measured.size());
-    for (std::size_t k = 0; k < has.size(); ++k)
-        has[k] = has[k] && has_b[k];
+    // The features the pair has along each strength, the other off.
+    std::vector<bool> has(std::size_t(measured.size()), true);
+    const auto keep = [&](const Eigen::VectorXd &m) {
+        for (Eigen::Index k = 0; k < m.size(); ++k)
+            has[std::size_t(k)] = has[std::size_t(k)] && std::isfinite(m[k]);
+    };
+    for (double t : profilePoints(a0, a1, pa.toScale(pa.off)))
+        keep(pair.mean(pa.fromScale(t), pb.off));
+    for (double t : profilePoints(b0, b1, pb.toScale(pb.off)))
+        keep(pair.mean(pa.off, pb.fromScale(t)));
     const auto chi2 = [&](double ta, double tb) {
         const double sa = pa.fromScale(ta), sb = pb.fromScale(tb);
         return chiSquare(measured, atBaseWhereMissing(pair.mean(sa, sb), has, base_mean),
@@ -374,11 +453,11 @@ PairFit fitPair(const Response &a, const Prior &pa, const Response &b, const Pri
             if (c < best)
                 best = c, ta = x, tb = y;
         }
-    // Coordinate refinement, then each strength's profile at the other's best value.
-    for (int round = 0; round < 3; ++round) {
-        ta = minimiseProfile([&](double t) { return chi2(t, tb); }, a0, a1, 1.0).t_best;
-        tb = minimiseProfile([&](double t) { return chi2(ta, t); }, b0, b1, 1.0).t_best;
-    }
+    // Refined from the grid's best by a simplex (two strengths that trade against each other
+    // lie along a narrow diagonal valley, where three rounds of one strength at a time
+    // stopped a tenth of the way down it), then each strength's profile at the other's best.
+    std::tie(ta, tb) = simplexMinimum([&](double x, double y) { return chi2(x, y); }, ta, tb,
+                                      (a1 - a0) / (n - 1.0), (b1 - b0) / (n - 1.0), a0, a1, b0, b1);
     PairFit fit;
     fit.chi2 = chi2(ta, tb);
     const int dof = std::max(1, int(use.size()) - 2);

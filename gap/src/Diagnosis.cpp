@@ -1262,18 +1262,103 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         for (std::size_t i : applicable)
             if (int(pool.size()) < opt.pair_pool && promising(i))
                 pool.push_back(i);
+        const auto rawEffect = [&](const std::string &name) -> const Effect * {
+            for (const Effect *e : effects)
+                if (e->name == name)
+                    return e;
+            throw std::logic_error("diagnose: no catalogue effect " + name);
+        };
+        const auto isChain = [&](const Live &L) {
+            return L.result.effect.kind == Effect::Kind::Measurement;
+        };
+        // A measuring-chain effect with one of the soil is read on the soil effect's own runs
+        // at each strength its table holds (`ChainOnSoilResponse`): runs already made, read
+        // through another sensor, all requested at once.
+        struct ChainOnSoil {
+            std::size_t soil, chain;                 // indices into `live`
+            std::vector<std::size_t> request_of_row; // first request of each soil strength
+        };
+        std::vector<ChainOnSoil> chain_tables;
+        std::vector<VariantRequest> chain_requests;
+        const auto nonOff = [](const TabulatedResponse &r, const Prior &p) {
+            std::vector<double> out;
+            for (double s : r.strengths())
+                if (std::abs(s - p.off) > 1e-12 * (1.0 + std::abs(s)))
+                    out.push_back(s);
+            return out;
+        };
+        for (std::size_t a = 0; a < pool.size(); ++a)
+            for (std::size_t b = a + 1; b < pool.size(); ++b) {
+                if (isChain(live[pool[a]]) == isChain(live[pool[b]]))
+                    continue;
+                ChainOnSoil t{isChain(live[pool[a]]) ? pool[b] : pool[a],
+                              isChain(live[pool[a]]) ? pool[a] : pool[b],
+                              {}};
+                const Live &soil = live[t.soil], &chain = live[t.chain];
+                for (double s : nonOff(*soil.response, soil.result.effect.prior)) {
+                    t.request_of_row.push_back(chain_requests.size());
+                    for (double c : nonOff(*chain.response, chain.result.effect.prior))
+                        chain_requests.push_back({chain.result.name + " " + fmt(c) + " on " +
+                                                      soil.result.name + " " + fmt(s),
+                                                  rawEffect(soil.result.name), s,
+                                                  rawEffect(chain.result.name), c, "",
+                                                  opt.signature_seeds});
+                }
+                chain_tables.push_back(std::move(t));
+            }
+        if (!chain_requests.empty())
+            log("the measuring chain read on the soil effects' runs: " +
+                std::to_string(chain_requests.size()) + " variants");
+        const auto chain_rows = simulateValid(chain_requests);
+        for (const auto &r : chain_requests)
+            D.simulations += r.seeds;
+        // The chain's table on each of the soil effect's strengths; none where a run failed
+        // (the pair is then taken as a sum, as two effects of the soil are).
+        const auto chainOnSoil = [&](const ChainOnSoil &t,
+                                     bool soil_is_a) -> std::unique_ptr<PairModel> {
+            const Live &soil = live[t.soil], &chain = live[t.chain];
+            const Prior &ps = soil.result.effect.prior, &pc = chain.result.effect.prior;
+            std::vector<double> strengths{ps.off};
+            std::vector<TabulatedResponse> rows{*chain.response};
+            const std::vector<double> soil_s = nonOff(*soil.response, ps),
+                                      chain_s = nonOff(*chain.response, pc);
+            for (std::size_t i = 0; i < soil_s.size(); ++i) {
+                std::vector<double> c{pc.off};
+                std::vector<Eigen::VectorXd> means{soil.response->mean(soil_s[i])},
+                    vars{soil.response->variance(soil_s[i])};
+                for (std::size_t j = 0; j < chain_s.size(); ++j) {
+                    const auto mv = meanAndVariance(chain_rows[t.request_of_row[i] + j], bed_sd);
+                    if (!coversBase(mv.first, means.front(), meas.keys))
+                        return nullptr;
+                    c.push_back(chain_s[j]);
+                    means.push_back(mv.first);
+                    vars.push_back(mv.second);
+                }
+                strengths.push_back(soil_s[i]);
+                rows.emplace_back(pc, c, means, vars);
+            }
+            return std::make_unique<ChainOnSoilResponse>(ps, strengths, std::move(rows), soil_is_a);
+        };
         std::vector<PairResult> pairs;
+        const auto off = meanAndVariance(firstRows(base_rows, opt.signature_seeds), bed_sd);
         for (std::size_t a = 0; a < pool.size(); ++a)
             for (std::size_t b = a + 1; b < pool.size(); ++b) {
                 const Live &A = live[pool[a]], &B = live[pool[b]];
                 PairResult P;
                 P.a = A.result.name;
                 P.b = B.result.name;
-                const auto off = meanAndVariance(firstRows(base_rows, opt.signature_seeds), bed_sd);
                 const Prior &pa = A.result.effect.prior, &pb = B.result.effect.prior;
+                std::unique_ptr<PairModel> model;
+                for (const ChainOnSoil &t : chain_tables)
+                    if ((t.soil == pool[a] && t.chain == pool[b]) ||
+                        (t.soil == pool[b] && t.chain == pool[a]))
+                        model = chainOnSoil(t, t.soil == pool[a]);
+                if (!model)
+                    model = std::make_unique<PairResponse>(*A.response, *B.response, off.first,
+                                                           off.second);
                 const auto fit = [&](const Eigen::VectorXd &measured) {
-                    return fitPair(*A.response, pa, *B.response, pb, off.first, off.second,
-                                   measured, u2_fixed, D.calibration, correlation);
+                    return fitPair(*model, pa, pb, off.first, off.second, measured, u2_fixed,
+                                   D.calibration, correlation);
                 };
                 P.fit = fit(meas.value);
                 const auto refit = [&](const Eigen::VectorXd &pseudo) {
@@ -1282,8 +1367,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                     t << pa.toScale(f.a.strength), pb.toScale(f.b.strength);
                     return t;
                 };
-                const PairResponse both(*A.response, *B.response, off.first, off.second);
-                luck.widen(refit, both.mean(P.fit.a.strength, P.fit.b.strength),
+                luck.widen(refit, model->mean(P.fit.a.strength, P.fit.b.strength),
                            {{&P.fit.a, &pa}, {&P.fit.b, &pb}});
                 pairs.push_back(P);
             }

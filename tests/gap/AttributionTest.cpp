@@ -165,11 +165,57 @@ TEST_CASE("two effects with different signatures are both recovered by the pair 
     const auto ra = linear(pa, base, Ja, {0.0, 1.0});
     const auto rb = linear(pb, base, Jb, {0.0, 2.0});
     const Eigen::VectorXd y = base + 0.3 * Ja + 1.2 * Jb;
-    const auto fit = fitPair(ra, pa, rb, pb, base, Eigen::VectorXd::Zero(6), y,
+    const PairResponse sum(ra, rb, base, Eigen::VectorXd::Zero(6));
+    const auto fit = fitPair(sum, pa, pb, base, Eigen::VectorXd::Zero(6), y,
                              Eigen::VectorXd::Constant(6, 1e-4), all(6));
     CHECK(fit.a.strength == Approx(0.3).margin(0.01));
     CHECK(fit.b.strength == Approx(1.2).margin(0.01));
     CHECK(fit.chi2 < 1e-3);
+}
+
+TEST_CASE("a zero offset read on a soil effect's own runs is fitted with it where a sum of "
+          "their changes is not",
+          "[gap][attribution]") {
+    // The soil's strength s scales a curve, y = s x^2; the sensor's zero offset c shifts what
+    // it reads, y = s (x - c)^2, at x = 1 ... 6: their changes do not add. The chain is
+    // tabulated as the diagnosis tabulates it (17 offsets over its prior) on the soil's base
+    // (s = 1) and on its one other simulated strength (s = 2).
+    const Prior soil{0.5, 2.0, 1.0, false}, chain{-1.0, 1.0, 0.0, false};
+    const auto curve = [](double s, double c) {
+        Eigen::VectorXd y(6);
+        for (int k = 0; k < 6; ++k)
+            y[k] = s * (k + 1 - c) * (k + 1 - c);
+        return y;
+    };
+    const auto chainOn = [&](double s) {
+        std::vector<double> at;
+        std::vector<Eigen::VectorXd> means, vars;
+        for (int j = 0; j < 17; ++j) {
+            at.push_back(-1.0 + 2.0 * j / 16.0);
+            means.push_back(curve(s, at.back()));
+            vars.push_back(Eigen::VectorXd::Zero(6));
+        }
+        return TabulatedResponse(chain, at, means, vars);
+    };
+    const ChainOnSoilResponse read({soil}, {1.0, 2.0}, {chainOn(1.0), chainOn(2.0)}, true);
+    const Eigen::VectorXd base = curve(1.0, 0.0), zero = Eigen::VectorXd::Zero(6);
+    // Exact at a simulated soil strength and a tabulated offset; linear in s between.
+    CHECK((read.mean(2.0, 0.375) - curve(2.0, 0.375)).norm() < 1e-9);
+    CHECK((read.mean(1.5, 0.375) - curve(1.5, 0.375)).norm() < 1e-9);
+    const Eigen::VectorXd y = curve(1.5, 0.4);
+    const Eigen::VectorXd u2 = Eigen::VectorXd::Constant(6, 1e-4);
+    const PairFit fit = fitPair(read, soil, chain, base, zero, y, u2, all(6));
+    // Against the world's own strengths, within the table's interpolation in c (step 0.125).
+    CHECK(fit.a.strength == Approx(1.5).margin(0.02));
+    CHECK(fit.b.strength == Approx(0.4).margin(0.02));
+    // The same tables added as two changes to the base miss it by far.
+    const TabulatedResponse soil_alone(soil, {1.0, 2.0}, {curve(1.0, 0.0), curve(2.0, 0.0)},
+                                       {zero, zero});
+    const TabulatedResponse chain_alone = chainOn(1.0);
+    const PairResponse sum(soil_alone, chain_alone, base, zero);
+    const PairFit summed = fitPair(sum, soil, chain, base, zero, y, u2, all(6));
+    CHECK(summed.chi2 > 100.0 * std::max(fit.chi2, 1.0));
+    CHECK(std::abs(summed.b.strength - 0.4) > 0.1);
 }
 
 TEST_CASE("signature overlap: proportional signatures overlap fully, orthogonal ones not at all",

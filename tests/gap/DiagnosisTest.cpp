@@ -35,6 +35,8 @@ struct Truth {
     /// The measuring world's heap (an angle of repose experiment, where the set has one): by
     /// default the model's own law (`angle`), else this angle.
     double heap_deg = 0.0;
+    /// A sensor zero offset (m) on top of the effect: a world with two effects at once.
+    double zero_offset_m = 0.0;
 };
 
 /// The analytic heap's angle: 30 deg, which denser grains steepen in proportion (the model's
@@ -98,6 +100,12 @@ ExperimentSet measuredSet(const Truth &t, unsigned seed) {
                     m.builtin = t.effect;
                     c = applyMeasurementEffect(m, t.strength, e, "pressure_Pa", c);
                 }
+                if (t.zero_offset_m != 0.0) {
+                    Effect m;
+                    m.kind = Effect::Kind::Measurement;
+                    m.builtin = "sensor_zero_offset";
+                    c = applyMeasurementEffect(m, t.zero_offset_m, e, "pressure_Pa", c);
+                }
                 tr.curves["pressure_Pa"] = c;
                 e.trials.push_back(tr);
             }
@@ -151,7 +159,7 @@ public:
                         if (!eff)
                             continue;
                         if (eff->kind == Effect::Kind::Measurement)
-                            measurement = eff, t.strength = str;
+                            measurement = eff; // read below, at its own strength
                         else
                             t = {alias.count(eff->name) ? alias.at(eff->name) : eff->name, str};
                     }
@@ -1687,4 +1695,40 @@ TEST_CASE("diagnosis: two effects that each explain and that the held-out experi
                                         "experiments do not tell them apart"));
     CHECK(d.indistinguishable.size() == 1);
     CHECK((d.best_model == "cohesion" || d.best_model == "cohesion_twin"));
+}
+
+TEST_CASE("diagnosis: a hidden effect of the soil with a sensor zero offset is explained by the "
+          "pair at both strengths",
+          "[gap][diagnosis]") {
+    // No single effect explains a cohesion whose curves a zero offset also shifts. The pair's
+    // fit reads the offset on cohesion's own runs (`ChainOnSoilResponse`): with their changes
+    // added instead it claimed 2 of these 12 worlds, cohesion 20-25 % and the offset 25-75 %
+    // low, the rest left with a gap.
+    int explained = 0;
+    for (unsigned seed : {7u, 1u, 2u})
+        for (const auto &[cohesion, offset] : std::vector<std::pair<double, double>>{
+                 {4.0e4, 0.001}, {8.0e4, 0.001}, {8.0e4, 0.0015}, {4.0e4, 0.0015}}) {
+            Truth t{"cohesion", cohesion};
+            t.zero_offset_m = offset;
+            const Diagnosis d = run(t, seed);
+            INFO("seed " << seed << ", cohesion " << cohesion << ", offset " << offset << ": "
+                         << d.claim);
+            CHECK(d.outcome != Diagnosis::Outcome::Explained); // no single is the cause
+            if (d.outcome != Diagnosis::Outcome::ExplainedByPair)
+                continue;
+            ++explained;
+            const PairResult *pair = nullptr;
+            for (const PairResult &p : d.pairs)
+                if (p.a + " + " + p.b == d.best_model)
+                    pair = &p;
+            REQUIRE(pair);
+            const bool cohesion_first = pair->a == "cohesion";
+            const StrengthFit &c = cohesion_first ? pair->fit.a : pair->fit.b,
+                              &z = cohesion_first ? pair->fit.b : pair->fit.a;
+            CHECK((cohesion_first ? pair->b : pair->a) == "sensor_zero_offset");
+            CHECK(c.strength == Approx(cohesion).epsilon(0.10));
+            CHECK(z.strength == Approx(offset).epsilon(0.10));
+        }
+    // Measured 10 of 12 (the other two: the right pair, short of the pairs' level).
+    CHECK(explained >= 9);
 }
