@@ -1213,6 +1213,16 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // explains as well and is not told apart leaves the gap unexplained: the claim would be a
     // coin's toss between two effects that each pass every test (found by a review; named
     // beside the claim until 2026-12-07).
+    // How much better one model predicts the held-out experiments than another: the test each
+    // passed against the null, the other in the null's place.
+    const auto versus = [&](const Eigen::VectorXd &mean, const Eigen::VectorXd &variance,
+                            const Eigen::MatrixXd &rows, const Eigen::VectorXd &other_mean,
+                            const Eigen::VectorXd &other_variance,
+                            const Eigen::MatrixXd &other_rows) {
+        return compareDensities(
+            meas.value, mean, variance, other_mean, other_variance, D.held_out, bed_keys, meas.keys,
+            leaveOneSeedOut(rows, other_rows, other_mean, other_mean, measured_luck));
+    };
     const CandidateResult *twin_rival = nullptr;
     double twin_rival_p = 1.0; // the winner against it
     if (winner) {
@@ -1224,11 +1234,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             const CandidateResult &R = L.result;
             if (&L == W || !R.confirmed || R.after.gap)
                 continue;
-            const Eigen::VectorXd &rival = R.confirmed_mean;
-            const DensityComparison c = compareDensities(
-                meas.value, W->result.confirmed_mean, W->predictive_variance, rival,
-                L.predictive_variance, D.held_out, bed_keys, meas.keys,
-                leaveOneSeedOut(W->confirmed_rows, L.confirmed_rows, rival, rival, measured_luck));
+            const DensityComparison c =
+                versus(W->result.confirmed_mean, W->predictive_variance, W->confirmed_rows,
+                       R.confirmed_mean, L.predictive_variance, L.confirmed_rows);
             D.rivals.push_back({R.name, c.p_value, R.fit.at_prior_edge, R.beats_null});
             if (!(c.p_value < opt.alpha) && R.explains && !twin_rival) {
                 twin_rival = &R;
@@ -1257,6 +1265,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     // and a pair would be judged where it could not be told from it (a single there is never
     // claimed either).
     const bool single_leaves_no_gap = best_no_gap != nullptr;
+    std::optional<std::size_t> pair_rival; // in D.pairs: a pair the best cannot be told from
+    double pair_rival_p = 1.0;
     if (!any_explains && !single_leaves_no_gap && resolved && claim_possible) {
         std::vector<std::size_t> pool;
         for (std::size_t i : applicable)
@@ -1399,6 +1409,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             D.simulations += r.seeds;
         const double pair_level = opt.alpha / double(std::max<std::size_t>(1, judged + pr.size()));
         D.pair_level = pair_level;
+        std::vector<Eigen::VectorXd> pair_variance(confirm_pairs);
         for (std::size_t i = 0; i < confirm_pairs; ++i) {
             PairResult &P = pairs[i];
             P.confirmed = true;
@@ -1409,9 +1420,28 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 strengthSpread(responseOf(P.a), P.fit.a) + strengthSpread(responseOf(P.b), P.fit.b);
             const bool better = evaluateModel(pair_rows[i], P.held_out, P.versus_null, P.after,
                                               P.confirmed_mean, P.confirmed_z, spread);
+            pair_variance[i] = predictiveVariance(pair_rows[i], spread);
             P.explains = better && P.versus_null.p_value < pair_level && !P.after.gap &&
                          !D.held_out.empty() && !P.fit.a.at_prior_edge && !P.fit.b.at_prior_edge &&
                          resolved;
+        }
+        // As for the singles: the best held-out prediction among the pairs without a gap is
+        // told apart from every other pair that leaves no gap, and where one that explains is
+        // not, neither is claimed.
+        if (const PairResult *best = bestWithoutGap(pairs); best && best->explains) {
+            const std::size_t w = std::size_t(best - pairs.data());
+            for (std::size_t i = 0; i < confirm_pairs; ++i) {
+                PairResult &R = pairs[i];
+                if (i == w || R.after.gap)
+                    continue;
+                R.best_over_it_p = versus(best->confirmed_mean, pair_variance[w], pair_rows[w],
+                                          R.confirmed_mean, pair_variance[i], pair_rows[i])
+                                       .p_value;
+                if (!(R.best_over_it_p < opt.alpha) && R.explains && !pair_rival) {
+                    pair_rival = i;
+                    pair_rival_p = R.best_over_it_p;
+                }
+            }
         }
         D.pairs = pairs;
     }
@@ -1439,7 +1469,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // and only if that one explains (until 2026-12-07 the best of those that explain: a
         // pair predicting better but not claimable was not told apart).
         const PairResult *pair = bestWithoutGap(D.pairs);
-        if (pair && !pair->explains)
+        if (pair && (!pair->explains || pair_rival))
             pair = nullptr;
         if (pair) {
             D.outcome = Diagnosis::Outcome::ExplainedByPair;
@@ -1461,7 +1491,18 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 claim << "unexplained: no held-out experiment to test a candidate on (a claim "
                          "needs experiments it was not fitted to: give two or more experiments "
                          "of a type, or name them with --hold-out)";
-            else if (twin_rival) {
+            else if (pair_rival) {
+                const auto told = [&](const PairResult &P) {
+                    return P.a + " + " + P.b + " (" + fmt(P.fit.a.strength) + ", " +
+                           fmt(P.fit.b.strength) + ", held-out gap " + percentOf(P.held_out.gap) +
+                           " %, p = " + fmt(P.versus_null.p_value, 2) + ")";
+                };
+                claim << "unexplained: the pairs " << told(*bestWithoutGap(D.pairs)) << " and "
+                      << told(D.pairs[*pair_rival])
+                      << " each beat the null model and leave no gap, and these experiments do "
+                         "not tell them apart (p = "
+                      << fmt(pair_rival_p, 2) << " for the first against the second)";
+            } else if (twin_rival) {
                 const auto told = [&](const CandidateResult &R) {
                     return R.name + " (" + strengthText(R.effect, R.fit.strength) +
                            ", held-out gap " + percentOf(R.held_out.gap) +

@@ -190,6 +190,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
             pj["held_out_gain"] = gain(p.versus_null);
             pj["gap_test_with_effects"] = verdict(p.after);
             pj["explains"] = p.explains;
+            pj["p_value_best_pair_over_it"] = number(p.best_over_it_p);
         }
         j["pairs"].push_back(pj);
     }

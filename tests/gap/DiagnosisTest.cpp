@@ -1732,3 +1732,38 @@ TEST_CASE("diagnosis: a hidden effect of the soil with a sensor zero offset is e
     // Measured 10 of 12 (the other two: the right pair, short of the pairs' level).
     CHECK(explained >= 9);
 }
+
+TEST_CASE("diagnosis: two pairs that each explain and that the held-out experiments cannot tell "
+          "apart are both named, and neither is claimed",
+          "[gap][diagnosis]") {
+    // cohesion_twin is cohesion's physics under another name: with the zero offset, each pair
+    // passes every test the other passes. As for two singles, claiming the one that predicts a
+    // little better would be a coin's toss.
+    EffectCatalogue c = shippedEffects();
+    Effect twin = c.find("cohesion");
+    twin.name = "cohesion_twin";
+    twin.signature = {1.2e5, 2.5e5}; // other table points: not the very same fit
+    c.effects.push_back(twin);
+    AnalyticSimulator sim;
+    sim.alias["cohesion_twin"] = "cohesion";
+    Truth t{"cohesion", 8.0e4};
+    t.zero_offset_m = 0.001;
+    const Diagnosis d = diagnose(measuredSet(t, 7), c.diagnosable(), sim, analyticOptions());
+    INFO(d.claim);
+    int explaining = 0;
+    for (const PairResult &p : d.pairs)
+        if (p.explains) {
+            ++explaining;
+            UNSCOPED_INFO(p.a << " + " << p.b << " p " << p.versus_null.p_value << " best over it "
+                              << p.best_over_it_p);
+        }
+    REQUIRE(explaining == 2);
+    CHECK(d.outcome == Diagnosis::Outcome::Unexplained);
+    CHECK_THAT(d.claim, Catch::Contains("each beat the null model and leave no gap, and these "
+                                        "experiments do not tell them apart"));
+    CHECK_THAT(d.claim, Catch::Contains("cohesion_twin + sensor_zero_offset"));
+    int compared = 0;
+    for (const PairResult &p : d.pairs)
+        compared += std::isfinite(p.best_over_it_p);
+    CHECK(compared == 1);
+}

@@ -927,5 +927,15 @@ TEST_CASE("a direct shear test's vertical displacement is the lab's plate rise: 
     const auto at = std::find(sim4.x.begin(), sim4.x.end(), back.x.back());
     REQUIRE(at != sim4.x.end());
     CHECK(back.y.back() == Approx(sim4.y[std::size_t(at - sim4.x.begin())]).epsilon(1e-8));
+    // A rise sampled elsewhere than its stress (another run's samples) is refused, named:
+    // a row of the twin's file would pair values of two instants.
+    auto torn = curves;
+    Curve &short_rise = torn[0].at("s4").at("vertical_displacement_m");
+    short_rise.x.pop_back();
+    short_rise.y.pop_back();
+    CHECK_THROWS_WITH(writeTwin(design, torn, key, (scratch / "torn").string(),
+                                (scratch / "torn.key.json").string()),
+                      Catch::Contains("experiment 's4', repeat 1: its 'vertical_displacement_m' "
+                                      "was not sampled with its 'shear_stress_Pa'"));
     fs::remove_all(scratch);
 }

@@ -168,7 +168,7 @@ private:
 /// grid (`rows[i]` at `strengths[i]`, the off value among them), and between those strengths
 /// interpolated as a table is. A chain's change is no sum with a soil effect's: a zero offset
 /// shifts whatever curve the soil gives, and added to a cohesion's change it fitted a hidden
-/// cohesion 4e4 J/m^3 with a 1 mm offset as 3.1e4 with 0.64 mm, which then left a gap.
+/// cohesion 4e4 J/m^3 with a 1 mm offset as 3.2e4 with 0.75 mm.
 class ChainOnSoilResponse final : public PairModel {
 public:
     /// `soil_is_a`: the soil effect is the pair's first (strength `sa`).

@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 
 #include <functional>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -135,6 +136,10 @@ struct PairResult {
     GapVerdict after;
     Eigen::VectorXd confirmed_mean;
     Eigen::VectorXd confirmed_z;
+    /// p of the best pair (the best held-out prediction without a gap) predicting the held-out
+    /// experiments better than this one; NaN for the best itself, a pair with a gap, or one
+    /// not confirmed.
+    double best_over_it_p = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct Diagnosis {
