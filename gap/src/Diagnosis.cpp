@@ -246,6 +246,15 @@ BedLuck bedLuck(const Measured &meas, const FeatureSet &calibration,
 
 /// The first confirmed candidate that would explain the gap but for its kinds of observable
 /// asking for different strengths of it; null if none.
+/// Each kind's strength with its interval, and their agreement: "kind s [lo, hi]; ...; p = ...".
+std::string kindsText(const std::vector<std::pair<std::string, StrengthFit>> &by_kind,
+                      const StrengthAgreement &agreement) {
+    std::string out;
+    for (const auto &[kind, fit] : by_kind)
+        out += kind + ' ' + fmt(fit.strength) + " [" + fmt(fit.lo) + ", " + fmt(fit.hi) + "]; ";
+    return out + "p = " + fmt(agreement.p_value, 2);
+}
+
 const CandidateResult *disagreeing(const std::vector<CandidateResult> &candidates) {
     for (const CandidateResult &R : candidates)
         if (R.confirmed && R.beats_null && !R.after.gap && !R.fit.at_prior_edge &&
@@ -374,7 +383,10 @@ std::string headline(const Diagnosis &d) {
         const std::string why = p->explains    ? "explains"
                                 : !beats       ? "does not beat the null model"
                                 : p->after.gap ? "beats the null model but leaves a gap"
-                                               : "beats the null model but is not claimable";
+                                : !p->strengths_agree
+                                    ? "beats the null model but its kinds of observable ask for "
+                                      "different strengths"
+                                    : "beats the null model but is not claimable";
         return out + (claimed ? "the pair " : "; closest: the pair ") + d.best_model + ", " +
                strengths + heldOut(m.held_out->gap, m.versus_null->p_value, m.level, why, p->after);
     }
@@ -910,15 +922,15 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     for (const FeatureSet *part : {&D.calibration, &D.held_out})
         for (Eigen::Index k : *part)
             kinds[meas.keys[std::size_t(k)].kind].push_back(k);
-    const auto fitByKind = [&](CandidateResult &R, const Response &response) {
-        const Prior &p = R.effect.prior;
+    const auto fitByKind = [&](const Response &response, const Prior &p,
+                               std::vector<std::pair<std::string, StrengthFit>> &by_kind) {
         std::vector<StrengthFit> parts;
         for (const auto &[kind, use] : kinds) {
             parts.push_back(
                 fitOn(response, p, use, bedLuck(meas, use, base_rows, opt.signature_seeds)));
-            R.by_kind.emplace_back(kind, parts.back());
+            by_kind.emplace_back(kind, parts.back());
         }
-        R.agreement = strengthAgreement(parts, p);
+        return strengthAgreement(parts, p);
     };
     for (Live &L : live) {
         if (!L.response)
@@ -1185,7 +1197,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // A strength at its prior's edge may stand in for something the catalogue lacks (LIGGGHTS'
         // 5x softer soil fitted by the softest grains allowed): it may beat the null, it is
         // still not claimed as the cause.
-        fitByKind(R, *L.response);
+        R.agreement = fitByKind(*L.response, R.effect.prior, R.by_kind);
         R.strengths_agree = R.agreement.p_value >= opt.agreement_level;
         R.explains =
             R.beats_null && !R.after.gap && !R.fit.at_prior_edge && resolved && R.strengths_agree;
@@ -1379,6 +1391,14 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 };
                 luck.widen(refit, model->mean(P.fit.a.strength, P.fit.b.strength),
                            {{&P.fit.a, &pa}, {&P.fit.b, &pb}});
+                // Each strength by kind, the other held at its fit: a pair fitted where no kind
+                // alone asks for it absorbs a difference of model form, as a single does.
+                P.a_agreement =
+                    fitByKind(PairSlice(*model, true, P.fit.b.strength), pa, P.a_by_kind);
+                P.b_agreement =
+                    fitByKind(PairSlice(*model, false, P.fit.a.strength), pb, P.b_by_kind);
+                P.strengths_agree = P.a_agreement.p_value >= opt.agreement_level &&
+                                    P.b_agreement.p_value >= opt.agreement_level;
                 pairs.push_back(P);
             }
         std::sort(pairs.begin(), pairs.end(),
@@ -1392,15 +1412,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const std::size_t confirm_pairs = std::min<std::size_t>(2, pairs.size());
         std::vector<VariantRequest> pr;
         for (std::size_t i = 0; i < confirm_pairs; ++i) {
-            const Effect *ea = nullptr, *eb = nullptr;
-            for (const Effect *e : effects) {
-                if (e->name == pairs[i].a)
-                    ea = e;
-                if (e->name == pairs[i].b)
-                    eb = e;
-            }
-            pr.push_back({"confirm " + pairs[i].a + " + " + pairs[i].b, ea, pairs[i].fit.a.strength,
-                          eb, pairs[i].fit.b.strength, "", opt.seeds});
+            pr.push_back({"confirm " + pairs[i].a + " + " + pairs[i].b, rawEffect(pairs[i].a),
+                          pairs[i].fit.a.strength, rawEffect(pairs[i].b), pairs[i].fit.b.strength,
+                          "", opt.seeds});
         }
         if (!pr.empty())
             log("no single effect explains the gap: confirming " + std::to_string(pr.size()) + " pairs");
@@ -1423,7 +1437,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             pair_variance[i] = predictiveVariance(pair_rows[i], spread);
             P.explains = better && P.versus_null.p_value < pair_level && !P.after.gap &&
                          !D.held_out.empty() && !P.fit.a.at_prior_edge && !P.fit.b.at_prior_edge &&
-                         resolved;
+                         resolved && P.strengths_agree;
         }
         // As for the singles: the best held-out prediction among the pairs without a gap is
         // told apart from every other pair that leaves no gap, and where one that explains is
@@ -1469,6 +1483,12 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // and only if that one explains (until 2026-12-07 the best of those that explain: a
         // pair predicting better but not claimable was not told apart).
         const PairResult *pair = bestWithoutGap(D.pairs);
+        // The best pair would explain but for its kinds' agreement.
+        const PairResult *torn_pair =
+            pair && !pair->strengths_agree && pair->versus_null.p_value < D.pair_level &&
+                    !pair->fit.a.at_prior_edge && !pair->fit.b.at_prior_edge
+                ? pair
+                : nullptr;
         if (pair && (!pair->explains || pair_rival))
             pair = nullptr;
         if (pair) {
@@ -1541,11 +1561,20 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                       << percentOf(torn->held_out.gap)
                       << " %, p = " << fmt(torn->versus_null.p_value, 2)
                       << ") beats the null model and leaves no gap, but the kinds of observable "
-                         "ask for different strengths of it (";
-                for (const auto &[kind, fit] : torn->by_kind)
-                    claim << kind << ' ' << fmt(fit.strength) << " [" << fmt(fit.lo) << ", "
-                          << fmt(fit.hi) << "]; ";
-                claim << "p = " << fmt(torn->agreement.p_value, 2)
+                         "ask for different strengths of it ("
+                      << kindsText(torn->by_kind, torn->agreement)
+                      << "): it absorbs a difference of model form rather than explaining it";
+            } else if (torn_pair) {
+                const PairResult &P = *torn_pair;
+                const bool a_torn = !(P.a_agreement.p_value >= opt.agreement_level);
+                claim << "unexplained: the pair " << P.a << " + " << P.b << " ("
+                      << fmt(P.fit.a.strength) << ", " << fmt(P.fit.b.strength) << ", held-out gap "
+                      << percentOf(P.held_out.gap) << " %, p = " << fmt(P.versus_null.p_value, 2)
+                      << ") beats the null model and leaves no gap, but the kinds of observable "
+                         "ask for different strengths of "
+                      << (a_torn ? P.a : P.b) << " ("
+                      << (a_torn ? kindsText(P.a_by_kind, P.a_agreement)
+                                 : kindsText(P.b_by_kind, P.b_agreement))
                       << "): it absorbs a difference of model form rather than explaining it";
             } else if (!claim_possible)
                 claim << "unexplained: the held-out experiments are one piece of evidence: "

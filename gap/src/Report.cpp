@@ -8,6 +8,7 @@
 #include <fstream>
 #include <set>
 #include <sstream>
+#include <tuple>
 
 namespace grainlink::gap {
 
@@ -62,6 +63,19 @@ Json strength(const Effect &e, const StrengthFit &f) {
             {"at_prior_edge", f.at_prior_edge},
             {"bed_luck_sd", number(f.luck_sd)},
             {"bed_luck_sd_scale", e.prior.log_scale ? "log" : "linear"}};
+}
+
+/// An effect's strength asked for by each kind of observable, and their agreement, into `into`.
+void byKind(Json &into, const Effect &e,
+            const std::vector<std::pair<std::string, StrengthFit>> &by_kind,
+            const StrengthAgreement &agreement) {
+    into["strength_by_kind"] = Json::array();
+    for (const auto &[kind, fit] : by_kind)
+        into["strength_by_kind"].push_back({{"kind", kind}, {"strength", strength(e, fit)}});
+    into["strength_agreement"] = {{"chi2", number(agreement.chi2)},
+                                  {"dof", agreement.dof},
+                                  {"p_value", number(agreement.p_value)},
+                                  {"weighted_mean", number(agreement.mean)}};
 }
 
 void writeAtomically(const fs::path &path, const std::string &text) {
@@ -165,14 +179,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
                 cj["held_out_gain"] = gain(c.versus_null);
                 cj["beats_null"] = c.beats_null;
                 cj["gap_test_with_effect"] = verdict(c.after);
-                cj["strength_by_kind"] = Json::array();
-                for (const auto &[kind, fit] : c.by_kind)
-                    cj["strength_by_kind"].push_back(
-                        {{"kind", kind}, {"strength", strength(c.effect, fit)}});
-                cj["strength_agreement"] = {{"chi2", number(c.agreement.chi2)},
-                                            {"dof", c.agreement.dof},
-                                            {"p_value", number(c.agreement.p_value)},
-                                            {"weighted_mean", number(c.agreement.mean)}};
+                byKind(cj, c.effect, c.by_kind, c.agreement);
                 cj["explains"] = c.explains;
             }
         }
@@ -191,6 +198,18 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
             pj["gap_test_with_effects"] = verdict(p.after);
             pj["explains"] = p.explains;
             pj["p_value_best_pair_over_it"] = number(p.best_over_it_p);
+            // Each strength by kind, the other held at its fit.
+            Json parts = Json::array();
+            for (const auto &[name, by_kind, agreement] :
+                 {std::tie(p.a, p.a_by_kind, p.a_agreement),
+                  std::tie(p.b, p.b_by_kind, p.b_agreement)})
+                for (const CandidateResult &c : d.candidates)
+                    if (c.name == name) {
+                        Json part{{"effect", name}};
+                        byKind(part, c.effect, by_kind, agreement);
+                        parts.push_back(part);
+                    }
+            pj["by_kind"] = parts;
         }
         j["pairs"].push_back(pj);
     }

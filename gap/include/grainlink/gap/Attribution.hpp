@@ -186,6 +186,26 @@ private:
     bool soil_is_a_;
 };
 
+/// One strength of a pair with the other held: a response of one effect (the kinds' agreement
+/// asks each strength of a pair what it asks of a single's).
+class PairSlice final : public Response {
+public:
+    /// `along_a`: the pair's first strength varies, the second is held at `held`.
+    PairSlice(const PairModel &pair, bool along_a, double held)
+        : pair_(pair), along_a_(along_a), held_(held) {}
+    Eigen::VectorXd mean(double s) const override {
+        return along_a_ ? pair_.mean(s, held_) : pair_.mean(held_, s);
+    }
+    Eigen::VectorXd variance(double s) const override {
+        return along_a_ ? pair_.variance(s, held_) : pair_.variance(held_, s);
+    }
+
+private:
+    const PairModel &pair_;
+    bool along_a_;
+    double held_;
+};
+
 struct PairFit {
     StrengthFit a, b; ///< each strength with its interval at the other's best value
     double chi2 = 0.0;

@@ -140,6 +140,11 @@ struct PairResult {
     /// experiments better than this one; NaN for the best itself, a pair with a gap, or one
     /// not confirmed.
     double best_over_it_p = std::numeric_limits<double>::quiet_NaN();
+    /// Each strength by kind of observable, the other held at its fit (as a single's
+    /// `by_kind`), and whether they agree: both must.
+    std::vector<std::pair<std::string, StrengthFit>> a_by_kind, b_by_kind;
+    StrengthAgreement a_agreement, b_agreement;
+    bool strengths_agree = true;
 };
 
 struct Diagnosis {
