@@ -34,7 +34,7 @@ std::string percentOf(double fraction) {
 /// The spread a fitted strength's 95 % interval gives its prediction, ((m(hi) - m(lo))/3.92)^2
 /// per feature (0 where the table has no value): a model predicts with what it knows. The
 /// interval with the beds' luck at the normal quantile (`StrengthFit::spread_lo`).
-Eigen::VectorXd strengthSpread(const TabulatedResponse &table, const StrengthFit &fit) {
+Eigen::VectorXd strengthSpread(const Response &table, const StrengthFit &fit) {
     const Eigen::VectorXd half =
         (table.mean(fit.spread_hi) - table.mean(fit.spread_lo)) / (2.0 * 1.96);
     Eigen::VectorXd var = half.array().square().matrix();
@@ -1362,6 +1362,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             return std::make_unique<ChainOnSoilResponse>(ps, strengths, std::move(rows), soil_is_a);
         };
         std::vector<PairResult> pairs;
+        std::vector<std::unique_ptr<PairModel>> models; // each pair's, in `pairs` order
         const auto off = meanAndVariance(firstRows(base_rows, opt.signature_seeds), bed_sd);
         for (std::size_t a = 0; a < pool.size(); ++a)
             for (std::size_t b = a + 1; b < pool.size(); ++b) {
@@ -1400,15 +1401,24 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 P.strengths_agree = P.a_agreement.p_value >= opt.agreement_level &&
                                     P.b_agreement.p_value >= opt.agreement_level;
                 pairs.push_back(P);
+                models.push_back(std::move(model));
             }
-        std::sort(pairs.begin(), pairs.end(),
-                  [](const PairResult &x, const PairResult &y) { return x.fit.chi2 < y.fit.chi2; });
-        const auto responseOf = [&](const std::string &name) -> const TabulatedResponse & {
-            for (const Live &L : live)
-                if (L.result.name == name)
-                    return *L.response;
-            throw std::logic_error("diagnose: a pair of an effect without a response: " + name);
-        };
+        {
+            std::vector<std::size_t> order(pairs.size());
+            for (std::size_t i = 0; i < order.size(); ++i)
+                order[i] = i;
+            std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
+                return pairs[x].fit.chi2 < pairs[y].fit.chi2;
+            });
+            std::vector<PairResult> by_chi2;
+            std::vector<std::unique_ptr<PairModel>> models_by_chi2;
+            for (std::size_t i : order) {
+                by_chi2.push_back(pairs[i]);
+                models_by_chi2.push_back(std::move(models[i]));
+            }
+            pairs.swap(by_chi2);
+            models.swap(models_by_chi2);
+        }
         const std::size_t confirm_pairs = std::min<std::size_t>(2, pairs.size());
         std::vector<VariantRequest> pr;
         for (std::size_t i = 0; i < confirm_pairs; ++i) {
@@ -1430,8 +1440,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             // Each strength's interval spreads the prediction, as a single's does: without it a
             // pair predicted more sharply than any single, and a wrong pair beat the null at
             // p = 5e-7 on LIGGGHTS' rolling-friction twin.
+            // Each read along the pair's own model, the other strength held at its fit (a zero
+            // offset moves a cohesive curve otherwise than the base's).
             const Eigen::VectorXd spread =
-                strengthSpread(responseOf(P.a), P.fit.a) + strengthSpread(responseOf(P.b), P.fit.b);
+                strengthSpread(PairSlice(*models[i], true, P.fit.b.strength), P.fit.a) +
+                strengthSpread(PairSlice(*models[i], false, P.fit.a.strength), P.fit.b);
             const bool better = evaluateModel(pair_rows[i], P.held_out, P.versus_null, P.after,
                                               P.confirmed_mean, P.confirmed_z, spread);
             pair_variance[i] = predictiveVariance(pair_rows[i], spread);
