@@ -191,9 +191,11 @@ std::vector<double> profilePoints(double t0, double t1, double t_off) {
     return t;
 }
 
-/// Whether `response` has feature k at every point a profile over `prior` looks at.
-std::vector<bool> hasEverywhere(const Response &response, const Prior &prior, Eigen::Index n) {
-    std::vector<bool> all(std::size_t(n), true);
+/// Which of the features marked in `all` `response` has at every point a profile over `prior`
+/// looks at.
+std::vector<bool> hasEverywhere(const Response &response, const Prior &prior,
+                                std::vector<bool> all) {
+    const Eigen::Index n = Eigen::Index(all.size());
     const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi);
     for (double t : profilePoints(t0, t1, prior.toScale(prior.off))) {
         const Eigen::VectorXd m = response.mean(prior.fromScale(t));
@@ -285,7 +287,8 @@ StrengthFit fitStrength(const Response &response, const Prior &prior,
                         const Eigen::VectorXd &measured, const Eigen::VectorXd &u2_fixed,
                         const FeatureSet &use, const BlockCorrelation &correlation) {
     const double t0 = prior.toScale(prior.lo), t1 = prior.toScale(prior.hi);
-    const std::vector<bool> has = hasEverywhere(response, prior, measured.size());
+    const std::vector<bool> has =
+        hasEverywhere(response, prior, std::vector<bool>(std::size_t(measured.size()), true));
     const Eigen::VectorXd off_mean = response.mean(prior.off),
                           off_var = response.variance(prior.off);
     const auto chi2 = [&](double t) {
@@ -430,15 +433,10 @@ PairFit fitPair(const PairModel &pair, const Prior &pa, const Prior &pb,
     const double b0 = pb.toScale(pb.lo), b1 = pb.toScale(pb.hi);
     constexpr int n = 41;
     // The features the pair has along each strength, the other off.
-    std::vector<bool> has(std::size_t(measured.size()), true);
-    const auto keep = [&](const Eigen::VectorXd &m) {
-        for (Eigen::Index k = 0; k < m.size(); ++k)
-            has[std::size_t(k)] = has[std::size_t(k)] && std::isfinite(m[k]);
-    };
-    for (double t : profilePoints(a0, a1, pa.toScale(pa.off)))
-        keep(pair.mean(pa.fromScale(t), pb.off));
-    for (double t : profilePoints(b0, b1, pb.toScale(pb.off)))
-        keep(pair.mean(pa.off, pb.fromScale(t)));
+    const std::vector<bool> has =
+        hasEverywhere(PairSlice(pair, false, pa.off), pb,
+                      hasEverywhere(PairSlice(pair, true, pb.off), pa,
+                                    std::vector<bool>(std::size_t(measured.size()), true)));
     const auto chi2 = [&](double ta, double tb) {
         const double sa = pa.fromScale(ta), sb = pb.fromScale(tb);
         return chiSquare(measured, atBaseWhereMissing(pair.mean(sa, sb), has, base_mean),

@@ -8,6 +8,7 @@
 #include <functional>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -244,8 +245,6 @@ BedLuck bedLuck(const Measured &meas, const FeatureSet &calibration,
     return luck;
 }
 
-/// The first confirmed candidate that would explain the gap but for its kinds of observable
-/// asking for different strengths of it; null if none.
 /// Each kind's strength with its interval, and their agreement: "kind s [lo, hi]; ...; p = ...".
 std::string kindsText(const std::vector<std::pair<std::string, StrengthFit>> &by_kind,
                       const StrengthAgreement &agreement) {
@@ -255,6 +254,8 @@ std::string kindsText(const std::vector<std::pair<std::string, StrengthFit>> &by
     return out + "p = " + fmt(agreement.p_value, 2);
 }
 
+/// The first confirmed candidate that would explain the gap but for its kinds of observable
+/// asking for different strengths of it; null if none.
 const CandidateResult *disagreeing(const std::vector<CandidateResult> &candidates) {
     for (const CandidateResult &R : candidates)
         if (R.confirmed && R.beats_null && !R.after.gap && !R.fit.at_prior_edge &&
@@ -1405,8 +1406,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             }
         {
             std::vector<std::size_t> order(pairs.size());
-            for (std::size_t i = 0; i < order.size(); ++i)
-                order[i] = i;
+            std::iota(order.begin(), order.end(), std::size_t(0));
             std::stable_sort(order.begin(), order.end(), [&](std::size_t x, std::size_t y) {
                 return pairs[x].fit.chi2 < pairs[y].fit.chi2;
             });
@@ -1439,18 +1439,18 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             P.confirmed = true;
             // Each strength's interval spreads the prediction, as a single's does: without it a
             // pair predicted more sharply than any single, and a wrong pair beat the null at
-            // p = 5e-7 on LIGGGHTS' rolling-friction twin.
-            // Each read along the pair's own model, the other strength held at its fit (a zero
-            // offset moves a cohesive curve otherwise than the base's).
+            // p = 5e-7 on LIGGGHTS' rolling-friction twin. Each is read along the pair's own
+            // model, the other strength held at its fit (a zero offset moves a cohesive curve
+            // otherwise than the base's).
             const Eigen::VectorXd spread =
                 strengthSpread(PairSlice(*models[i], true, P.fit.b.strength), P.fit.a) +
                 strengthSpread(PairSlice(*models[i], false, P.fit.a.strength), P.fit.b);
             const bool better = evaluateModel(pair_rows[i], P.held_out, P.versus_null, P.after,
                                               P.confirmed_mean, P.confirmed_z, spread);
             pair_variance[i] = predictiveVariance(pair_rows[i], spread);
-            P.explains = better && P.versus_null.p_value < pair_level && !P.after.gap &&
-                         !D.held_out.empty() && !P.fit.a.at_prior_edge && !P.fit.b.at_prior_edge &&
-                         resolved && P.strengths_agree;
+            P.beats_null = better && P.versus_null.p_value < pair_level && !D.held_out.empty();
+            P.explains = P.beats_null && !P.after.gap && !P.fit.a.at_prior_edge &&
+                         !P.fit.b.at_prior_edge && resolved && P.strengths_agree;
         }
         // As for the singles: the best held-out prediction among the pairs without a gap is
         // told apart from every other pair that leaves no gap, and where one that explains is
@@ -1497,11 +1497,11 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         // pair predicting better but not claimable was not told apart).
         const PairResult *pair = bestWithoutGap(D.pairs);
         // The best pair would explain but for its kinds' agreement.
-        const PairResult *torn_pair =
-            pair && !pair->strengths_agree && pair->versus_null.p_value < D.pair_level &&
-                    !pair->fit.a.at_prior_edge && !pair->fit.b.at_prior_edge
-                ? pair
-                : nullptr;
+        const PairResult *torn_pair = pair && pair->beats_null && !pair->strengths_agree &&
+                                              !pair->fit.a.at_prior_edge &&
+                                              !pair->fit.b.at_prior_edge
+                                          ? pair
+                                          : nullptr;
         if (pair && (!pair->explains || pair_rival))
             pair = nullptr;
         if (pair) {

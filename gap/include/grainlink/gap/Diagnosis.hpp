@@ -132,6 +132,7 @@ struct PairResult {
     bool confirmed = false;
     HeldOutScore held_out;
     DensityComparison versus_null;
+    bool beats_null = false; ///< predicts the held-out experiments better, at the pairs' level
     bool explains = false;
     GapVerdict after;
     Eigen::VectorXd confirmed_mean;
