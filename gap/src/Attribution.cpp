@@ -398,31 +398,32 @@ Eigen::VectorXd PairResponse::variance(double sa, double sb) const {
     return (a_.variance(sa) + b_.variance(sb) - base_var_).cwiseMax(0.0);
 }
 
-ChainOnSoilResponse::ChainOnSoilResponse(const Prior &soil, std::vector<double> strengths,
-                                         std::vector<TabulatedResponse> rows, bool soil_is_a)
-    : soil_(soil), strengths_(std::move(strengths)), rows_(std::move(rows)), soil_is_a_(soil_is_a) {
+ChainOnEffectResponse::ChainOnEffectResponse(const Prior &under, std::vector<double> strengths,
+                                             std::vector<TabulatedResponse> rows, bool under_is_a)
+    : under_(under), strengths_(std::move(strengths)), rows_(std::move(rows)),
+      under_is_a_(under_is_a) {
     if (strengths_.size() < 2 || rows_.size() != strengths_.size())
-        throw std::invalid_argument("ChainOnSoilResponse: need >= 2 soil strengths, each with "
-                                    "the chain's response");
+        throw std::invalid_argument("ChainOnEffectResponse: need >= 2 strengths of the partner, "
+                                    "each with the chain's response");
 }
 
-TabulatedResponse ChainOnSoilResponse::soilTable(double s_chain) const {
+TabulatedResponse ChainOnEffectResponse::underTable(double s_chain) const {
     std::vector<Eigen::VectorXd> means, variances;
     for (const TabulatedResponse &row : rows_) {
         means.push_back(row.mean(s_chain));
         variances.push_back(row.variance(s_chain));
     }
-    return TabulatedResponse(soil_, strengths_, std::move(means), std::move(variances));
+    return TabulatedResponse(under_, strengths_, std::move(means), std::move(variances));
 }
 
-Eigen::VectorXd ChainOnSoilResponse::mean(double sa, double sb) const {
-    const double soil = soil_is_a_ ? sa : sb, chain = soil_is_a_ ? sb : sa;
-    return soilTable(chain).mean(soil);
+Eigen::VectorXd ChainOnEffectResponse::mean(double sa, double sb) const {
+    const double under = under_is_a_ ? sa : sb, chain = under_is_a_ ? sb : sa;
+    return underTable(chain).mean(under);
 }
 
-Eigen::VectorXd ChainOnSoilResponse::variance(double sa, double sb) const {
-    const double soil = soil_is_a_ ? sa : sb, chain = soil_is_a_ ? sb : sa;
-    return soilTable(chain).variance(soil);
+Eigen::VectorXd ChainOnEffectResponse::variance(double sa, double sb) const {
+    const double under = under_is_a_ ? sa : sb, chain = under_is_a_ ? sb : sa;
+    return underTable(chain).variance(under);
 }
 
 PairFit fitPair(const PairModel &pair, const Prior &pa, const Prior &pb,

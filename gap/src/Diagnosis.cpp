@@ -1281,10 +1281,26 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     std::optional<std::size_t> pair_rival; // in D.pairs: a pair the best cannot be told from
     double pair_rival_p = 1.0;
     if (!any_explains && !single_leaves_no_gap && resolved && claim_possible) {
-        std::vector<std::size_t> pool;
-        for (std::size_t i : applicable)
-            if (int(pool.size()) < opt.pair_pool && promising(i))
-                pool.push_back(i);
+        // The pairs fitted: the first `pair_pool` promising singles with each other, and the
+        // leader with every effect that acts on the design. A partner need not fit well alone:
+        // with a zero offset hidden beside it, a rig compliance fitted alone at a tenth of its
+        // strength ranked fifth, and offset + domain size was claimed in its place (p = 1e-6).
+        // Fitting a pair costs no run; only the best two are confirmed.
+        std::vector<std::pair<std::size_t, std::size_t>> combos; // indices into `live`
+        {
+            std::vector<std::size_t> pool;
+            for (std::size_t i : applicable)
+                if (int(pool.size()) < opt.pair_pool && promising(i))
+                    pool.push_back(i);
+            for (std::size_t a = 0; a < pool.size(); ++a)
+                for (std::size_t b = a + 1; b < pool.size(); ++b)
+                    combos.emplace_back(pool[a], pool[b]);
+            if (!pool.empty() && pool.front() == applicable.front())
+                for (std::size_t i : applicable)
+                    if (i != pool.front() && live[i].result.actsOnDesign() &&
+                        std::find(pool.begin(), pool.end(), i) == pool.end())
+                        combos.emplace_back(pool.front(), i);
+        }
         const auto rawEffect = [&](const std::string &name) -> const Effect * {
             for (const Effect *e : effects)
                 if (e->name == name)
@@ -1294,14 +1310,15 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const auto isChain = [&](const Live &L) {
             return L.result.effect.kind == Effect::Kind::Measurement;
         };
-        // A measuring-chain effect with one of the soil is read on the soil effect's own runs
-        // at each strength its table holds (`ChainOnSoilResponse`): runs already made, read
-        // through another sensor, all requested at once.
-        struct ChainOnSoil {
-            std::size_t soil, chain;                 // indices into `live`
-            std::vector<std::size_t> request_of_row; // first request of each soil strength
+        // A measuring-chain effect is read on its partner's own runs at each strength the
+        // partner's table holds (`ChainOnEffectResponse`): runs already made, read through
+        // another sensor, all requested at once. With two chain effects, the second on the
+        // first.
+        struct ChainOnEffect {
+            std::size_t under, chain;                // indices into `live`
+            std::vector<std::size_t> request_of_row; // first request of each strength under it
         };
-        std::vector<ChainOnSoil> chain_tables;
+        std::vector<ChainOnEffect> chain_tables;
         std::vector<VariantRequest> chain_requests;
         const auto nonOff = [](const TabulatedResponse &r, const Prior &p) {
             std::vector<double> out;
@@ -1310,45 +1327,42 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                     out.push_back(s);
             return out;
         };
-        for (std::size_t a = 0; a < pool.size(); ++a)
-            for (std::size_t b = a + 1; b < pool.size(); ++b) {
-                if (isChain(live[pool[a]]) == isChain(live[pool[b]]))
-                    continue;
-                ChainOnSoil t{isChain(live[pool[a]]) ? pool[b] : pool[a],
-                              isChain(live[pool[a]]) ? pool[a] : pool[b],
-                              {}};
-                const Live &soil = live[t.soil], &chain = live[t.chain];
-                for (double s : nonOff(*soil.response, soil.result.effect.prior)) {
-                    t.request_of_row.push_back(chain_requests.size());
-                    for (double c : nonOff(*chain.response, chain.result.effect.prior))
-                        chain_requests.push_back({chain.result.name + " " + fmt(c) + " on " +
-                                                      soil.result.name + " " + fmt(s),
-                                                  rawEffect(soil.result.name), s,
-                                                  rawEffect(chain.result.name), c, "",
-                                                  opt.signature_seeds});
-                }
-                chain_tables.push_back(std::move(t));
+        for (const auto &[a, b] : combos) {
+            if (!isChain(live[a]) && !isChain(live[b]))
+                continue;
+            ChainOnEffect t{isChain(live[b]) ? a : b, isChain(live[b]) ? b : a, {}};
+            const Live &under = live[t.under], &chain = live[t.chain];
+            for (double s : nonOff(*under.response, under.result.effect.prior)) {
+                t.request_of_row.push_back(chain_requests.size());
+                for (double c : nonOff(*chain.response, chain.result.effect.prior))
+                    chain_requests.push_back({chain.result.name + " " + fmt(c) + " on " +
+                                                  under.result.name + " " + fmt(s),
+                                              rawEffect(under.result.name), s,
+                                              rawEffect(chain.result.name), c, "",
+                                              opt.signature_seeds});
             }
+            chain_tables.push_back(std::move(t));
+        }
         if (!chain_requests.empty())
-            log("the measuring chain read on the soil effects' runs: " +
+            log("the measuring chain read on its partners' runs: " +
                 std::to_string(chain_requests.size()) + " variants");
         const auto chain_rows = simulateValid(chain_requests);
         for (const auto &r : chain_requests)
             D.simulations += r.seeds;
-        // The chain's table on each of the soil effect's strengths; none where a run failed
-        // (the pair is then taken as a sum, as two effects of the soil are).
-        const auto chainOnSoil = [&](const ChainOnSoil &t,
-                                     bool soil_is_a) -> std::unique_ptr<PairModel> {
-            const Live &soil = live[t.soil], &chain = live[t.chain];
-            const Prior &ps = soil.result.effect.prior, &pc = chain.result.effect.prior;
-            std::vector<double> strengths{ps.off};
+        // The chain's table on each of its partner's strengths; none where a run failed (the
+        // pair is then taken as a sum, as two effects of the soil are).
+        const auto chainOnEffect = [&](const ChainOnEffect &t,
+                                       bool under_is_a) -> std::unique_ptr<PairModel> {
+            const Live &under = live[t.under], &chain = live[t.chain];
+            const Prior &pu = under.result.effect.prior, &pc = chain.result.effect.prior;
+            std::vector<double> strengths{pu.off};
             std::vector<TabulatedResponse> rows{*chain.response};
-            const std::vector<double> soil_s = nonOff(*soil.response, ps),
+            const std::vector<double> under_s = nonOff(*under.response, pu),
                                       chain_s = nonOff(*chain.response, pc);
-            for (std::size_t i = 0; i < soil_s.size(); ++i) {
+            for (std::size_t i = 0; i < under_s.size(); ++i) {
                 std::vector<double> c{pc.off};
-                std::vector<Eigen::VectorXd> means{soil.response->mean(soil_s[i])},
-                    vars{soil.response->variance(soil_s[i])};
+                std::vector<Eigen::VectorXd> means{under.response->mean(under_s[i])},
+                    vars{under.response->variance(under_s[i])};
                 for (std::size_t j = 0; j < chain_s.size(); ++j) {
                     const auto mv = meanAndVariance(chain_rows[t.request_of_row[i] + j], bed_sd);
                     if (!coversBase(mv.first, means.front(), meas.keys))
@@ -1357,53 +1371,50 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                     means.push_back(mv.first);
                     vars.push_back(mv.second);
                 }
-                strengths.push_back(soil_s[i]);
+                strengths.push_back(under_s[i]);
                 rows.emplace_back(pc, c, means, vars);
             }
-            return std::make_unique<ChainOnSoilResponse>(ps, strengths, std::move(rows), soil_is_a);
+            return std::make_unique<ChainOnEffectResponse>(pu, strengths, std::move(rows),
+                                                           under_is_a);
         };
         std::vector<PairResult> pairs;
         std::vector<std::unique_ptr<PairModel>> models; // each pair's, in `pairs` order
         const auto off = meanAndVariance(firstRows(base_rows, opt.signature_seeds), bed_sd);
-        for (std::size_t a = 0; a < pool.size(); ++a)
-            for (std::size_t b = a + 1; b < pool.size(); ++b) {
-                const Live &A = live[pool[a]], &B = live[pool[b]];
-                PairResult P;
-                P.a = A.result.name;
-                P.b = B.result.name;
-                const Prior &pa = A.result.effect.prior, &pb = B.result.effect.prior;
-                std::unique_ptr<PairModel> model;
-                for (const ChainOnSoil &t : chain_tables)
-                    if ((t.soil == pool[a] && t.chain == pool[b]) ||
-                        (t.soil == pool[b] && t.chain == pool[a]))
-                        model = chainOnSoil(t, t.soil == pool[a]);
-                if (!model)
-                    model = std::make_unique<PairResponse>(*A.response, *B.response, off.first,
-                                                           off.second);
-                const auto fit = [&](const Eigen::VectorXd &measured) {
-                    return fitPair(*model, pa, pb, off.first, off.second, measured, u2_fixed,
-                                   D.calibration, correlation);
-                };
-                P.fit = fit(meas.value);
-                const auto refit = [&](const Eigen::VectorXd &pseudo) {
-                    const PairFit f = fit(pseudo);
-                    Eigen::VectorXd t(2);
-                    t << pa.toScale(f.a.strength), pb.toScale(f.b.strength);
-                    return t;
-                };
-                luck.widen(refit, model->mean(P.fit.a.strength, P.fit.b.strength),
-                           {{&P.fit.a, &pa}, {&P.fit.b, &pb}});
-                // Each strength by kind, the other held at its fit: a pair fitted where no kind
-                // alone asks for it absorbs a difference of model form, as a single does.
-                P.a_agreement =
-                    fitByKind(PairSlice(*model, true, P.fit.b.strength), pa, P.a_by_kind);
-                P.b_agreement =
-                    fitByKind(PairSlice(*model, false, P.fit.a.strength), pb, P.b_by_kind);
-                P.strengths_agree = P.a_agreement.p_value >= opt.agreement_level &&
-                                    P.b_agreement.p_value >= opt.agreement_level;
-                pairs.push_back(P);
-                models.push_back(std::move(model));
-            }
+        for (const auto &[a, b] : combos) {
+            const Live &A = live[a], &B = live[b];
+            PairResult P;
+            P.a = A.result.name;
+            P.b = B.result.name;
+            const Prior &pa = A.result.effect.prior, &pb = B.result.effect.prior;
+            std::unique_ptr<PairModel> model;
+            for (const ChainOnEffect &t : chain_tables)
+                if ((t.under == a && t.chain == b) || (t.under == b && t.chain == a))
+                    model = chainOnEffect(t, t.under == a);
+            if (!model)
+                model =
+                    std::make_unique<PairResponse>(*A.response, *B.response, off.first, off.second);
+            const auto fit = [&](const Eigen::VectorXd &measured) {
+                return fitPair(*model, pa, pb, off.first, off.second, measured, u2_fixed,
+                               D.calibration, correlation);
+            };
+            P.fit = fit(meas.value);
+            const auto refit = [&](const Eigen::VectorXd &pseudo) {
+                const PairFit f = fit(pseudo);
+                Eigen::VectorXd t(2);
+                t << pa.toScale(f.a.strength), pb.toScale(f.b.strength);
+                return t;
+            };
+            luck.widen(refit, model->mean(P.fit.a.strength, P.fit.b.strength),
+                       {{&P.fit.a, &pa}, {&P.fit.b, &pb}});
+            // Each strength by kind, the other held at its fit: a pair fitted where no kind
+            // alone asks for it absorbs a difference of model form, as a single does.
+            P.a_agreement = fitByKind(PairSlice(*model, true, P.fit.b.strength), pa, P.a_by_kind);
+            P.b_agreement = fitByKind(PairSlice(*model, false, P.fit.a.strength), pb, P.b_by_kind);
+            P.strengths_agree = P.a_agreement.p_value >= opt.agreement_level &&
+                                P.b_agreement.p_value >= opt.agreement_level;
+            pairs.push_back(P);
+            models.push_back(std::move(model));
+        }
         {
             std::vector<std::size_t> order(pairs.size());
             std::iota(order.begin(), order.end(), std::size_t(0));

@@ -197,7 +197,7 @@ TEST_CASE("a zero offset read on a soil effect's own runs is fitted with it wher
         }
         return TabulatedResponse(chain, at, means, vars);
     };
-    const ChainOnSoilResponse read({soil}, {1.0, 2.0}, {chainOn(1.0), chainOn(2.0)}, true);
+    const ChainOnEffectResponse read({soil}, {1.0, 2.0}, {chainOn(1.0), chainOn(2.0)}, true);
     const Eigen::VectorXd base = curve(1.0, 0.0), zero = Eigen::VectorXd::Zero(6);
     // Exact at a simulated soil strength and a tabulated offset; linear in s between.
     CHECK((read.mean(2.0, 0.375) - curve(2.0, 0.375)).norm() < 1e-9);

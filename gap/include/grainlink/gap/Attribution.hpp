@@ -163,27 +163,28 @@ private:
     Eigen::VectorXd base_mean_, base_var_;
 };
 
-/// An effect of the soil with one of the measuring chain, the chain read on the soil effect's
-/// own runs: at each strength the soil effect was simulated at, the chain's response over its
-/// grid (`rows[i]` at `strengths[i]`, the off value among them), and between those strengths
-/// interpolated as a table is. A chain's change is no sum with a soil effect's: a zero offset
-/// shifts whatever curve the soil gives, and added to a cohesion's change it fitted a hidden
-/// cohesion 4e4 J/m^3 with a 1 mm offset as 3.2e4 with 0.75 mm.
-class ChainOnSoilResponse final : public PairModel {
+/// An effect of the measuring chain with any other, the chain read on its partner's own runs:
+/// at each strength the partner was simulated at, the chain's response over its grid
+/// (`rows[i]` at `strengths[i]`, the off value among them), and between those strengths
+/// interpolated as a table is. A chain's change is no sum with another effect's: a zero offset
+/// shifts whatever curve the soil (or a compliant rig) gives, and added to a cohesion's change
+/// it fitted a hidden cohesion 4e4 J/m^3 with a 1 mm offset as 3.2e4 with 0.75 mm.
+class ChainOnEffectResponse final : public PairModel {
 public:
-    /// `soil_is_a`: the soil effect is the pair's first (strength `sa`).
-    ChainOnSoilResponse(const Prior &soil, std::vector<double> strengths,
-                        std::vector<TabulatedResponse> rows, bool soil_is_a);
+    /// `under`: the partner's prior; `under_is_a`: the partner is the pair's first (strength
+    /// `sa`).
+    ChainOnEffectResponse(const Prior &under, std::vector<double> strengths,
+                          std::vector<TabulatedResponse> rows, bool under_is_a);
     Eigen::VectorXd mean(double sa, double sb) const override;
     Eigen::VectorXd variance(double sa, double sb) const override;
 
 private:
-    /// The soil effect's table with the chain at `s_chain`.
-    TabulatedResponse soilTable(double s_chain) const;
-    Prior soil_;
+    /// The partner's table with the chain at `s_chain`.
+    TabulatedResponse underTable(double s_chain) const;
+    Prior under_;
     std::vector<double> strengths_;
     std::vector<TabulatedResponse> rows_;
-    bool soil_is_a_;
+    bool under_is_a_;
 };
 
 /// One strength of a pair with the other held: a response of one effect (the kinds' agreement
