@@ -971,7 +971,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 best = s;
         return best;
     };
-    D.overlap.assign(applicable.size(), std::vector<double>(applicable.size(), 1.0));
+    const std::vector<double> ones(applicable.size(), 1.0);
+    D.overlap.assign(applicable.size(), ones);
     for (std::size_t a = 0; a < applicable.size(); ++a)
         for (std::size_t b = 0; b < applicable.size(); ++b)
             if (a != b)
