@@ -269,6 +269,21 @@ TEST_CASE(
         applyMeasurementEffect(c.find("rig_compliance"), 1e-5, e, "pressure_Pa", curve);
     CHECK(rig.x[1] == Approx(0.01 + 1e-5 * 40000.0 * M_PI * 0.0025));
     CHECK(rig.x[0] == 0.0);
+    // Both at once, in either order (a pair of them reads one on the other's reads): the
+    // sinkage plus the offset plus the rig's deflection, 10 + 1 + 3.14 mm.
+    for (const auto &[first, second] : {std::pair{"sensor_zero_offset", "rig_compliance"},
+                                        std::pair{"rig_compliance", "sensor_zero_offset"}}) {
+        const auto strength = [](const std::string &name) {
+            return name == "rig_compliance" ? 1e-5 : 0.001;
+        };
+        const Curve once =
+            applyMeasurementEffect(c.find(first), strength(first), e, "pressure_Pa", curve);
+        const Curve both =
+            applyMeasurementEffect(c.find(second), strength(second), e, "pressure_Pa", once);
+        CHECK(both.x[0] == Approx(0.001));
+        CHECK(both.x[1] == Approx(0.01 + 0.001 + 1e-5 * 40000.0 * M_PI * 0.0025));
+        CHECK(both.y == curve.y);
+    }
 }
 
 TEST_CASE("an effects file with a bad expression or no signature is refused with its line",
