@@ -619,11 +619,24 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     log("design: " + std::to_string(set.experiments.size()) + " experiments, " +
         std::to_string(n) + " features");
 
+    // The runs asked for, each once (by the simulator's cache ids): the measuring chain's
+    // variants read runs already asked for (the base's, an effect's), and a run asked for again
+    // is not made twice. A simulator that names no ids: every seed of a request is a run.
+    std::set<std::string> asked;
+    const auto tally = [&](const ExperimentSet &on, const std::vector<VariantRequest> &requests) {
+        for (const VariantRequest &r : requests) {
+            const std::vector<std::string> ids = simulator.runIds(on, r);
+            if (ids.empty())
+                D.simulations += r.seeds;
+            for (const std::string &id : ids)
+                ++(asked.insert(id).second ? D.simulations : D.reads);
+        }
+    };
+
     // 1. Numerical uncertainty: the base over its seeds, and each numerical check.
     const std::vector<VariantRequest> first = firstRequests(simulator, opt);
     const auto first_rows = simulator.simulate(set, design, first);
-    for (const auto &r : first)
-        D.simulations += r.seeds;
+    tally(set, first);
     const Eigen::MatrixXd &base_rows = first_rows[0];
     std::vector<NumericalCheck> checks;
     for (std::size_t i = 1; i < first.size(); ++i)
@@ -820,8 +833,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     }
     log("signatures: " + std::to_string(sig.size()) + " variants");
     const auto sig_rows = simulator.simulate(set, design, sig);
-    for (const auto &r : sig)
-        D.simulations += r.seeds;
+    tally(set, sig);
     // One bed's scatter from every group of seeds so far: every response below (signatures,
     // confirmations, pairs) carries it, so that a fit follows the means, not the few seeds'
     // chance scatter (a 2-seed variance at one strength drew fits to its neighbours).
@@ -1108,8 +1120,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         confirm.push_back(confirmRequest(i));
     log("confirming " + std::to_string(confirm.size()) + " candidates");
     auto confirm_rows = simulateValid(confirm);
-    for (const auto &r : confirm)
-        D.simulations += r.seeds;
+    tally(set, confirm);
     // A candidate whose confirming runs failed predicts nothing: the next one by calibration
     // chi^2 is confirmed in its place (once), so that one failed run does not end the search.
     {
@@ -1131,8 +1142,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             for (std::size_t k = 0; k < more.size(); ++k) {
                 confirm.push_back(more[k]);
                 confirm_rows.push_back(more_rows[k]);
-                D.simulations += more[k].seeds;
             }
+            tally(set, more);
         }
     }
     // The signature is a coarse table: add each confirming run to it, refit, and where the
@@ -1173,10 +1184,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             }
         }
         const auto again_rows = simulateValid(again);
-        for (std::size_t i = 0; i < again.size(); ++i) {
-            D.simulations += again[i].seeds;
+        tally(set, again);
+        for (std::size_t i = 0; i < again.size(); ++i)
             final_rows[again_of[i]] = again_rows[i];
-        }
     }
     // The level is divided among the candidates that can be claimed: one whose confirming runs
     // failed predicts nothing (and failed whatever the held-out data say), so it takes no
@@ -1348,8 +1358,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             log("the measuring chain read on its partners' runs: " +
                 std::to_string(chain_requests.size()) + " variants");
         const auto chain_rows = simulateValid(chain_requests);
-        for (const auto &r : chain_requests)
-            D.simulations += r.seeds;
+        tally(set, chain_requests);
         // The chain's table on each of its partner's strengths; none where a run failed (the
         // pair is then taken as a sum, as two effects of the soil are).
         const auto chainOnEffect = [&](const ChainOnEffect &t,
@@ -1441,8 +1450,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         if (!pr.empty())
             log("no single effect explains the gap: confirming " + std::to_string(pr.size()) + " pairs");
         const auto pair_rows = simulateValid(pr);
-        for (const auto &r : pr)
-            D.simulations += r.seeds;
+        tally(set, pr);
         const double pair_level = opt.alpha / double(std::max<std::size_t>(1, judged + pr.size()));
         D.pair_level = pair_level;
         std::vector<Eigen::VectorXd> pair_variance(confirm_pairs);
@@ -1740,8 +1748,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                 log("probe " + probe.name + " not run: " + e.what());
                 continue;
             }
-            for (const auto &r : req)
-                D.simulations += r.seeds;
+            tally(probe, req);
             const ProbeSeparation ps = probeSeparation(rows);
             const double sep = ps.chi2.size() > 0 ? ps.chi2.sum() : 0.0;
             if (sep > best_sep && sep > 0.0) { // a probe that moves nothing names nothing

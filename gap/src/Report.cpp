@@ -236,6 +236,7 @@ Json toJson(const Diagnosis &d, const ExperimentSet &set) {
     j["unexplained"] = d.unexplained;
     j["claim_level"] = {{"single", number(d.single_level)}, {"pair", number(d.pair_level)}};
     j["simulations"] = d.simulations;
+    j["simulations_read"] = d.reads;
     return j;
 }
 
@@ -348,7 +349,10 @@ std::string reportText(const Diagnosis &d, const ExperimentSet &set) {
     }
     if (!d.unexplained.empty())
         r << "\nWhat remains beyond 2 u_val with the best model: " << d.unexplained << '\n';
-    r << "\nSimulations: " << d.simulations << " (variant x seed runs asked for; cached runs reused)\n";
+    r << "\nSimulations: " << d.simulations << " runs asked for (cached runs reused)";
+    if (d.reads > 0)
+        r << "; " << d.reads << " more asked for were read from those runs (the measuring chain)";
+    r << "\n";
     return r.str();
 }
 

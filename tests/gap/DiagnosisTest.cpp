@@ -143,10 +143,32 @@ public:
             "soil: {contact: {rolling: {model: none}, tangential: {stick_angle_deg: 30}}, "
             "deposition: {radius: {distribution: constant, value_m: 0.002}}}");
     }
+    /// Name each run by its soil variant, check and seed, as grainlink's cache does (the
+    /// measuring chain's effects read the run of the rest), and keep every id simulate is asked.
+    bool names_runs = false;
+    std::set<std::string> made;
+    int asked = 0;
+    std::vector<std::string> runIds(const ExperimentSet &, const VariantRequest &r) const override {
+        std::vector<std::string> ids;
+        if (!names_runs)
+            return ids;
+        std::string soil = r.check;
+        for (auto [eff, str] :
+             {std::pair{r.effect, r.strength}, std::pair{r.second, r.second_strength}})
+            if (eff && eff->kind != Effect::Kind::Measurement)
+                soil += " " + eff->name + "=" + std::to_string(str);
+        for (int s = 0; s < r.seeds; ++s)
+            ids.push_back(soil + " seed " + std::to_string(r.seed_offset + s));
+        return ids;
+    }
     std::vector<Eigen::MatrixXd> simulate(const ExperimentSet &set, const FeatureDesign &design,
                                           const std::vector<VariantRequest> &requests) override {
         std::vector<Eigen::MatrixXd> out;
         for (const VariantRequest &r : requests) {
+            for (const std::string &id : runIds(set, r)) {
+                made.insert(id);
+                ++asked;
+            }
             Eigen::MatrixXd rows(r.seeds, Eigen::Index(design.size()));
             for (int s = 0; s < r.seeds; ++s) {
                 std::mt19937 rng(1000 + s); // the same seeds for every variant
@@ -1773,6 +1795,30 @@ TEST_CASE("diagnosis: a rig compliance with a sensor zero offset is explained by
         "rig_compliance", {{1.5e-5, 0.001}, {3.0e-5, 0.001}, {3.0e-5, 0.0015}, {1.5e-5, 0.0015}},
         0.35);
     CHECK(explained >= 9);
+}
+
+TEST_CASE("diagnosis counts each run it asks for once: the measuring chain's variants read runs "
+          "already asked for",
+          "[gap][diagnosis]") {
+    // A cohesion with a zero offset goes through every step that asks for runs: the base and
+    // its check, the signatures (the offset's and the compliance's read the base's runs), the
+    // confirmations, the chain read on cohesion's runs and the pairs' confirmations.
+    AnalyticSimulator sim;
+    sim.names_runs = true;
+    const EffectCatalogue c = shippedEffects();
+    Truth t{"cohesion", 8.0e4};
+    t.zero_offset_m = 0.001;
+    const Diagnosis d = diagnose(measuredSet(t, 7), c.diagnosable(), sim, analyticOptions());
+    INFO(d.claim);
+    REQUIRE_FALSE(d.pairs.empty());
+    CHECK(d.simulations == int(sim.made.size()));
+    CHECK(d.simulations + d.reads == sim.asked);
+    // At least each measuring-chain signature: two effects, their strengths, three seeds.
+    int chain_signatures = 0;
+    for (const Effect *e : c.diagnosable())
+        if (e->kind == Effect::Kind::Measurement)
+            chain_signatures += int(e->signature.size()) * analyticOptions().signature_seeds;
+    CHECK(d.reads >= chain_signatures);
 }
 
 TEST_CASE("diagnosis: two pairs that each explain and that the held-out experiments cannot tell "

@@ -214,7 +214,12 @@ struct Diagnosis {
     std::string nearest_to_claim;
     std::string claim;        ///< one sentence: the result (and what was not compared)
     std::string unexplained;  ///< what remains (features still flagged after the best model)
-    int simulations = 0;      ///< variant x seed runs requested
+    /// The runs asked for, each once (cached runs reused): a variant on a seed, over a group of
+    /// experiments on one bed where the simulator runs them so.
+    int simulations = 0;
+    /// Variants answered by a run already asked for: the measuring chain's variants read the
+    /// runs of the base or of an effect of the soil (a zero offset reruns nothing).
+    int reads = 0;
     /// The levels a confirmed single and a confirmed pair are tested at against the null:
     /// alpha over the singles whose confirming runs ran (and the pairs confirmed); 0 when
     /// nothing was confirmed.
