@@ -33,8 +33,11 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 # the restitution of grainlink's viscous 0.2 N s/m at a typical contact of this bed (damping
 # ratio ~0.33). dt is 2e-5 s, not the self-test's 4e-5: with Mindlin's tangential spring both
 # codes press the plates 6-10x softer at 4e-5 s than at 2e-5 s (unresolved).
+# "scale" multiplies every grain's radius and divides the count by its cube (the same bed height):
+# finer grains than the base's, as a real soil always has.
 BASE = {"E": 2.7e7, "e": 0.3, "mu": math.tan(math.radians(32)), "mur": 0.3, "coh": 0.0,
-        "rho": 2400.0, "dt": 2.0e-5}
+        "rho": 2400.0, "dt": 2.0e-5, "scale": 1.0}
+RADII = (0.0018, 0.0019, 0.0020)  # m, the base's three grain sizes
 BOXES = {"wide": {"x0": 0.0, "x1": 0.05, "count": 1300, "height": 0.08},
          "narrow": {"x0": 0.0075, "x1": 0.0425, "count": 640, "height": 0.09}}
 PLATES = [("wide", 0.020), ("wide", 0.025), ("wide", 0.030), ("narrow", 0.020)]
@@ -135,7 +138,7 @@ def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("--out", required=True)
     parser.add_argument("--set", action="append", default=[],
-                        help="NAME=VALUE over the base soil: E, e, mu, mur, coh, rho, dt")
+                        help="NAME=VALUE over the base soil: E, e, mu, mur, coh, rho, dt, scale")
     parser.add_argument("--zero-offset", type=float, default=0.0, metavar="M",
                         help="add M metres to every written sinkage")
     parser.add_argument("--compliance", type=float, default=0.0, metavar="M_PER_N",
@@ -159,8 +162,10 @@ def main():
         seed = PRIMES[(opts.first_seed + rep) % len(PRIMES)]   # LIGGGHTS wants primes > 1e4
         for box_name, box in BOXES.items():
             bed = os.path.join(workdir, f"bed_{box_name}_{rep}.data")
-            run_liggghts("bed.in", dict(soil, x0=box["x0"], x1=box["x1"], height=box["height"],
-                                        count=box["count"], seed=seed,
+            radii = {f"r{i + 1}": r * soil["scale"] for i, r in enumerate(RADII)}
+            run_liggghts("bed.in", dict(soil, **radii, x0=box["x0"], x1=box["x1"],
+                                        height=box["height"],
+                                        count=round(box["count"] / soil["scale"] ** 3), seed=seed,
                                         settle_steps=int(SETTLE_S / soil["dt"]), out=bed), workdir)
             for plate_box, diameter in PLATES:
                 if plate_box != box_name:
