@@ -493,14 +493,28 @@ Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const
     return o;
 }
 
-namespace {
-/// log N(r | 0, v): one feature's log predictive density, the score both held-out measures use.
-double logDensity(double r, double v) { return -0.5 * (r * r / v + std::log(2.0 * M_PI * v)); }
-} // namespace
+double EstimatedVariance::dofOf(Eigen::Index k, double v) const {
+    if (variance.size() <= k || !(variance[k] > 0.0) || !(dof[k] > 0.0))
+        return std::numeric_limits<double>::infinity();
+    // Welch-Satterthwaite with every other part of v exact.
+    const double share = std::max(1.0, v / variance[k]);
+    return dof[k] * share * share;
+}
+
+double logPredictiveDensity(double r, double v, double dof) {
+    if (!(dof < 1e6))
+        return -0.5 * (r * r / v + std::log(2.0 * M_PI * v));
+    return std::lgamma(0.5 * (dof + 1.0)) - std::lgamma(0.5 * dof) -
+           0.5 * std::log(dof * M_PI * v) - 0.5 * (dof + 1.0) * std::log1p(r * r / (dof * v));
+}
+
+double logPredictiveSlope(double r, double v, double dof) {
+    return !(dof < 1e6) ? -r / v : -(dof + 1.0) * r / (dof * v + r * r);
+}
 
 HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd &predicted,
                           const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_val,
-                          const FeatureSet &use) {
+                          const FeatureSet &use, const EstimatedVariance &estimated) {
     HeldOutScore s;
     double se = 0.0, rel = 0.0, excess = 0.0;
     for (Eigen::Index k : use) {
@@ -514,7 +528,7 @@ HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd
         // near zero (a straight wheel's side force, traction at zero slip) weighted by 1/y^2
         // outweighed every other feature (the CMU wheels: 2.9x too much traction, gap "0 %").
         excess += (r * r - u2_val[k]) / (y * y + u2_val[k]);
-        s.log_density += logDensity(r, v);
+        s.log_density += logPredictiveDensity(r, v, estimated.dofOf(k, v));
     }
     if (s.features == 0)
         return s;
@@ -540,19 +554,22 @@ bool canCarryClaim(const FeatureSet &use, const std::vector<FeatureKey> &bed_key
             seeds >= 2);
 }
 
-DensityComparison
-compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_mean,
-                 const Eigen::VectorXd &model_variance, const Eigen::VectorXd &null_mean,
-                 const Eigen::VectorXd &null_variance, const FeatureSet &use,
-                 const std::vector<FeatureKey> &bed_keys,
-                 const std::vector<FeatureKey> &experiment_keys, const SharedLuck &shared) {
+DensityComparison compareDensities(const Eigen::VectorXd &measured,
+                                   const Eigen::VectorXd &model_mean,
+                                   const Eigen::VectorXd &model_variance,
+                                   const Eigen::VectorXd &null_mean,
+                                   const Eigen::VectorXd &null_variance, const FeatureSet &use,
+                                   const std::vector<FeatureKey> &bed_keys,
+                                   const std::vector<FeatureKey> &experiment_keys,
+                                   const SharedLuck &shared, const EstimatedVariance &estimated) {
     const auto gains = [&](const Eigen::VectorXd &model, const Eigen::VectorXd &null) {
         Eigen::VectorXd gain = Eigen::VectorXd::Constant(measured.size(), kNaN);
         for (Eigen::Index k : use) {
             const double rm = measured[k] - model[k], rn = measured[k] - null[k];
             const double vm = model_variance[k], vn = null_variance[k];
             if (std::isfinite(rm) && std::isfinite(rn) && vm > 0.0 && vn > 0.0)
-                gain[k] = logDensity(rm, vm) - logDensity(rn, vn);
+                gain[k] = logPredictiveDensity(rm, vm, estimated.dofOf(k, vm)) -
+                          logPredictiveDensity(rn, vn, estimated.dofOf(k, vn));
         }
         return gain;
     };
@@ -598,8 +615,10 @@ compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_m
             for (Eigen::Index k : scored) {
                 const double weight =
                     1.0 / (double(size.size()) * size[experiment_keys[std::size_t(k)].experiment]);
-                const double d_gain = (measured[k] - null_mean[k]) / null_variance[k] -
-                                      (measured[k] - model_mean[k]) / model_variance[k];
+                const double vm = model_variance[k], vn = null_variance[k];
+                const double d_gain =
+                    logPredictiveSlope(measured[k] - model_mean[k], vm, estimated.dofOf(k, vm)) -
+                    logPredictiveSlope(measured[k] - null_mean[k], vn, estimated.dofOf(k, vn));
                 if (std::isfinite(shared.measured_sd[k]))
                     shift[bed_keys[std::size_t(k)].experiment] +=
                         weight * d_gain * shared.measured_sd[k];

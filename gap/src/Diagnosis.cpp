@@ -688,6 +688,19 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     for (const auto &[name, u] : V.u_checks)
         u2_fixed += u.array().square().matrix();
     const Eigen::VectorXd u2_val = V.u_val.array().square();
+    // The parts of every prediction's variance estimated from few samples, for Student's t
+    // held-out densities (`EstimatedVariance`): the measured repeats' scatter (trials - 1
+    // degrees of freedom) and, where the measurement has no repeats on rebuilt beds, one
+    // simulated bed's (seeds - 1), combined by Welch-Satterthwaite as u_val's are.
+    EstimatedVariance estimated{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n)};
+    for (Eigen::Index k = 0; k < n; ++k) {
+        const double rep = meas.u_repeats[k] * meas.u_repeats[k], bed = V.u_bed[k] * V.u_bed[k];
+        const double nu_rep = meas.trials[k] - 1.0, nu_bed = double(base_rows.rows()) - 1.0;
+        const double den =
+            (nu_rep > 0.0 ? rep * rep / nu_rep : 0.0) + (nu_bed > 0.0 ? bed * bed / nu_bed : 0.0);
+        estimated.variance[k] = rep + bed;
+        estimated.dof[k] = den > 0.0 ? (rep + bed) * (rep + bed) / den : 0.0;
+    }
 
     // Calibration and held-out features.
     const std::vector<std::string> held_ids = heldOutIds(set, opt);
@@ -700,7 +713,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         (held_set.count(meas.keys[std::size_t(k)].experiment) ? D.held_out : D.calibration)
             .push_back(k);
     }
-    D.held_out_base = scoreHeldOut(meas.value, V.simulated, u2_val, u2_val, D.held_out);
+    D.held_out_base = scoreHeldOut(meas.value, V.simulated, u2_val, u2_val, D.held_out, estimated);
 
     // Held-out evidence is counted per group of experiments that the model simulates on the same
     // beds (`Simulator::bedGroup`; grainlink's: one type in one box, whose seeds share one
@@ -772,7 +785,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
             null_var[k] = u2_val[k] + V.simulated[k] * V.simulated[k] * p.variance[Eigen::Index(i)];
         }
     }
-    D.held_out_null = scoreHeldOut(meas.value, null_mean, null_var, u2_val, D.held_out);
+    D.held_out_null = scoreHeldOut(meas.value, null_mean, null_var, u2_val, D.held_out, estimated);
     D.null_mean = null_mean;
     D.null_variance = null_var;
 
@@ -861,7 +874,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         const Eigen::VectorXd pooled = meanAndVariance(base_rows, bed_sd).second;
         for (Eigen::Index k : D.held_out)
             null_var[k] += u2_fixed[k] + pooled[k] - u2_val[k];
-        D.held_out_null = scoreHeldOut(meas.value, null_mean, null_var, u2_val, D.held_out);
+        D.held_out_null =
+            scoreHeldOut(meas.value, null_mean, null_var, u2_val, D.held_out, estimated);
         D.null_variance = null_var;
     }
     for (std::size_t li = 0; li < live.size(); ++li) {
@@ -952,9 +966,9 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         L.result.ranking_chi2 = L.result.fit.chi2;
         L.result.calibration_gain = L.result.fit.chi2_off - L.result.fit.chi2;
         const Eigen::VectorXd m = L.response->mean(L.result.fit.strength);
-        L.result.predicted = scoreHeldOut(meas.value, m,
-                                          u2_fixed + L.response->variance(L.result.fit.strength),
-                                          u2_val, D.held_out);
+        L.result.predicted =
+            scoreHeldOut(meas.value, m, u2_fixed + L.response->variance(L.result.fit.strength),
+                         u2_val, D.held_out, estimated);
     }
     std::stable_sort(live.begin(), live.end(), [](const Live &a, const Live &b) {
         if (bool(a.response) != bool(b.response))
@@ -1031,10 +1045,10 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
         mean = mv.first;
         const Eigen::VectorXd var = u2_fixed + mv.second;
         const Eigen::VectorXd predictive = predictiveVariance(rows, strength_var);
-        score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out);
+        score = scoreHeldOut(meas.value, mean, predictive, u2_val, D.held_out, estimated);
         versus_null = compareDensities(
             meas.value, mean, predictive, null_mean, null_var, D.held_out, bed_keys, meas.keys,
-            leaveOneSeedOut(rows, base_rows, V.simulated, null_mean, measured_luck));
+            leaveOneSeedOut(rows, base_rows, V.simulated, null_mean, measured_luck), estimated);
         z = (meas.value - mean).array() / var.array().sqrt();
         for (Eigen::Index k = 0; k < z.size(); ++k)
             z[k] = normalEquivalent(z[k], V.dof[k]);
@@ -1245,7 +1259,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
                             const Eigen::MatrixXd &other_rows) {
         return compareDensities(
             meas.value, mean, variance, other_mean, other_variance, D.held_out, bed_keys, meas.keys,
-            leaveOneSeedOut(rows, other_rows, other_mean, other_mean, measured_luck));
+            leaveOneSeedOut(rows, other_rows, other_mean, other_mean, measured_luck), estimated);
     };
     const CandidateResult *twin_rival = nullptr;
     double twin_rival_p = 1.0; // the winner against it

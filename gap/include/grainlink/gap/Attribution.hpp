@@ -230,6 +230,24 @@ Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const
                          const Eigen::VectorXd &base_mean, const Eigen::VectorXd &u2,
                          const FeatureSet &use, const BlockCorrelation &correlation = {});
 
+/// The part of every predictive variance that is estimated from few samples: the measured
+/// mean's scatter from its repeats (trials - 1 degrees of freedom). A held-out feature's
+/// density is then Student's t of the Welch-Satterthwaite degrees of freedom of its
+/// predictive variance, the predictive distribution of a variance estimated so: scored as
+/// normal, a sharp model is charged r^2 / s^2, whose mean is infinite when s^2 has two degrees
+/// of freedom (three repeats), and one bin whose repeats happen to agree outweighs the rest.
+/// Empty: every variance is exact (normal densities).
+struct EstimatedVariance {
+    Eigen::VectorXd variance, dof;
+    /// Degrees of freedom of a predictive variance v holding feature k's estimated part.
+    double dofOf(Eigen::Index k, double v) const;
+};
+
+/// log density of r under a predictive variance v of `dof` degrees of freedom (normal when
+/// infinite), and its derivative in r.
+double logPredictiveDensity(double r, double v, double dof);
+double logPredictiveSlope(double r, double v, double dof);
+
 /// How well predictions match held-out features. `smse`: mean squared error standardised by
 /// the prediction's own variance; `relative_rmse`: root mean square of (measured - predicted)
 /// / measured; `gap`: that relative error in excess of the validation uncertainty `u2_val`
@@ -242,7 +260,7 @@ struct HeldOutScore {
 };
 HeldOutScore scoreHeldOut(const Eigen::VectorXd &measured, const Eigen::VectorXd &predicted,
                           const Eigen::VectorXd &variance, const Eigen::VectorXd &u2_val,
-                          const FeatureSet &use);
+                          const FeatureSet &use, const EstimatedVariance &estimated = {});
 
 /// What the held-out experiments of one group of beds share beyond their own scatter, for
 /// `compareDensities`: the model's and the null's predictions with one simulated bed left out
@@ -287,13 +305,12 @@ struct DensityComparison {
 bool canCarryClaim(const FeatureSet &use, const std::vector<FeatureKey> &bed_keys,
                    const std::vector<FeatureKey> &experiment_keys, std::size_t seeds);
 
-DensityComparison compareDensities(const Eigen::VectorXd &measured,
-                                   const Eigen::VectorXd &model_mean,
-                                   const Eigen::VectorXd &model_variance,
-                                   const Eigen::VectorXd &null_mean,
-                                   const Eigen::VectorXd &null_variance, const FeatureSet &use,
-                                   const std::vector<FeatureKey> &bed_keys,
-                                   const std::vector<FeatureKey> &experiment_keys = {},
-                                   const SharedLuck &shared = {});
+DensityComparison
+compareDensities(const Eigen::VectorXd &measured, const Eigen::VectorXd &model_mean,
+                 const Eigen::VectorXd &model_variance, const Eigen::VectorXd &null_mean,
+                 const Eigen::VectorXd &null_variance, const FeatureSet &use,
+                 const std::vector<FeatureKey> &bed_keys,
+                 const std::vector<FeatureKey> &experiment_keys = {}, const SharedLuck &shared = {},
+                 const EstimatedVariance &estimated = {});
 
 } // namespace grainlink::gap
