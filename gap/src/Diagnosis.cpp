@@ -695,7 +695,8 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     EstimatedVariance estimated{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n)};
     for (Eigen::Index k = 0; k < n; ++k) {
         const double rep = meas.u_repeats[k] * meas.u_repeats[k], bed = V.u_bed[k] * V.u_bed[k];
-        const double nu_rep = meas.trials[k] - 1.0, nu_bed = double(base_rows.rows()) - 1.0;
+        const double nu_rep = meas.trials[k] - 1.0,
+                     nu_bed = double(base_rows.col(k).array().isFinite().count()) - 1.0;
         const double den =
             (nu_rep > 0.0 ? rep * rep / nu_rep : 0.0) + (nu_bed > 0.0 ? bed * bed / nu_bed : 0.0);
         estimated.variance[k] = rep + bed;
