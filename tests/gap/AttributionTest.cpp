@@ -680,6 +680,25 @@ TEST_CASE("the measured beds' shared luck, carried through the gain, holds the l
     };
     CHECK(in(groups(2, 2, 2)).measured_variance == Approx(0.25).epsilon(1e-12));
     CHECK(in(groups(2, 2, 1)).measured_variance == Approx(0.125).epsilon(1e-12));
+    // The same with the null at 2 and the variances estimated from three repeats (all of v, 2
+    // dof): d gain / d y is the difference of Student's t slopes (here by a finite difference of
+    // Boost's pdf), -1 a feature where the normal's is -2, so one group's variance is 0.25.
+    {
+        const boost::math::students_t t2(2.0);
+        const auto logT = [&](double r) { return std::log(boost::math::pdf(t2, r)); };
+        const double h = 1e-6;
+        const double slope_null = (logT(-2.0 + h) - logT(-2.0 - h)) / (2.0 * h);
+        const double slope_model = (logT(h) - logT(-h)) / (2.0 * h);
+        const double shift = 4.0 * 0.25 * (slope_model - slope_null) * 0.5;
+        const EstimatedVariance estimated{unit, Eigen::VectorXd::Constant(4, 2.0)};
+        SharedLuck two = hand;
+        for (auto &m : two.null_mean)
+            m = 2.0 * unit;
+        const auto t = compareDensities(zero, zero, unit, 2.0 * unit, unit, all(4), groups(2, 2, 2),
+                                        blockKeys(2, 2), two, estimated);
+        CHECK(t.measured_variance == Approx(shift * shift).epsilon(1e-6));
+        CHECK(t.measured_variance == Approx(0.25).epsilon(1e-6));
+    }
 
     // Three plates measured on the same three beds (trial t of every plate on bed t, whose
     // luck, sd `luck`, moves all of them: as a twin's are), features of noise sd 0.3. The
