@@ -493,14 +493,6 @@ Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const
     return o;
 }
 
-double EstimatedVariance::dofOf(Eigen::Index k, double v) const {
-    if (variance.size() <= k || !(variance[k] > 0.0) || !(dof[k] > 0.0))
-        return std::numeric_limits<double>::infinity();
-    // Welch-Satterthwaite with every other part of v exact.
-    const double share = std::max(1.0, v / variance[k]);
-    return dof[k] * share * share;
-}
-
 double logPredictiveDensity(double r, double v, double dof) {
     if (!(dof < 1e6))
         return -0.5 * (r * r / v + std::log(2.0 * M_PI * v));

@@ -688,20 +688,7 @@ Diagnosis diagnose(const ExperimentSet &set, const std::vector<const Effect *> &
     for (const auto &[name, u] : V.u_checks)
         u2_fixed += u.array().square().matrix();
     const Eigen::VectorXd u2_val = V.u_val.array().square();
-    // The parts of every prediction's variance estimated from few samples, for Student's t
-    // held-out densities (`EstimatedVariance`): the measured repeats' scatter (trials - 1
-    // degrees of freedom) and, where the measurement has no repeats on rebuilt beds, one
-    // simulated bed's (seeds - 1), combined by Welch-Satterthwaite as u_val's are.
-    EstimatedVariance estimated{Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n)};
-    for (Eigen::Index k = 0; k < n; ++k) {
-        const double rep = meas.u_repeats[k] * meas.u_repeats[k], bed = V.u_bed[k] * V.u_bed[k];
-        const double nu_rep = meas.trials[k] - 1.0,
-                     nu_bed = double(base_rows.col(k).array().isFinite().count()) - 1.0;
-        const double den =
-            (nu_rep > 0.0 ? rep * rep / nu_rep : 0.0) + (nu_bed > 0.0 ? bed * bed / nu_bed : 0.0);
-        estimated.variance[k] = rep + bed;
-        estimated.dof[k] = den > 0.0 ? (rep + bed) * (rep + bed) / den : 0.0;
-    }
+    const EstimatedVariance &estimated = V.estimated; // Student's t held-out densities
 
     // Calibration and held-out features.
     const std::vector<std::string> held_ids = heldOutIds(set, opt);

@@ -49,6 +49,14 @@ double normalBound(double p) {
     return boost::math::quantile(boost::math::complement(boost::math::normal(), 0.5 * p));
 }
 
+double EstimatedVariance::dofOf(Eigen::Index k, double v) const {
+    if (variance.size() <= k || !(variance[k] > 0.0) || !(dof[k] > 0.0))
+        return std::numeric_limits<double>::infinity();
+    // Welch-Satterthwaite with every other part of v exact.
+    const double share = std::max(1.0, v / variance[k]);
+    return dof[k] * share * share;
+}
+
 double normalEquivalent(double t, double dof) {
     if (!std::isfinite(t) || !std::isfinite(dof) || dof > 1e6)
         return t;
@@ -157,6 +165,7 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
     v.standardised = v.residual.array() / v.u_val.array();
     v.dof.resize(n);
     v.z.resize(n);
+    v.estimated = {Eigen::VectorXd::Zero(n), Eigen::VectorXd::Zero(n)};
     for (Eigen::Index k = 0; k < n; ++k) {
         const double nu_seed = b.count[k] - 1.0;
         const double nu_rep = measured.trials[k] - 1.0;
@@ -170,6 +179,13 @@ ValidationResult validate(const Measured &measured, const Eigen::MatrixXd &base,
             den += std::pow(u_rep, 4) / nu_rep;
         v.dof[k] = den > 0.0 ? std::pow(v.u_val[k], 4) / den
                              : std::numeric_limits<double>::infinity();
+        // The same parts but the simulated mean's own scatter, which every prediction takes
+        // from the pooled scatter instead (Diagnosis, step 5).
+        const double rep = u_rep * u_rep, bed = v.u_bed[k] * v.u_bed[k];
+        const double est_den =
+            (nu_rep > 0.0 ? rep * rep / nu_rep : 0.0) + (nu_seed > 0.0 ? bed * bed / nu_seed : 0.0);
+        v.estimated.variance[k] = rep + bed;
+        v.estimated.dof[k] = est_den > 0.0 ? (rep + bed) * (rep + bed) / est_den : 0.0;
         v.z[k] = normalEquivalent(v.standardised[k], v.dof[k]);
     }
     v.ratio = v.simulated.array() / measured.value.array();

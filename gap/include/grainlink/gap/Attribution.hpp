@@ -6,6 +6,7 @@
 // (docs/gap.md, "Attribution" and "Confirmation").
 #include "grainlink/gap/Correlation.hpp"
 #include "grainlink/gap/Features.hpp"
+#include "grainlink/gap/Validation.hpp"
 
 #include <Eigen/Core>
 
@@ -229,20 +230,6 @@ struct Overlap {
 Overlap signatureOverlap(const Response &i, double s_i, const Response &j, const Prior &pj,
                          const Eigen::VectorXd &base_mean, const Eigen::VectorXd &u2,
                          const FeatureSet &use, const BlockCorrelation &correlation = {});
-
-/// The part of every predictive variance that is estimated from few samples, per feature, with
-/// its degrees of freedom: the measured mean's scatter from its repeats (trials - 1) and, where
-/// there are no repeats on rebuilt beds, one simulated bed's (seeds - 1). A held-out feature's
-/// density is then Student's t of the Welch-Satterthwaite degrees of freedom of its predictive
-/// variance, as a residual over a variance estimated so is distributed: scored as normal, a
-/// sharp model is charged r^2 / s^2, whose mean is infinite when s^2 has two degrees of freedom
-/// (three repeats), and one bin whose repeats happen to agree outweighs the rest.
-/// Empty: every variance is exact (normal densities).
-struct EstimatedVariance {
-    Eigen::VectorXd variance, dof;
-    /// Degrees of freedom of a predictive variance v holding feature k's estimated part.
-    double dofOf(Eigen::Index k, double v) const;
-};
 
 /// log density of r under a predictive variance v of `dof` degrees of freedom (normal when
 /// infinite), and its derivative in r.

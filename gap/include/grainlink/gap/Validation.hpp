@@ -36,6 +36,20 @@ struct NumericalCheck {
     Eigen::MatrixXd rows; ///< seeds x features
 };
 
+/// The part of every predictive variance that is estimated from few samples, per feature, with
+/// its degrees of freedom: the measured mean's scatter from its repeats (trials - 1) and, where
+/// there are no repeats on rebuilt beds, one simulated bed's (seeds - 1). A held-out feature's
+/// density is then Student's t of the Welch-Satterthwaite degrees of freedom of its predictive
+/// variance, as a residual over a variance estimated so is distributed: scored as normal, a
+/// sharp model is charged r^2 / s^2, whose mean is infinite when s^2 has two degrees of freedom
+/// (three repeats), and one bin whose repeats happen to agree outweighs the rest.
+/// Empty: every variance is exact (normal densities).
+struct EstimatedVariance {
+    Eigen::VectorXd variance, dof;
+    /// Degrees of freedom of a predictive variance v holding feature k's estimated part.
+    double dofOf(Eigen::Index k, double v) const;
+};
+
 /// Every part of u_val, per feature, and the residuals it standardises.
 struct ValidationResult {
     Eigen::VectorXd simulated;  ///< base mean over seeds
@@ -54,6 +68,9 @@ struct ValidationResult {
     /// Degrees of freedom of u_val (Welch-Satterthwaite: the seeds' and repeats' scatter are
     /// estimates from few samples; stated uncertainties and checks count as exact).
     Eigen::VectorXd dof;
+    /// The parts of a prediction's variance estimated from few samples (the repeats' scatter,
+    /// one simulated bed's where there are no repeats): what the held-out densities read.
+    EstimatedVariance estimated;
     /// The standardised residual as the normal deviate of the same tail probability under
     /// Student's t with `dof`: what the gap test and the flags use.
     Eigen::VectorXd z;
